@@ -1,0 +1,72 @@
+// `labelmesh info FILE [--json]`: what a volume holds and where it sits.
+#include <CLI/CLI.hpp>
+
+#include <cstdio>
+#include <memory>
+
+#include "client/commands.h"
+#include "client/exit_codes.h"
+#include "core/pipeline.h"
+#include "core/report.h"
+
+namespace labelmesh::client {
+namespace {
+
+struct InfoOptions {
+  std::string path;
+  bool json = false;
+  uint64_t max_voxels = volume::ReadLimits{}.max_voxels;
+};
+
+void print_text(const std::string& path, const v1::InputSummary& s) {
+  std::printf("file         %s\n", path.c_str());
+  std::printf("format       %s\n", s.format().c_str());
+  std::printf("dims         %u x %u x %u\n", s.dims(0), s.dims(1), s.dims(2));
+  std::printf("spacing      %.6g x %.6g x %.6g mm\n", s.spacing(0), s.spacing(1), s.spacing(2));
+  std::printf("origin       %.6g %.6g %.6g mm\n", s.origin(0), s.origin(1), s.origin(2));
+  std::printf(
+      "direction    [%.6g %.6g %.6g; %.6g %.6g %.6g; %.6g %.6g %.6g] (columns = voxel axes)\n",
+      s.direction(0), s.direction(1), s.direction(2), s.direction(3), s.direction(4),
+      s.direction(5), s.direction(6), s.direction(7), s.direction(8));
+  std::printf("convention   %s\n", s.convention().c_str());
+  std::printf("voxel type   %s\n", s.voxel_type().c_str());
+  std::printf("background   %llu voxels\n", static_cast<unsigned long long>(s.background_voxels()));
+  std::printf("labels       %d\n", s.labels_size());
+  std::printf("  %10s %14s %16s\n", "label", "voxels", "volume (mm3)");
+  for (const auto& label : s.labels()) {
+    std::printf("  %10d %14llu %16.3f\n", label.label(),
+                static_cast<unsigned long long>(label.voxels()), label.volume_mm3());
+  }
+}
+
+}  // namespace
+
+CommandRunner add_info_command(CLI::App& app) {
+  auto options = std::make_shared<InfoOptions>();
+  CLI::App* info = app.add_subcommand("info", "Show a label volume's geometry and labels");
+  info->add_option("file", options->path,
+                   "Label volume (.nii .nii.gz .mha .mhd .nrrd .nhdr .inr .inr.gz .vti)")
+      ->required();
+  info->add_flag("--json", options->json, "Print the summary as protobuf JSON (InputSummary)");
+  info->add_option("--max-voxels", options->max_voxels, "Refuse volumes with more voxels than this")
+      ->capture_default_str();
+  info->footer(kExitCodeHelp);
+  return [options] {
+    volume::ReadLimits limits;
+    limits.max_voxels = options->max_voxels;
+    auto summary = summarise_volume(options->path, limits, RunContext{});
+    if (!summary.ok()) {
+      std::fprintf(stderr, "labelmesh info: %s\n", std::string(summary.status().message()).c_str());
+      return exit_code_for(summary.status());
+    }
+    const auto input = make_input_summary(*summary);
+    if (options->json) {
+      std::printf("%s\n", to_json(input).c_str());
+    } else {
+      print_text(options->path, input);
+    }
+    return int{kExitSuccess};
+  };
+}
+
+}  // namespace labelmesh::client

@@ -1,0 +1,35 @@
+// labelmesh: segmented label volumes in, surface meshes and a quality report out.
+#include <CLI/CLI.hpp>
+
+#include <cstdio>
+#include <map>
+
+#include "client/commands.h"
+#include "client/exit_codes.h"
+
+int main(int argc, char** argv) {
+  using namespace labelmesh::client;
+  CLI::App app{"labelmesh " LABELMESH_VERSION
+               ": meshes segmented medical label volumes (NIfTI, MetaImage, NRRD, INR, VTI).\n"
+               "Coordinates are in millimetres, in the input's patient space, LPS convention."};
+  app.require_subcommand(1);
+  app.footer(kExitCodeHelp);
+  std::map<const CLI::App*, CommandRunner> runners;
+  for (auto add : {add_info_command, add_mesh_command, add_phantom_command}) {
+    const size_t before = app.get_subcommands({}).size();
+    CommandRunner runner = add(app);
+    runners[app.get_subcommands({}).at(before)] = std::move(runner);
+  }
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::Success& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    app.exit(e);
+    return kExitUsage;
+  }
+  for (const auto& [subcommand, runner] : runners) {
+    if (subcommand->parsed()) return runner();
+  }
+  return kExitUsage;
+}

@@ -1,0 +1,134 @@
+#include "core/pipeline.h"
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+
+#include "core/report.h"
+#include "core/surface/extract_surfaces.h"
+#include "core/surface/write_surface.h"
+#include "core/text.h"
+#include "core/volume/read_label_volume.h"
+
+namespace labelmesh {
+namespace {
+
+// Times one stage and appends it to `stages`.
+class StageTimer {
+ public:
+  StageTimer(std::vector<StageTiming>& stages, std::string name)
+      : stages_(stages), name_(std::move(name)), start_(std::chrono::steady_clock::now()) {}
+  ~StageTimer() {
+    const std::chrono::duration<double> elapsed = std::chrono::steady_clock::now() - start_;
+    stages_.push_back({name_, elapsed.count()});
+  }
+
+ private:
+  std::vector<StageTiming>& stages_;
+  std::string name_;
+  std::chrono::steady_clock::time_point start_;
+};
+
+// The labels to mesh: those asked for (each must be present), or all.
+absl::StatusOr<std::vector<int32_t>> choose_labels(const std::string& path,
+                                                   const volume::VolumeStatistics& statistics,
+                                                   const std::vector<int32_t>& asked) {
+  std::vector<int32_t> labels;
+  if (asked.empty()) {
+    for (const auto& label : statistics.labels) labels.push_back(label.label);
+    if (labels.empty()) {
+      return absl::FailedPreconditionError(
+          cat(path, ": the volume holds only background (label 0); nothing to mesh"));
+    }
+    return labels;
+  }
+  for (int32_t label : asked) {
+    if (label == 0)
+      return absl::InvalidArgumentError("labels: 0 is the background and has no surface");
+    if (statistics.find(label) == nullptr) {
+      return absl::InvalidArgumentError(cat("labels: ", path, " has no voxel with label ", label));
+    }
+    if (std::find(labels.begin(), labels.end(), label) == labels.end()) labels.push_back(label);
+  }
+  return labels;
+}
+
+}  // namespace
+
+absl::StatusOr<VolumeSummary> summarise_volume(const std::string& path,
+                                               const volume::ReadLimits& limits,
+                                               const RunContext& context) {
+  auto volume = volume::read_label_volume(path, limits, context);
+  if (!volume.ok()) return volume.status();
+  return VolumeSummary{volume->format, volume->file_voxel_type, volume->geometry,
+                       volume::compute_label_statistics(*volume)};
+}
+
+absl::StatusOr<MeshResult> run_pipeline(const std::string& path, const MeshParams& params,
+                                        const RunContext& context) {
+  MeshResult result;
+  absl::StatusOr<volume::LabelVolume> volume;
+  {
+    StageTimer timer(result.stages, "read");
+    context.report("read", 0);
+    volume = volume::read_label_volume(path, params.limits, context);
+  }
+  if (!volume.ok()) return volume.status();
+  {
+    StageTimer timer(result.stages, "label_statistics");
+    result.input = {volume->format, volume->file_voxel_type, volume->geometry,
+                    volume::compute_label_statistics(*volume)};
+  }
+  auto labels = choose_labels(path, result.input.statistics, params.labels);
+  if (!labels.ok()) return labels.status();
+
+  absl::StatusOr<std::vector<surface::LabelSurface>> surfaces;
+  {
+    StageTimer timer(result.stages, "marching_cubes");
+    context.report("marching_cubes", 0);
+    surfaces = surface::extract_surfaces(*volume, result.input.statistics, *labels, context);
+  }
+  if (!surfaces.ok()) return surfaces.status();
+  {
+    StageTimer timer(result.stages, "surface_statistics");
+    for (auto& extracted : *surfaces) {
+      SurfaceResult surface;
+      surface.label = extracted.label;
+      surface.stage = "marching_cubes";
+      surface.statistics = surface::compute_surface_statistics(extracted.mesh);
+      surface.mesh = std::move(extracted.mesh);
+      result.surfaces.push_back(std::move(surface));
+    }
+  }
+  return result;
+}
+
+absl::Status write_results(MeshResult& result, const MeshParams& params, const std::string& out_dir,
+                           const RunContext& context) {
+  std::error_code error;
+  std::filesystem::create_directories(out_dir, error);
+  if (error) return absl::InternalError(cat(out_dir, ": cannot create the directory"));
+  {
+    StageTimer timer(result.stages, "write");
+    size_t done = 0;
+    for (auto& surface : result.surfaces) {
+      if (auto s = context.check_stop(); !s.ok()) return s;
+      surface.files.clear();
+      for (auto format : params.formats) {
+        const std::string name =
+            cat("surface-label", surface.label, ".", surface::surface_format_name(format));
+        const auto path = (std::filesystem::path(out_dir) / name).string();
+        if (auto s = surface::write_surface(surface.mesh, path, format); !s.ok()) return s;
+        surface.files.push_back(name);
+      }
+      context.report("write", double(++done) / double(result.surfaces.size()));
+    }
+  }
+  const auto report_path = (std::filesystem::path(out_dir) / "report.json").string();
+  std::ofstream out(report_path);
+  out << report_json(result, params);
+  if (!out) return absl::InternalError(cat(report_path, ": could not write the report"));
+  return absl::OkStatus();
+}
+
+}  // namespace labelmesh

@@ -1,0 +1,30 @@
+// Marching Cubes surfaces of labels (paper §2.2), with VTK's discrete flying
+// edges: one closed surface per label, in patient (LPS) space, outward.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "core/run_context.h"
+#include "core/surface/triangle_mesh.h"
+#include "core/volume/label_statistics.h"
+#include "core/volume/label_volume.h"
+
+namespace labelmesh::surface {
+
+struct LabelSurface {
+  int32_t label = 0;
+  TriangleMesh mesh;
+};
+
+// Extracts the boundary of each of `labels` (each must be present in
+// `statistics`). Each label is cut to its bounding box plus one voxel of
+// background, so a label touching the volume's edge still gets a closed
+// surface. Vertices sit on voxel faces, halfway between voxel centres.
+// Errors: INVALID_ARGUMENT for an absent label, CANCELLED.
+absl::StatusOr<std::vector<LabelSurface>> extract_surfaces(
+    const volume::LabelVolume& volume, const volume::VolumeStatistics& statistics,
+    const std::vector<int32_t>& labels, const RunContext& context);
+
+}  // namespace labelmesh::surface

@@ -1,0 +1,179 @@
+#include "core/surface/surface_statistics.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <numeric>
+
+namespace labelmesh::surface {
+namespace {
+
+using Vec = std::array<double, 3>;
+
+Vec sub(const Vec& a, const Vec& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
+double dot(const Vec& a, const Vec& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+Vec cross(const Vec& a, const Vec& b) {
+  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+}
+double norm(const Vec& a) { return std::sqrt(dot(a, a)); }
+
+// Angle between two edge vectors, degrees; robust near 0 and 180.
+double angle_deg(const Vec& u, const Vec& v) {
+  return std::atan2(norm(cross(u, v)), dot(u, v)) * 180.0 / std::numbers::pi;
+}
+
+class DisjointSets {
+ public:
+  explicit DisjointSets(size_t n) : parent_(n) { std::iota(parent_.begin(), parent_.end(), 0u); }
+  uint32_t find(uint32_t x) {
+    while (parent_[x] != x) x = parent_[x] = parent_[parent_[x]];
+    return x;
+  }
+  bool unite(uint32_t a, uint32_t b) {
+    a = find(a);
+    b = find(b);
+    if (a == b) return false;
+    parent_[b] = a;
+    return true;
+  }
+
+ private:
+  std::vector<uint32_t> parent_;
+};
+
+// A reference point near the surface keeps the volume sum well conditioned.
+Vec centre_of(const TriangleMesh& mesh) {
+  Vec lo{std::numeric_limits<double>::max(), std::numeric_limits<double>::max(),
+         std::numeric_limits<double>::max()};
+  Vec hi{-lo[0], -lo[1], -lo[2]};
+  for (const auto& p : mesh.points) {
+    for (int c = 0; c < 3; ++c) {
+      lo[c] = std::min(lo[c], p[c]);
+      hi[c] = std::max(hi[c], p[c]);
+    }
+  }
+  return mesh.points.empty() ? Vec{0, 0, 0}
+                             : Vec{(lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, (lo[2] + hi[2]) / 2};
+}
+
+// Counts vertices whose link (the edges opposite them) is not one path or cycle.
+uint32_t count_non_manifold_vertices(const TriangleMesh& mesh) {
+  const size_t n = mesh.points.size();
+  std::vector<uint32_t> offsets(n + 1, 0);
+  for (const auto& t : mesh.triangles) {
+    for (uint32_t v : t) ++offsets[v + 1];
+  }
+  std::partial_sum(offsets.begin(), offsets.end(), offsets.begin());
+  std::vector<std::array<uint32_t, 2>> links(offsets.back());
+  std::vector<uint32_t> fill(offsets.begin(), offsets.end() - 1);
+  for (const auto& t : mesh.triangles) {
+    links[fill[t[0]]++] = {t[1], t[2]};
+    links[fill[t[1]]++] = {t[2], t[0]};
+    links[fill[t[2]]++] = {t[0], t[1]};
+  }
+  uint32_t count = 0;
+  std::vector<uint32_t> local, parent;
+  for (size_t v = 0; v < n; ++v) {
+    if (offsets[v] == offsets[v + 1]) continue;
+    local.clear();
+    for (uint32_t e = offsets[v]; e < offsets[v + 1]; ++e) {
+      local.push_back(links[e][0]);
+      local.push_back(links[e][1]);
+    }
+    std::sort(local.begin(), local.end());
+    local.erase(std::unique(local.begin(), local.end()), local.end());
+    parent.resize(local.size());
+    std::iota(parent.begin(), parent.end(), 0u);
+    auto slot = [&](uint32_t id) {
+      return static_cast<uint32_t>(std::lower_bound(local.begin(), local.end(), id) -
+                                   local.begin());
+    };
+    auto root = [&](uint32_t x) {
+      while (parent[x] != x) x = parent[x] = parent[parent[x]];
+      return x;
+    };
+    size_t groups = local.size();
+    for (uint32_t e = offsets[v]; e < offsets[v + 1]; ++e) {
+      const uint32_t a = root(slot(links[e][0])), b = root(slot(links[e][1]));
+      if (a != b) {
+        parent[b] = a;
+        --groups;
+      }
+    }
+    if (groups > 1) ++count;
+  }
+  return count;
+}
+
+}  // namespace
+
+double signed_volume(const TriangleMesh& mesh) {
+  const Vec o = centre_of(mesh);
+  double six_volume = 0;
+  for (const auto& t : mesh.triangles) {
+    const Vec a = sub(mesh.points[t[0]], o), b = sub(mesh.points[t[1]], o),
+              c = sub(mesh.points[t[2]], o);
+    six_volume += dot(a, cross(b, c));
+  }
+  return six_volume / 6.0;
+}
+
+SurfaceStatistics compute_surface_statistics(const TriangleMesh& mesh) {
+  SurfaceStatistics s;
+  s.nodes = static_cast<uint32_t>(mesh.points.size());
+  s.triangles = static_cast<uint32_t>(mesh.triangles.size());
+  if (mesh.triangles.empty()) return s;
+
+  s.min_angle_deg = 180;
+  s.max_angle_deg = 0;
+  std::vector<uint64_t> edges;
+  edges.reserve(3 * mesh.triangles.size());
+  std::vector<char> used(mesh.points.size(), 0);
+  DisjointSets sets(mesh.points.size());
+  for (const auto& t : mesh.triangles) {
+    const Vec& p0 = mesh.points[t[0]];
+    const Vec& p1 = mesh.points[t[1]];
+    const Vec& p2 = mesh.points[t[2]];
+    const double angles[3] = {angle_deg(sub(p1, p0), sub(p2, p0)),
+                              angle_deg(sub(p2, p1), sub(p0, p1)),
+                              angle_deg(sub(p0, p2), sub(p1, p2))};
+    for (double a : angles) {
+      s.min_angle_deg = std::min(s.min_angle_deg, a);
+      s.max_angle_deg = std::max(s.max_angle_deg, a);
+    }
+    s.area_mm2 += 0.5 * norm(cross(sub(p1, p0), sub(p2, p0)));
+    for (int e = 0; e < 3; ++e) {
+      const uint32_t a = t[e], b = t[(e + 1) % 3];
+      edges.push_back(uint64_t{std::min(a, b)} << 32 | std::max(a, b));
+      used[a] = 1;
+    }
+    sets.unite(t[0], t[1]);
+    sets.unite(t[0], t[2]);
+  }
+  std::sort(edges.begin(), edges.end());
+  int64_t unique_edges = 0;
+  for (size_t i = 0; i < edges.size();) {
+    size_t j = i + 1;
+    while (j < edges.size() && edges[j] == edges[i]) ++j;
+    ++unique_edges;
+    if (j - i == 1) ++s.boundary_edges;
+    if (j - i > 2) ++s.non_manifold_edges;
+    i = j;
+  }
+  int64_t used_vertices = 0;
+  for (size_t v = 0; v < used.size(); ++v) {
+    if (!used[v]) continue;
+    ++used_vertices;
+    if (sets.find(static_cast<uint32_t>(v)) == v) ++s.components;
+  }
+  s.non_manifold_vertices = count_non_manifold_vertices(mesh);
+  s.closed = s.boundary_edges == 0;
+  s.manifold = s.non_manifold_edges == 0 && s.non_manifold_vertices == 0;
+  s.euler_characteristic =
+      used_vertices - unique_edges + static_cast<int64_t>(mesh.triangles.size());
+  s.volume_mm3 = signed_volume(mesh);
+  return s;
+}
+
+}  // namespace labelmesh::surface

@@ -1,0 +1,36 @@
+// Surface mesh files: STL (binary), PLY (binary), OBJ, OFF and VTP.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <vtkSmartPointer.h>
+
+#include "absl/status/status.h"
+#include "core/surface/triangle_mesh.h"
+
+class vtkPolyData;
+
+namespace labelmesh::surface {
+
+enum class SurfaceFormat { kStl, kPly, kObj, kOff, kVtp };
+
+// "stl", "ply", "obj", "off" or "vtp"; nullopt otherwise.
+std::optional<SurfaceFormat> surface_format_from_name(std::string_view name);
+// The file extension without the dot; also the format's name.
+std::string_view surface_format_name(SurfaceFormat format);
+const std::vector<SurfaceFormat>& all_surface_formats();
+
+// The mesh as VTK polygons (points in mm, triangles as given).
+vtkSmartPointer<vtkPolyData> to_polydata(const TriangleMesh& mesh);
+
+// Writes `mesh` to `path`. VTK's writers do STL, PLY, OBJ and VTP; CGAL's does
+// OFF. Errors: INTERNAL naming the file when it cannot be written.
+absl::Status write_surface(const TriangleMesh& mesh, const std::string& path, SurfaceFormat format);
+
+// OFF through CGAL's polygon-soup writer (write_off.cc keeps CGAL out of here).
+absl::Status write_off(const TriangleMesh& mesh, const std::string& path);
+
+}  // namespace labelmesh::surface

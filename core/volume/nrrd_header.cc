@@ -1,0 +1,222 @@
+// NRRD (.nrrd attached, .nhdr detached) header checks, after the NRRD0004/5
+// format definition: "field: value" lines, a blank line before attached data.
+#include <cmath>
+
+#include "core/text.h"
+#include "core/volume/header_checks.h"
+#include "core/volume/header_formats.h"
+#include "core/volume/text_header.h"
+
+namespace labelmesh::volume::internal {
+namespace {
+
+absl::StatusOr<ScalarType> nrrd_scalar_type(const std::string& path, std::string_view name) {
+  struct Known {
+    std::string_view name;
+    ScalarType type;
+  };
+  static constexpr Known kKnown[] = {{"signed char", ScalarType::kInt8},
+                                     {"int8", ScalarType::kInt8},
+                                     {"int8_t", ScalarType::kInt8},
+                                     {"uchar", ScalarType::kUInt8},
+                                     {"unsigned char", ScalarType::kUInt8},
+                                     {"uint8", ScalarType::kUInt8},
+                                     {"uint8_t", ScalarType::kUInt8},
+                                     {"short", ScalarType::kInt16},
+                                     {"short int", ScalarType::kInt16},
+                                     {"signed short", ScalarType::kInt16},
+                                     {"signed short int", ScalarType::kInt16},
+                                     {"int16", ScalarType::kInt16},
+                                     {"int16_t", ScalarType::kInt16},
+                                     {"ushort", ScalarType::kUInt16},
+                                     {"unsigned short", ScalarType::kUInt16},
+                                     {"unsigned short int", ScalarType::kUInt16},
+                                     {"uint16", ScalarType::kUInt16},
+                                     {"uint16_t", ScalarType::kUInt16},
+                                     {"int", ScalarType::kInt32},
+                                     {"signed int", ScalarType::kInt32},
+                                     {"int32", ScalarType::kInt32},
+                                     {"int32_t", ScalarType::kInt32},
+                                     {"uint", ScalarType::kUInt32},
+                                     {"unsigned int", ScalarType::kUInt32},
+                                     {"uint32", ScalarType::kUInt32},
+                                     {"uint32_t", ScalarType::kUInt32},
+                                     {"longlong", ScalarType::kInt64},
+                                     {"long long", ScalarType::kInt64},
+                                     {"long long int", ScalarType::kInt64},
+                                     {"signed long long", ScalarType::kInt64},
+                                     {"signed long long int", ScalarType::kInt64},
+                                     {"int64", ScalarType::kInt64},
+                                     {"int64_t", ScalarType::kInt64},
+                                     {"ulonglong", ScalarType::kUInt64},
+                                     {"unsigned long long", ScalarType::kUInt64},
+                                     {"unsigned long long int", ScalarType::kUInt64},
+                                     {"uint64", ScalarType::kUInt64},
+                                     {"uint64_t", ScalarType::kUInt64},
+                                     {"float", ScalarType::kFloat32},
+                                     {"double", ScalarType::kFloat64}};
+  for (const auto& known : kKnown) {
+    if (known.name == name) return known.type;
+  }
+  return field_error(path, "type", "is not an integer or real scalar type");
+}
+
+// Sign flips that take a NRRD space to LPS, per coordinate.
+absl::StatusOr<std::array<double, 3>> nrrd_space_to_lps(const std::string& path,
+                                                        std::string_view space) {
+  if (space == "left-posterior-superior" || space == "LPS") return std::array<double, 3>{1, 1, 1};
+  if (space == "right-anterior-superior" || space == "RAS") return std::array<double, 3>{-1, -1, 1};
+  if (space == "left-anterior-superior" || space == "LAS") return std::array<double, 3>{1, -1, 1};
+  // No anatomical frame: taken as LPS, as stored.
+  if (space == "scanner-xyz" || space == "3D-right-handed") return std::array<double, 3>{1, 1, 1};
+  return field_error(path, "space",
+                     "is not a 3-D space labelmesh knows (LPS, RAS, LAS, scanner-xyz, "
+                     "3D-right-handed)");
+}
+
+}  // namespace
+
+absl::StatusOr<VolumeHeader> check_nrrd_header(const std::string& path, const ReadLimits& limits) {
+  auto bytes = read_prefix(path, limits.max_header_bytes, false);
+  if (!bytes.ok()) return bytes.status();
+  if (!std::string_view(*bytes).starts_with("NRRD000")) {
+    return field_error(path, "magic", "the file does not start with NRRD000X");
+  }
+  auto text = parse_text_header(
+      path, *bytes, {.separator = ": ", .comment = "#", .last_key = "", .skip_marker = ":="},
+      limits.max_header_bytes);
+  if (!text.ok()) return text.status();
+  const TextHeader& h = *text;
+
+  auto dimension = h.find("dimension");
+  if (!dimension || *dimension != "3") return field_error(path, "dimension", "must be 3");
+  if (auto space_dimension = h.find("space dimension");
+      space_dimension && *space_dimension != "3") {
+    return field_error(path, "space dimension", "must be 3");
+  }
+  auto type_name = h.find("type");
+  if (!type_name) return field_error(path, "type", "is missing");
+  auto type = nrrd_scalar_type(path, *type_name);
+  if (!type.ok()) return type.status();
+
+  auto size_text = h.find("sizes");
+  if (!size_text) return field_error(path, "sizes", "is missing");
+  auto sizes = parse_numbers(path, "sizes", *size_text, 3);
+  if (!sizes.ok()) return sizes.status();
+  std::array<int64_t, 3> dims{};
+  for (int axis = 0; axis < 3; ++axis) {
+    const double d = (*sizes)[axis];
+    if (d != std::floor(d) || d < 1 || d > 1e12) {
+      return field_error(
+          path, "sizes",
+          cat("size ", show(d), " along axis ", axis, " must be a whole number >= 1"));
+    }
+    dims[axis] = static_cast<int64_t>(d);
+  }
+  if (auto s = check_dims(path, "sizes", dims, limits); !s.ok()) return s;
+
+  if (auto kinds = h.find("kinds")) {
+    for (std::string_view kind : split_any(*kinds, " ")) {
+      if (kind != "domain" && kind != "space" && kind != "???" && kind != "none") {
+        return field_error(path, "kinds", "every axis must be a spatial (domain/space) axis");
+      }
+    }
+  }
+  for (std::string_view skip : {"byte skip", "byteskip", "line skip", "lineskip"}) {
+    if (auto value = h.find(skip); value && *value != "0") {
+      return field_error(path, skip, "skipping data before the voxels is not supported");
+    }
+  }
+
+  VolumeHeader header;
+  header.format = ImageFormat::kNrrd;
+  header.scalar_type = *type;
+  ImageGeometry& g = header.geometry;
+  g.dims = dims;
+
+  std::array<double, 3> to_lps{1, 1, 1};
+  if (auto space = h.find("space")) {
+    auto flips = nrrd_space_to_lps(path, *space);
+    if (!flips.ok()) return flips.status();
+    to_lps = *flips;
+  }
+  if (auto directions = h.find("space directions")) {
+    if (contains(*directions, "none")) {
+      return field_error(path, "space directions", "every axis needs a direction");
+    }
+    auto vectors = parse_numbers(path, "space directions", *directions, 9);
+    if (!vectors.ok()) return vectors.status();
+    for (int axis = 0; axis < 3; ++axis) {
+      double norm2 = 0;
+      for (int row = 0; row < 3; ++row) {
+        const double v = to_lps[row] * (*vectors)[3 * axis + row];
+        g.direction[3 * row + axis] = v;
+        norm2 += v * v;
+      }
+      g.spacing[axis] = std::sqrt(norm2);
+    }
+    if (auto s = check_spacing(path, "space directions", g.spacing); !s.ok()) return s;
+    if (auto s = normalise_direction(path, "space directions", g.direction); !s.ok()) return s;
+  } else if (auto spacings = h.find("spacings")) {
+    auto values = parse_numbers(path, "spacings", *spacings, 3);
+    if (!values.ok()) return values.status();
+    g.spacing = {(*values)[0], (*values)[1], (*values)[2]};
+    if (auto s = check_spacing(path, "spacings", g.spacing); !s.ok()) return s;
+  }
+  if (auto origin = h.find("space origin")) {
+    auto values = parse_numbers(path, "space origin", *origin, 3);
+    if (!values.ok()) return values.status();
+    for (int row = 0; row < 3; ++row) g.origin[row] = to_lps[row] * (*values)[row];
+  }
+
+  auto encoding = h.find("encoding");
+  if (!encoding) return field_error(path, "encoding", "is missing");
+  if (*encoding == "raw") {
+    header.encoding = DataEncoding::kRaw;
+  } else if (*encoding == "gzip" || *encoding == "gz") {
+    header.encoding = DataEncoding::kGzip;
+  } else {
+    return field_error(path, "encoding", "only raw and gzip voxel data are supported");
+  }
+  if (scalar_size(*type) > 1) {
+    auto endian = h.find("endian");
+    if (!endian || (*endian != "little" && *endian != "big")) {
+      return field_error(path, "endian", "must be little or big for multi-byte voxels");
+    }
+    header.big_endian = *endian == "big";
+  }
+
+  auto data_file = h.find("data file");
+  if (!data_file) data_file = h.find("datafile");
+  if (data_file) {
+    if (std::string_view(*data_file).starts_with("LIST") || contains(*data_file, " ") ||
+        contains(*data_file, "%")) {
+      return field_error(path, "data file", "lists of data files are not supported");
+    }
+    if (!is_plain_file_name(*data_file)) {
+      return field_error(path, "data file", "must name a file in the header's own directory");
+    }
+    header.data_path = sibling_path(path, *data_file);
+    header.file_offset = 0;
+  } else {
+    if (h.size >= bytes->size() && bytes->size() < limits.max_header_bytes) {
+      return field_error(path, "data file", "is missing and no voxels follow the header");
+    }
+    header.data_path = path;
+    header.file_offset = h.size;
+  }
+
+  const uint64_t needed = header.data_bytes();
+  if (header.encoding == DataEncoding::kRaw) {
+    if (auto s = check_raw_payload(header.data_path, header.file_offset, needed); !s.ok()) return s;
+    return header;
+  }
+  if (auto s = check_encoded_payload(header.data_path, header.file_offset, DataEncoding::kGzip, 0,
+                                     needed);
+      !s.ok()) {
+    return s;
+  }
+  return header;
+}
+
+}  // namespace labelmesh::volume::internal

@@ -1,0 +1,64 @@
+#include "core/volume/text_header.h"
+
+#include "core/text.h"
+#include "core/volume/header_checks.h"
+
+namespace labelmesh::volume::internal {
+
+std::optional<std::string_view> TextHeader::find(std::string_view key) const {
+  auto it = fields.find(key);
+  if (it == fields.end()) return std::nullopt;
+  return std::string_view(it->second);
+}
+
+absl::StatusOr<TextHeader> parse_text_header(std::string_view path, std::string_view bytes,
+                                             const TextHeaderSyntax& syntax, uint64_t max_bytes) {
+  TextHeader header;
+  size_t position = 0;
+  int line_number = 0;
+  while (true) {
+    const size_t end = bytes.find('\n', position);
+    if (end == std::string_view::npos) {
+      if (bytes.size() >= max_bytes) {
+        return field_error(path, "header", cat("does not end within ", max_bytes, " bytes"));
+      }
+      if (syntax.last_key.empty() && position == bytes.size()) {
+        header.size = bytes.size();  // Detached header with no trailing blank line.
+        return header;
+      }
+      return field_error(path, "header", "ends before its last field");
+    }
+    ++line_number;
+    std::string_view line = bytes.substr(position, end - position);
+    position = end + 1;
+    if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+    if (line.empty()) {
+      if (syntax.last_key.empty()) {
+        header.size = position;
+        return header;
+      }
+      continue;
+    }
+    if (!syntax.comment.empty() && line.substr(0, syntax.comment.size()) == syntax.comment) {
+      continue;
+    }
+    if (!syntax.skip_marker.empty() && line.find(syntax.skip_marker) != std::string_view::npos) {
+      continue;
+    }
+    const size_t split = line.find(syntax.separator);
+    if (split == std::string_view::npos) {
+      if (line_number == 1) continue;  // Magic line (NRRD000X).
+      return field_error(path, cat("header line ", line_number),
+                         cat("has no \"", trim(syntax.separator), "\" between a key and a value"));
+    }
+    const std::string key(trim(line.substr(0, split)));
+    const std::string value(trim(line.substr(split + syntax.separator.size())));
+    header.fields.insert_or_assign(key, value);
+    if (!syntax.last_key.empty() && key == syntax.last_key) {
+      header.size = position;
+      return header;
+    }
+  }
+}
+
+}  // namespace labelmesh::volume::internal

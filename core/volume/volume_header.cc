@@ -1,0 +1,108 @@
+#include "core/volume/volume_header.h"
+
+#include "core/text.h"
+#include "core/volume/header_checks.h"
+#include "core/volume/header_formats.h"
+
+namespace labelmesh::volume {
+
+std::string_view scalar_type_name(ScalarType type) {
+  switch (type) {
+    case ScalarType::kInt8:
+      return "int8";
+    case ScalarType::kUInt8:
+      return "uint8";
+    case ScalarType::kInt16:
+      return "int16";
+    case ScalarType::kUInt16:
+      return "uint16";
+    case ScalarType::kInt32:
+      return "int32";
+    case ScalarType::kUInt32:
+      return "uint32";
+    case ScalarType::kInt64:
+      return "int64";
+    case ScalarType::kUInt64:
+      return "uint64";
+    case ScalarType::kFloat32:
+      return "float32";
+    case ScalarType::kFloat64:
+      return "float64";
+  }
+  return "unknown";
+}
+
+int scalar_size(ScalarType type) {
+  switch (type) {
+    case ScalarType::kInt8:
+    case ScalarType::kUInt8:
+      return 1;
+    case ScalarType::kInt16:
+    case ScalarType::kUInt16:
+      return 2;
+    case ScalarType::kInt32:
+    case ScalarType::kUInt32:
+    case ScalarType::kFloat32:
+      return 4;
+    case ScalarType::kInt64:
+    case ScalarType::kUInt64:
+    case ScalarType::kFloat64:
+      return 8;
+  }
+  return 0;
+}
+
+bool is_floating(ScalarType type) {
+  return type == ScalarType::kFloat32 || type == ScalarType::kFloat64;
+}
+
+uint64_t VolumeHeader::data_bytes() const {
+  return static_cast<uint64_t>(geometry.voxel_count()) *
+         static_cast<uint64_t>(scalar_size(scalar_type));
+}
+
+std::optional<ImageFormat> format_from_path(std::string_view path) {
+  const std::string lower = to_lower(path);
+  for (std::string_view ext : {".nii", ".nii.gz"}) {
+    if (std::string_view(lower).ends_with(ext)) return ImageFormat::kNifti;
+  }
+  for (std::string_view ext : {".mha", ".mhd"}) {
+    if (std::string_view(lower).ends_with(ext)) return ImageFormat::kMetaImage;
+  }
+  for (std::string_view ext : {".nrrd", ".nhdr"}) {
+    if (std::string_view(lower).ends_with(ext)) return ImageFormat::kNrrd;
+  }
+  for (std::string_view ext : {".inr", ".inr.gz"}) {
+    if (std::string_view(lower).ends_with(ext)) return ImageFormat::kInr;
+  }
+  if (std::string_view(lower).ends_with(".vti")) return ImageFormat::kVti;
+  return std::nullopt;
+}
+
+absl::StatusOr<VolumeHeader> check_volume_header(const std::string& path,
+                                                 const ReadLimits& limits) {
+  auto format = format_from_path(path);
+  if (!format) {
+    return absl::InvalidArgumentError(
+        cat(path,
+            ": file name: unknown extension; expected .nii, .nii.gz, .mha, .mhd, .nrrd, .nhdr, "
+            ".inr, .inr.gz or .vti"));
+  }
+  if (auto size = internal::file_size(path); !size.ok()) return size.status();
+  const bool gzip = std::string_view(to_lower(path)).ends_with(".gz");
+  switch (*format) {
+    case ImageFormat::kNifti:
+      return internal::check_nifti_header(path, gzip, limits);
+    case ImageFormat::kMetaImage:
+      return internal::check_metaimage_header(path, limits);
+    case ImageFormat::kNrrd:
+      return internal::check_nrrd_header(path, limits);
+    case ImageFormat::kInr:
+      return internal::check_inr_header(path, gzip, limits);
+    case ImageFormat::kVti:
+      return internal::check_vti_header(path, limits);
+  }
+  return absl::InternalError("unhandled image format");
+}
+
+}  // namespace labelmesh::volume

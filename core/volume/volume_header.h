@@ -1,0 +1,77 @@
+// Our own validation of label-volume headers. It runs before any library
+// reader sees a file: Debian's VTK 9.1 bundles MetaIO and nifticlib versions
+// with published header-overflow bugs, and uploads are untrusted. Every field
+// we rely on is checked before anything is allocated from it.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+
+#include "absl/status/statusor.h"
+#include "core/volume/label_volume.h"
+
+namespace labelmesh::volume {
+
+enum class ScalarType {
+  kInt8,
+  kUInt8,
+  kInt16,
+  kUInt16,
+  kInt32,
+  kUInt32,
+  kInt64,
+  kUInt64,
+  kFloat32,
+  kFloat64
+};
+
+std::string_view scalar_type_name(ScalarType type);
+int scalar_size(ScalarType type);
+bool is_floating(ScalarType type);
+
+// How the voxel bytes are stored in `data_path`.
+enum class DataEncoding { kRaw, kGzip, kZlib };
+
+struct ReadLimits {
+  // Volumes with more voxels than this are refused before any allocation.
+  uint64_t max_voxels = uint64_t{1} << 31;
+  // Text headers (MetaImage, NRRD, INR, VTI) longer than this are refused, bytes.
+  uint64_t max_header_bytes = uint64_t{1} << 16;
+};
+
+// Everything the readers need, taken from a header that passed every check.
+struct VolumeHeader {
+  ImageFormat format = ImageFormat::kNifti;
+  ScalarType scalar_type = ScalarType::kUInt8;
+  // Placement in LPS, for the voxel order stored in the file.
+  ImageGeometry geometry;
+  bool big_endian = false;
+  // File that holds the voxels: the header file itself unless detached.
+  std::string data_path;
+  DataEncoding encoding = DataEncoding::kRaw;
+  // Where the (raw or encoded) voxel stream starts in data_path.
+  uint64_t file_offset = 0;
+  // Bytes to skip in the decoded stream before the first voxel: non-zero when
+  // the header itself is compressed with the voxels (.nii.gz, .inr.gz).
+  uint64_t decoded_offset = 0;
+  // Encoded bytes after file_offset that belong to the voxels; 0 = to the end.
+  uint64_t compressed_bytes = 0;
+  // NIfTI scl_slope/scl_inter; identity elsewhere.
+  double rescale_slope = 1.0;
+  double rescale_intercept = 0.0;
+
+  uint64_t data_bytes() const;
+};
+
+// The format a path names by its extension, or nullopt.
+std::optional<ImageFormat> format_from_path(std::string_view path);
+
+// Parses and checks the header of `path`. Errors are INVALID_ARGUMENT naming
+// the file and field ("scan.nii: dim[2]: is 0, ..."), NOT_FOUND for a missing
+// file. Never echoes free-text header fields (patient data can hide there).
+absl::StatusOr<VolumeHeader> check_volume_header(const std::string& path,
+                                                 const ReadLimits& limits = {});
+
+}  // namespace labelmesh::volume
