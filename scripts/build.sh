@@ -1,0 +1,10 @@
+#!/usr/bin/env bash
+# Configures and builds one CMake preset (default: dev) with Ninja and ccache.
+# Usage: scripts/build.sh [preset]
+set -euo pipefail
+cd "$(dirname "$0")/.."
+preset=${1:-dev}
+export CCACHE_DIR=${CCACHE_DIR:-$HOME/.cache/labelmesh-ccache}
+cmake --preset "$preset" >/dev/null
+# Two jobs: VTK and CGAL translation units need about 1.5 GiB each.
+cmake --build --preset "$preset" -j "${LABELMESH_JOBS:-2}"

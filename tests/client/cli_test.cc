@@ -1,0 +1,138 @@
+// The labelmesh executable: exit codes, files and the report, end to end.
+#include <google/protobuf/util/json_util.h>
+#include <gtest/gtest.h>
+
+#include <sys/wait.h>
+#include <cstdio>
+#include <fstream>
+#include <numbers>
+#include <sstream>
+
+#include "labelmesh/v1/report.pb.h"
+#include "support/test_files.h"
+
+namespace labelmesh {
+namespace {
+
+struct CliRun {
+  int exit_code;
+  std::string output;  // stdout and stderr
+};
+
+CliRun run_cli(const std::string& arguments) {
+  const std::string command = std::string(LABELMESH_CLI) + " " + arguments + " 2>&1";
+  FILE* pipe = popen(command.c_str(), "r");
+  std::string output;
+  char buffer[4096];
+  while (size_t n = std::fread(buffer, 1, sizeof buffer, pipe)) output.append(buffer, n);
+  const int status = pclose(pipe);
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, output};
+}
+
+std::string slurp(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+TEST(Cli, MeshWritesSurfacesAndReport) {
+  const auto dir = testing::scratch_dir("cli-mesh");
+  ASSERT_EQ(run_cli("phantom nested-spheres --out " + (dir / "nested.nrrd").string()).exit_code, 0);
+  const CliRun run = run_cli("mesh " + (dir / "nested.nrrd").string() + " --out " +
+                             (dir / "out").string() + " --labels 1,3 --formats stl,ply,off");
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  for (const char* name : {"surface-label1.stl", "surface-label1.ply", "surface-label3.off"}) {
+    EXPECT_TRUE(std::filesystem::exists(dir / "out" / name)) << name;
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir / "out" / "surface-label2.stl"));
+  v1::Report report;
+  ASSERT_TRUE(
+      google::protobuf::util::JsonStringToMessage(slurp(dir / "out" / "report.json"), &report)
+          .ok());
+  EXPECT_EQ(report.input().convention(), "LPS");
+  EXPECT_EQ(report.input().format(), "nrrd");
+  ASSERT_EQ(report.input().labels_size(), 3);
+  ASSERT_EQ(report.surfaces_size(), 2);
+  EXPECT_EQ(report.surfaces(0).label(), 1);
+  EXPECT_EQ(report.surfaces(1).label(), 3);
+  for (const auto& s : report.surfaces()) {
+    EXPECT_EQ(s.stage(), "marching_cubes");
+    EXPECT_TRUE(s.closed());
+    EXPECT_TRUE(s.manifold());
+    EXPECT_GT(s.min_angle_deg(), 0);
+    EXPECT_LT(s.max_angle_deg(), 180);
+    EXPECT_EQ(s.files_size(), 3);
+  }
+  const double ball = 4.0 / 3.0 * std::numbers::pi * 6 * 6 * 6;
+  EXPECT_NEAR(report.surfaces(0).volume_mm3() / ball, 1.0, 0.03);
+  std::vector<std::string> stages;
+  for (const auto& stage : report.stages()) stages.push_back(stage.name());
+  EXPECT_EQ(stages, (std::vector<std::string>{"read", "label_statistics", "marching_cubes",
+                                              "surface_statistics", "write"}));
+  // The raw JSON keeps the proto field names.
+  EXPECT_NE(slurp(dir / "out" / "report.json").find("\"min_angle_deg\""), std::string::npos);
+}
+
+TEST(Cli, JsonReportOnStdout) {
+  const auto dir = testing::scratch_dir("cli-json");
+  ASSERT_EQ(run_cli("phantom torus --out " + (dir / "t.mha").string()).exit_code, 0);
+  const CliRun run = run_cli("mesh " + (dir / "t.mha").string() + " --out " + (dir / "o").string() +
+                             " --json 2>/dev/null");
+  ASSERT_EQ(run.exit_code, 0);
+  v1::Report report;
+  ASSERT_TRUE(google::protobuf::util::JsonStringToMessage(run.output, &report).ok()) << run.output;
+  ASSERT_EQ(report.surfaces_size(), 1);
+  EXPECT_EQ(report.surfaces(0).euler_characteristic(), 0);
+}
+
+TEST(Cli, InfoJsonOnRealData) {
+  const CliRun run = run_cli("info --json " + testing::shared_data("liver.inr.gz"));
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  v1::InputSummary summary;
+  ASSERT_TRUE(google::protobuf::util::JsonStringToMessage(run.output, &summary).ok()) << run.output;
+  EXPECT_EQ(summary.dims(0), 438u);
+  ASSERT_EQ(summary.labels_size(), 4);
+  EXPECT_EQ(summary.labels(3).label(), 255);
+  EXPECT_EQ(summary.labels(3).voxels(), 6322002u);
+  EXPECT_NEAR(summary.labels(3).volume_mm3(), 6322002 * 0.617188 * 0.617188 * 0.666667, 1.0);
+}
+
+TEST(Cli, ExitCodes) {
+  const auto dir = testing::scratch_dir("cli-codes");
+  EXPECT_EQ(run_cli("").exit_code, 2);
+  EXPECT_EQ(run_cli("mesh x.nii").exit_code, 2);  // --out missing
+  EXPECT_EQ(run_cli("mesh x.nii --out d --formats xyz").exit_code, 2);
+  EXPECT_EQ(run_cli("phantom cube --out x.nii").exit_code, 2);
+
+  const CliRun missing = run_cli("info " + (dir / "missing.nii").string());
+  EXPECT_EQ(missing.exit_code, 3);
+  EXPECT_NE(missing.output.find("missing.nii"), std::string::npos);
+
+  testing::write_file(dir / "broken.nii", testing::Nifti1Bytes(4, 4, 4).bytes().substr(0, 200));
+  const CliRun broken =
+      run_cli("mesh " + (dir / "broken.nii").string() + " --out " + (dir / "o").string());
+  EXPECT_EQ(broken.exit_code, 3);
+  EXPECT_NE(broken.output.find("broken.nii: header"), std::string::npos) << broken.output;
+
+  testing::write_file(dir / "empty.nii", testing::Nifti1Bytes(4, 4, 4).bytes());
+  const CliRun empty =
+      run_cli("mesh " + (dir / "empty.nii").string() + " --out " + (dir / "o").string());
+  EXPECT_EQ(empty.exit_code, 4);
+  EXPECT_NE(empty.output.find("only background"), std::string::npos) << empty.output;
+
+  ASSERT_EQ(run_cli("phantom sphere --out " + (dir / "s.vti").string()).exit_code, 0);
+  const CliRun absent =
+      run_cli("mesh " + (dir / "s.vti").string() + " --labels 5 --out " + (dir / "o").string());
+  EXPECT_EQ(absent.exit_code, 3);
+  EXPECT_NE(absent.output.find("label 5"), std::string::npos) << absent.output;
+}
+
+TEST(Cli, HelpDocumentsExitCodes) {
+  const CliRun run = run_cli("mesh --help");
+  EXPECT_EQ(run.exit_code, 0);
+  EXPECT_NE(run.output.find("3 bad input"), std::string::npos) << run.output;
+}
+
+}  // namespace
+}  // namespace labelmesh

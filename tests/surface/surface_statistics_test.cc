@@ -1,0 +1,83 @@
+#include "core/surface/surface_statistics.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace labelmesh::surface {
+namespace {
+
+// Unit right-corner tetrahedron, outward.
+TriangleMesh tetrahedron(double shift = 0) {
+  TriangleMesh m;
+  m.points = {{shift, 0, 0}, {shift + 1, 0, 0}, {shift, 1, 0}, {shift, 0, 1}};
+  m.triangles = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}};
+  return m;
+}
+
+TEST(SurfaceStatistics, Tetrahedron) {
+  const auto s = compute_surface_statistics(tetrahedron());
+  EXPECT_EQ(s.nodes, 4u);
+  EXPECT_EQ(s.triangles, 4u);
+  EXPECT_TRUE(s.closed);
+  EXPECT_TRUE(s.manifold);
+  EXPECT_EQ(s.euler_characteristic, 2);
+  EXPECT_EQ(s.components, 1u);
+  EXPECT_NEAR(s.volume_mm3, 1.0 / 6.0, 1e-12);
+  EXPECT_NEAR(s.min_angle_deg, 45.0, 1e-9);
+  EXPECT_NEAR(s.max_angle_deg, 90.0, 1e-9);
+  EXPECT_NEAR(s.area_mm2, 1.5 + std::sqrt(3.0) / 2, 1e-12);
+}
+
+TEST(SurfaceStatistics, InsideOutHasNegativeVolume) {
+  auto m = tetrahedron();
+  m.flip_orientation();
+  EXPECT_NEAR(compute_surface_statistics(m).volume_mm3, -1.0 / 6.0, 1e-12);
+}
+
+TEST(SurfaceStatistics, MissingTriangleLeavesThreeBoundaryEdges) {
+  auto m = tetrahedron();
+  m.triangles.pop_back();
+  const auto s = compute_surface_statistics(m);
+  EXPECT_FALSE(s.closed);
+  EXPECT_EQ(s.boundary_edges, 3u);
+  EXPECT_EQ(s.euler_characteristic, 1);
+  EXPECT_TRUE(s.manifold);
+}
+
+TEST(SurfaceStatistics, FinOnAnEdgeIsNonManifold) {
+  auto m = tetrahedron();
+  m.points.push_back({0.5, -1, 0});
+  m.triangles.push_back({0, 1, 4});
+  const auto s = compute_surface_statistics(m);
+  EXPECT_EQ(s.non_manifold_edges, 1u);
+  EXPECT_FALSE(s.manifold);
+}
+
+TEST(SurfaceStatistics, TwoTetrahedraSharingAVertexMakeABowtie) {
+  auto m = tetrahedron();
+  const auto other = tetrahedron(-1);  // its vertex 1 is (0,0,0) = our vertex 0
+  const uint32_t base = static_cast<uint32_t>(m.points.size());
+  for (const auto& p : other.points) m.points.push_back(p);
+  for (auto t : other.triangles) {
+    for (auto& v : t) v = v == 1 ? 0 : v + base;
+    m.triangles.push_back(t);
+  }
+  const auto s = compute_surface_statistics(m);
+  EXPECT_EQ(s.non_manifold_vertices, 1u);
+  EXPECT_EQ(s.non_manifold_edges, 0u);
+  EXPECT_FALSE(s.manifold);
+  EXPECT_EQ(s.components, 1u);
+}
+
+TEST(SurfaceStatistics, SliverTriangleAngles) {
+  TriangleMesh m;
+  m.points = {{0, 0, 0}, {1, 0, 0}, {0.5, 1e-3, 0}};
+  m.triangles = {{0, 1, 2}};
+  const auto s = compute_surface_statistics(m);
+  EXPECT_LT(s.min_angle_deg, 0.2);
+  EXPECT_GT(s.max_angle_deg, 179.5);
+}
+
+}  // namespace
+}  // namespace labelmesh::surface
