@@ -1,7 +1,6 @@
 #include "core/surface/write_surface.h"
 
 #include <vtkCellArray.h>
-#include <vtkCommand.h>
 #include <vtkDoubleArray.h>
 #include <vtkNew.h>
 #include <vtkOBJWriter.h>
@@ -12,22 +11,16 @@
 #include <vtkXMLPolyDataWriter.h>
 
 #include "core/text.h"
+#include "core/vtk_error_flag.h"
 
 namespace labelmesh::surface {
 namespace {
-
-class ErrorFlag : public vtkCommand {
- public:
-  static ErrorFlag* New() { return new ErrorFlag; }
-  void Execute(vtkObject*, unsigned long, void*) override { raised = true; }
-  bool raised = false;
-};
 
 template <typename Writer>
 absl::Status run_writer(Writer* writer, vtkPolyData* polydata, const std::string& path) {
   writer->SetInputData(polydata);
   writer->SetFileName(path.c_str());
-  vtkNew<ErrorFlag> flag;
+  vtkNew<VtkErrorFlag> flag;
   writer->AddObserver(vtkCommand::ErrorEvent, flag);
   const int written = writer->Write();
   if (written != 1 || flag->raised) {

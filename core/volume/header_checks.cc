@@ -176,6 +176,20 @@ absl::StatusOr<std::vector<double>> parse_numbers(std::string_view path, std::st
   return values;
 }
 
+absl::StatusOr<std::array<int64_t, 3>> whole_sizes(std::string_view path, std::string_view field,
+                                                   const std::vector<double>& values) {
+  std::array<int64_t, 3> dims{};
+  for (int axis = 0; axis < 3; ++axis) {
+    const double d = values[axis];
+    if (d != std::floor(d) || d < 1 || d > 1e12) {
+      return field_error(
+          path, field, cat("size ", show(d), " along axis ", axis, " must be a whole number >= 1"));
+    }
+    dims[axis] = static_cast<int64_t>(d);
+  }
+  return dims;
+}
+
 std::string sibling_path(std::string_view path, std::string_view name) {
   return (std::filesystem::path(path).parent_path() / std::filesystem::path(name)).string();
 }

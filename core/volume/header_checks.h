@@ -53,6 +53,10 @@ absl::Status check_encoded_payload(std::string_view path, uint64_t file_offset,
 absl::StatusOr<std::vector<double>> parse_numbers(std::string_view path, std::string_view field,
                                                   std::string_view text, size_t count);
 
+// Three sizes that must be whole numbers >= 1 (DimSize, sizes, ...).
+absl::StatusOr<std::array<int64_t, 3>> whole_sizes(std::string_view path, std::string_view field,
+                                                   const std::vector<double>& values);
+
 // The directory part of `path` joined with `name` (for detached data files).
 std::string sibling_path(std::string_view path, std::string_view name);
 

@@ -76,16 +76,9 @@ absl::StatusOr<VolumeHeader> check_metaimage_header(const std::string& path,
   if (!dim_text) return field_error(path, "DimSize", "is missing");
   auto dim_values = parse_numbers(path, "DimSize", *dim_text, 3);
   if (!dim_values.ok()) return dim_values.status();
-  std::array<int64_t, 3> dims{};
-  for (int axis = 0; axis < 3; ++axis) {
-    const double d = (*dim_values)[axis];
-    if (d != std::floor(d) || d < 1 || d > 1e12) {
-      return field_error(
-          path, "DimSize",
-          cat("size ", show(d), " along axis ", axis, " must be a whole number >= 1"));
-    }
-    dims[axis] = static_cast<int64_t>(d);
-  }
+  auto whole = whole_sizes(path, "DimSize", *dim_values);
+  if (!whole.ok()) return whole.status();
+  const std::array<int64_t, 3> dims = *whole;
   if (auto s = check_dims(path, "DimSize", dims, limits); !s.ok()) return s;
 
   auto element_type = h.find("ElementType");

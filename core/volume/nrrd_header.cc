@@ -103,16 +103,9 @@ absl::StatusOr<VolumeHeader> check_nrrd_header(const std::string& path, const Re
   if (!size_text) return field_error(path, "sizes", "is missing");
   auto sizes = parse_numbers(path, "sizes", *size_text, 3);
   if (!sizes.ok()) return sizes.status();
-  std::array<int64_t, 3> dims{};
-  for (int axis = 0; axis < 3; ++axis) {
-    const double d = (*sizes)[axis];
-    if (d != std::floor(d) || d < 1 || d > 1e12) {
-      return field_error(
-          path, "sizes",
-          cat("size ", show(d), " along axis ", axis, " must be a whole number >= 1"));
-    }
-    dims[axis] = static_cast<int64_t>(d);
-  }
+  auto whole = whole_sizes(path, "sizes", *sizes);
+  if (!whole.ok()) return whole.status();
+  const std::array<int64_t, 3> dims = *whole;
   if (auto s = check_dims(path, "sizes", dims, limits); !s.ok()) return s;
 
   if (auto kinds = h.find("kinds")) {

@@ -4,7 +4,6 @@
 #include <cmath>
 #include <limits>
 
-#include <vtkCommand.h>
 #include <vtkDataArray.h>
 #include <vtkExecutive.h>
 #include <vtkImageData.h>
@@ -16,20 +15,12 @@
 #include "core/text.h"
 #include "core/volume/header_checks.h"
 #include "core/volume/payload_stream.h"
+#include "core/vtk_error_flag.h"
 
 namespace labelmesh::volume {
 namespace {
 
 using internal::field_error;
-
-// Records that a VTK algorithm reported an error. Observing ErrorEvent also
-// keeps VTK from printing the message: reader messages may quote header text.
-class ErrorFlag : public vtkCommand {
- public:
-  static ErrorFlag* New() { return new ErrorFlag; }
-  void Execute(vtkObject*, unsigned long, void*) override { raised = true; }
-  bool raised = false;
-};
 
 int vtk_type_of(ScalarType type) {
   switch (type) {
@@ -59,7 +50,7 @@ int vtk_type_of(ScalarType type) {
 
 // Runs a VTK reader; false when it reported any error.
 bool run_reader(vtkAlgorithm* reader) {
-  vtkNew<ErrorFlag> flag;
+  vtkNew<VtkErrorFlag> flag;
   reader->AddObserver(vtkCommand::ErrorEvent, flag);
   reader->GetExecutive()->AddObserver(vtkCommand::ErrorEvent, flag);
   reader->Update();

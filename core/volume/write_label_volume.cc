@@ -7,7 +7,6 @@
 #include <fstream>
 #include <sstream>
 
-#include <vtkCommand.h>
 #include <vtkDataArray.h>
 #include <vtkImageData.h>
 #include <vtkMatrix3x3.h>
@@ -19,16 +18,10 @@
 
 #include "core/text.h"
 #include "core/volume/volume_header.h"
+#include "core/vtk_error_flag.h"
 
 namespace labelmesh::volume {
 namespace {
-
-class ErrorFlag : public vtkCommand {
- public:
-  static ErrorFlag* New() { return new ErrorFlag; }
-  void Execute(vtkObject*, unsigned long, void*) override { raised = true; }
-  bool raised = false;
-};
 
 struct TypeNames {
   int vtk_type;
@@ -199,7 +192,7 @@ absl::Status write_nifti(const LabelVolume& volume, const std::string& path) {
   writer->SetFileName(path.c_str());
   writer->SetSFormMatrix(to_ras);
   if (to_ras->Determinant() > 0) writer->SetQFormMatrix(to_ras);
-  vtkNew<ErrorFlag> flag;
+  vtkNew<VtkErrorFlag> flag;
   writer->AddObserver(vtkCommand::ErrorEvent, flag);
   writer->Write();
   return flag->raised ? io_error(path) : absl::OkStatus();
@@ -211,7 +204,7 @@ absl::Status write_vti(const LabelVolume& volume, const std::string& path) {
   writer->SetFileName(path.c_str());
   writer->SetDataModeToAppended();
   writer->SetCompressorTypeToZLib();
-  vtkNew<ErrorFlag> flag;
+  vtkNew<VtkErrorFlag> flag;
   writer->AddObserver(vtkCommand::ErrorEvent, flag);
   return writer->Write() == 1 && !flag->raised ? absl::OkStatus() : io_error(path);
 }

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <map>
 
+#include "core/pipeline.h"
 #include "core/volume/label_statistics.h"
 #include "core/volume/phantom.h"
 #include "core/volume/write_label_volume.h"
@@ -140,11 +141,14 @@ struct RealVolume {
 
 class RealData : public ::testing::TestWithParam<RealVolume> {};
 
+// Through summarise_volume(), the code behind `labelmesh info`.
 TEST_P(RealData, MatchesSources) {
   const RealVolume& expected = GetParam();
-  const LabelVolume volume = read_or_die(testing::shared_data(expected.file));
-  EXPECT_EQ(volume.geometry.dims, expected.dims);
-  const auto stats = compute_label_statistics(volume);
+  const auto summary =
+      summarise_volume(testing::shared_data(expected.file), ReadLimits{}, RunContext{});
+  ASSERT_TRUE(summary.ok()) << summary.status();
+  EXPECT_EQ(summary->geometry.dims, expected.dims);
+  const auto& stats = summary->statistics;
   EXPECT_EQ(stats.labels.size(), expected.label_count);
   for (const auto& [label, voxels] : expected.voxels) {
     if (label == 0) {
