@@ -67,8 +67,6 @@ std::array<double, 3> ImageGeometry::to_index(const std::array<double, 3>& point
 
 double ImageGeometry::voxel_volume() const { return std::abs(determinant(index_to_mm(*this))); }
 
-bool ImageGeometry::mirrored() const { return determinant(index_to_mm(*this)) < 0; }
-
 void ImageGeometry::reverse_axis(int axis) {
   const double steps = static_cast<double>(dims[axis] - 1) * spacing[axis];
   for (int row = 0; row < 3; ++row) {

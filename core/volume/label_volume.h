@@ -31,8 +31,6 @@ struct ImageGeometry {
   std::array<double, 3> to_index(const std::array<double, 3>& point) const;
   // Volume of one voxel in mm^3 (|det| of direction x diag(spacing)).
   double voxel_volume() const;
-  // True when direction x diag(spacing) has a negative determinant (a mirrored grid).
-  bool mirrored() const;
   int64_t voxel_count() const { return dims[0] * dims[1] * dims[2]; }
 
   // Makes index k run the other way along `axis`: used when a reader stores

@@ -52,10 +52,6 @@ int scalar_size(ScalarType type) {
   return 0;
 }
 
-bool is_floating(ScalarType type) {
-  return type == ScalarType::kFloat32 || type == ScalarType::kFloat64;
-}
-
 uint64_t VolumeHeader::data_bytes() const {
   return static_cast<uint64_t>(geometry.voxel_count()) *
          static_cast<uint64_t>(scalar_size(scalar_type));

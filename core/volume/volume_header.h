@@ -29,7 +29,6 @@ enum class ScalarType {
 
 std::string_view scalar_type_name(ScalarType type);
 int scalar_size(ScalarType type);
-bool is_floating(ScalarType type);
 
 // How the voxel bytes are stored in `data_path`.
 enum class DataEncoding { kRaw, kGzip, kZlib };
