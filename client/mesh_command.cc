@@ -18,20 +18,39 @@ struct MeshCommandOptions {
   std::string path;
   std::string out_dir;
   std::vector<int32_t> labels;
-  std::string surface = "mc";
+  std::string surface = "poisson";
+  PoissonOptions poisson;
+  std::string normals = "uniform";
+  std::string point_reduction = "grid";
+  bool keep_strands = false;
   std::vector<std::string> formats{"stl", "vtp"};
   uint64_t max_voxels = volume::ReadLimits{}.max_voxels;
   bool json = false;
 };
 
+// "-" for a figure the stage does not measure.
+std::string optional_figure(bool present, double value, const char* format) {
+  if (!present) return "-";
+  char text[32];
+  std::snprintf(text, sizeof text, format, value);
+  return text;
+}
+
 void print_summary(const MeshResult& result, const std::string& out_dir) {
-  std::printf("%8s %-15s %9s %9s %8s %8s %6s %8s %14s\n", "label", "stage", "nodes", "triangles",
-              "min_ang", "max_ang", "closed", "manifold", "volume (mm3)");
+  std::printf("%8s %-15s %9s %9s %8s %8s %6s %8s %14s %9s %9s\n", "label", "stage", "nodes",
+              "triangles", "min_ang", "max_ang", "closed", "manifold", "volume (mm3)", "self_int",
+              "hausdorff");
   for (const auto& s : result.surfaces) {
     const auto& st = s.statistics;
-    std::printf("%8d %-15s %9u %9u %8.3f %8.3f %6s %8s %14.3f\n", s.label, s.stage.c_str(),
+    const auto& distance = s.distance_to_marching_cubes;
+    std::printf("%8d %-15s %9u %9u %8.3f %8.3f %6s %8s %14.3f %9s %9s\n", s.label, s.stage.c_str(),
                 st.nodes, st.triangles, st.min_angle_deg, st.max_angle_deg,
-                st.closed ? "yes" : "no", st.manifold ? "yes" : "no", st.volume_mm3);
+                st.closed ? "yes" : "no", st.manifold ? "yes" : "no", st.volume_mm3,
+                optional_figure(s.self_intersections.has_value(),
+                                double(s.self_intersections.value_or(0)), "%.0f")
+                    .c_str(),
+                optional_figure(distance.has_value(), distance ? distance->hausdorff_mm : 0, "%.3f")
+                    .c_str());
   }
   std::printf("meshes and report.json written to %s\n", out_dir.c_str());
 }
@@ -48,8 +67,35 @@ CommandRunner add_mesh_command(CLI::App& app) {
   mesh->add_option("--labels", options->labels,
                    "Labels to mesh, e.g. 1,3 (default: every non-zero label)")
       ->delimiter(',');
-  mesh->add_option("--surface", options->surface, "Surface method: mc (Marching Cubes)")
-      ->check(CLI::IsMember({"mc"}))
+  mesh->add_option("--surface", options->surface,
+                   "Surface method: mc (Marching Cubes), repaired (MC repaired with CGAL), "
+                   "poisson (repaired MC, then CGAL Poisson reconstruction)")
+      ->check(CLI::IsMember({"mc", "repaired", "poisson"}))
+      ->capture_default_str();
+  auto& poisson = options->poisson;
+  mesh->add_option("--min-angle", poisson.min_angle_deg,
+                   "Poisson: smallest triangle angle, degrees, at most 30")
+      ->capture_default_str();
+  mesh->add_option("--max-edge", poisson.max_edge_voxels, "Poisson: longest triangle edge, voxels")
+      ->capture_default_str();
+  mesh->add_option("--max-distance", poisson.max_distance_voxels,
+                   "Poisson: surface mesher distance bound, voxels")
+      ->capture_default_str();
+  mesh->add_option("--min-component-voxels", poisson.min_component_voxels,
+                   "Drop connected components of a label with fewer voxels (repaired, poisson)")
+      ->capture_default_str();
+  mesh->add_flag("--keep-strands", options->keep_strands,
+                 "Keep strands one voxel thick (repaired, poisson); by default they are pruned");
+  mesh->add_option("--normals", options->normals,
+                   "Poisson: vertex normals from incident triangles, uniform or area weighted")
+      ->check(CLI::IsMember({"uniform", "area"}))
+      ->capture_default_str();
+  mesh->add_option("--point-reduction", options->point_reduction,
+                   "Poisson: thin the oriented points with grid, hierarchy or none")
+      ->check(CLI::IsMember({"grid", "hierarchy", "none"}))
+      ->capture_default_str();
+  mesh->add_option("--point-cell", poisson.point_cell_voxels,
+                   "Poisson: grid cell of the point reduction, voxels")
       ->capture_default_str();
   mesh->add_option("--formats", options->formats,
                    "Surface files per label: stl, ply, obj, off, vtp")
@@ -64,7 +110,23 @@ CommandRunner add_mesh_command(CLI::App& app) {
   return [options] {
     v1::MeshOptions proto;
     for (int32_t label : options->labels) proto.add_labels(label);
-    proto.set_surface(v1::SURFACE_METHOD_MARCHING_CUBES);
+    proto.set_surface(options->surface == "mc"         ? v1::SURFACE_METHOD_MARCHING_CUBES
+                      : options->surface == "repaired" ? v1::SURFACE_METHOD_REPAIRED
+                                                       : v1::SURFACE_METHOD_POISSON);
+    const auto& poisson = options->poisson;
+    proto.set_min_angle_deg(poisson.min_angle_deg);
+    proto.set_max_edge_voxels(poisson.max_edge_voxels);
+    proto.set_max_distance_voxels(poisson.max_distance_voxels);
+    proto.set_min_component_voxels(poisson.min_component_voxels);
+    proto.set_point_cell_voxels(poisson.point_cell_voxels);
+    proto.set_prune_strands(!options->keep_strands);
+
+    proto.set_normals(options->normals == "area" ? v1::NORMAL_WEIGHTING_AREA
+                                                 : v1::NORMAL_WEIGHTING_UNIFORM);
+    proto.set_point_reduction(options->point_reduction == "hierarchy"
+                                  ? v1::POINT_REDUCTION_HIERARCHY
+                              : options->point_reduction == "none" ? v1::POINT_REDUCTION_NONE
+                                                                   : v1::POINT_REDUCTION_GRID);
     for (const auto& format : options->formats) proto.add_formats(format);
     proto.set_max_voxels(options->max_voxels);
     auto params = params_from_options(proto);

@@ -1,9 +1,9 @@
 #include "core/pipeline.h"
 
-#include <chrono>
 #include <filesystem>
 #include <fstream>
 
+#include "core/quality_surfaces.h"
 #include "core/report.h"
 #include "core/surface/extract_surfaces.h"
 #include "core/surface/write_surface.h"
@@ -12,22 +12,6 @@
 
 namespace labelmesh {
 namespace {
-
-// Times one stage and appends it to `stages`.
-class StageTimer {
- public:
-  StageTimer(std::vector<StageTiming>& stages, std::string name)
-      : stages_(stages), name_(std::move(name)), start_(std::chrono::steady_clock::now()) {}
-  ~StageTimer() {
-    const std::chrono::duration<double> elapsed = std::chrono::steady_clock::now() - start_;
-    stages_.push_back({name_, elapsed.count()});
-  }
-
- private:
-  std::vector<StageTiming>& stages_;
-  std::string name_;
-  std::chrono::steady_clock::time_point start_;
-};
 
 // The labels to mesh: those asked for (each must be present), or all.
 absl::StatusOr<std::vector<int32_t>> choose_labels(const std::string& path,
@@ -95,9 +79,21 @@ absl::StatusOr<MeshResult> run_pipeline(const std::string& path, const MeshParam
       SurfaceResult surface;
       surface.label = extracted.label;
       surface.stage = "marching_cubes";
+      surface.is_output = params.surface == SurfaceMethod::kMarchingCubes;
       surface.statistics = surface::compute_surface_statistics(extracted.mesh);
       surface.mesh = std::move(extracted.mesh);
       result.surfaces.push_back(std::move(surface));
+    }
+  }
+  if (params.surface == SurfaceMethod::kMarchingCubes) return result;
+  // The Marching Cubes surfaces were kept for their figures only.
+  for (auto& surface : result.surfaces) surface.mesh = {};
+  for (int32_t label : *labels) {
+    const auto* statistics = result.input.statistics.find(label);
+    if (auto s = add_quality_surfaces(*volume, *statistics, params, context, result.surfaces,
+                                      result.stages);
+        !s.ok()) {
+      return s;
     }
   }
   return result;
@@ -114,6 +110,7 @@ absl::Status write_results(MeshResult& result, const MeshParams& params, const s
     for (auto& surface : result.surfaces) {
       if (auto s = context.check_stop(); !s.ok()) return s;
       surface.files.clear();
+      if (!surface.is_output) continue;
       for (auto format : params.formats) {
         const std::string name =
             cat("surface-label", surface.label, ".", surface::surface_format_name(format));

@@ -2,23 +2,23 @@
 // volume, count labels, extract surfaces, measure them, write the results.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "absl/status/statusor.h"
 #include "core/mesh_params.h"
 #include "core/run_context.h"
+#include "core/stage_timer.h"
+#include "core/surface/poisson_surface.h"
+#include "core/surface/surface_checks.h"
+#include "core/surface/surface_repair.h"
 #include "core/surface/surface_statistics.h"
 #include "core/surface/triangle_mesh.h"
 #include "core/volume/label_statistics.h"
 #include "core/volume/label_volume.h"
 
 namespace labelmesh {
-
-struct StageTiming {
-  std::string name;
-  double seconds = 0;
-};
 
 // The input as read: format, placement and label counts.
 struct VolumeSummary {
@@ -28,12 +28,34 @@ struct VolumeSummary {
   volume::VolumeStatistics statistics;
 };
 
+// Which connected pieces of a label a surface covers.
+struct ComponentCounts {
+  uint32_t kept = 0;
+  // Components under the size threshold, left out of the surface.
+  uint32_t dropped = 0;
+  uint64_t dropped_voxels = 0;
+  // Voxels removed as strands one voxel thick before splitting.
+  uint64_t pruned_voxels = 0;
+};
+
+// One label's surface after one stage. A run keeps every stage's figures (the
+// paper's Table 2 columns) but writes files only for the final stage.
 struct SurfaceResult {
   int32_t label = 0;
-  // Stage that produced the surface: "marching_cubes".
+  // Stage that produced the surface: "marching_cubes", "repaired" or "poisson".
   std::string stage;
+  // True for the stage whose surface is the run's output.
+  bool is_output = false;
   surface::TriangleMesh mesh;
   surface::SurfaceStatistics statistics;
+  // Only for stages after Marching Cubes.
+  std::optional<ComponentCounts> components;
+  std::optional<surface::RepairCounts> repair;
+  std::optional<surface::PoissonFigures> poisson;
+  // Only for the output stage, when it is not Marching Cubes itself.
+  std::optional<uint64_t> self_intersections;
+  // To the Marching Cubes surface of the kept components.
+  std::optional<surface::SurfaceDistance> distance_to_marching_cubes;
   // Files written for it, relative to the output directory.
   std::vector<std::string> files;
 };

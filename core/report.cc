@@ -2,9 +2,132 @@
 
 #include <google/protobuf/util/json_util.h>
 
+#include <cmath>
+
 #include "core/text.h"
 
 namespace labelmesh {
+namespace {
+
+v1::SurfaceMethod to_proto(SurfaceMethod method) {
+  switch (method) {
+    case SurfaceMethod::kMarchingCubes:
+      return v1::SURFACE_METHOD_MARCHING_CUBES;
+    case SurfaceMethod::kRepaired:
+      return v1::SURFACE_METHOD_REPAIRED;
+    case SurfaceMethod::kPoisson:
+      return v1::SURFACE_METHOD_POISSON;
+  }
+  return v1::SURFACE_METHOD_UNSPECIFIED;
+}
+
+v1::PointReduction to_proto(surface::PointReduction reduction) {
+  switch (reduction) {
+    case surface::PointReduction::kGrid:
+      return v1::POINT_REDUCTION_GRID;
+    case surface::PointReduction::kHierarchy:
+      return v1::POINT_REDUCTION_HIERARCHY;
+    case surface::PointReduction::kNone:
+      return v1::POINT_REDUCTION_NONE;
+  }
+  return v1::POINT_REDUCTION_UNSPECIFIED;
+}
+
+// A length in voxels must be finite and positive.
+absl::Status check_voxels(std::string_view field, double value) {
+  if (std::isfinite(value) && value > 0) return absl::OkStatus();
+  return absl::InvalidArgumentError(cat(field, ": ", value, " is not a positive number of voxels"));
+}
+
+absl::Status read_poisson_options(const v1::MeshOptions& options, PoissonOptions& poisson) {
+  if (options.has_min_angle_deg()) {
+    poisson.min_angle_deg = options.min_angle_deg();
+    // CGAL's surface mesher terminates for angle bounds up to 30 degrees.
+    if (!(poisson.min_angle_deg > 0 && poisson.min_angle_deg <= 30)) {
+      return absl::InvalidArgumentError(
+          cat("min_angle_deg: ", poisson.min_angle_deg, " is outside (0, 30]"));
+    }
+  }
+  if (options.has_max_edge_voxels()) {
+    poisson.max_edge_voxels = options.max_edge_voxels();
+    if (auto s = check_voxels("max_edge_voxels", poisson.max_edge_voxels); !s.ok()) return s;
+  }
+  if (options.has_max_distance_voxels()) {
+    poisson.max_distance_voxels = options.max_distance_voxels();
+    if (auto s = check_voxels("max_distance_voxels", poisson.max_distance_voxels); !s.ok())
+      return s;
+  }
+  if (options.has_prune_strands()) poisson.prune_strands = options.prune_strands();
+
+  if (options.has_min_component_voxels())
+    poisson.min_component_voxels = options.min_component_voxels();
+  if (options.has_point_cell_voxels()) {
+    poisson.point_cell_voxels = options.point_cell_voxels();
+    if (auto s = check_voxels("point_cell_voxels", poisson.point_cell_voxels); !s.ok()) return s;
+  }
+  switch (options.normals()) {
+    case v1::NORMAL_WEIGHTING_UNSPECIFIED:
+    case v1::NORMAL_WEIGHTING_UNIFORM:
+      poisson.normals = surface::NormalWeighting::kUniform;
+      break;
+    case v1::NORMAL_WEIGHTING_AREA:
+      poisson.normals = surface::NormalWeighting::kArea;
+      break;
+    default:
+      return absl::InvalidArgumentError("normals: unknown weighting");
+  }
+  switch (options.point_reduction()) {
+    case v1::POINT_REDUCTION_UNSPECIFIED:
+    case v1::POINT_REDUCTION_GRID:
+      poisson.point_reduction = surface::PointReduction::kGrid;
+      break;
+    case v1::POINT_REDUCTION_HIERARCHY:
+      poisson.point_reduction = surface::PointReduction::kHierarchy;
+      break;
+    case v1::POINT_REDUCTION_NONE:
+      poisson.point_reduction = surface::PointReduction::kNone;
+      break;
+    default:
+      return absl::InvalidArgumentError("point_reduction: unknown method");
+  }
+  return absl::OkStatus();
+}
+
+void add_quality_figures(const SurfaceResult& surface, v1::SurfaceSummary& entry) {
+  if (surface.self_intersections) entry.set_self_intersections(*surface.self_intersections);
+  if (surface.distance_to_marching_cubes) {
+    entry.set_hausdorff_mm(surface.distance_to_marching_cubes->hausdorff_mm);
+    entry.set_mean_distance_mm(surface.distance_to_marching_cubes->mean_mm);
+  }
+  if (surface.components) {
+    entry.set_components_kept(surface.components->kept);
+    entry.set_components_dropped(surface.components->dropped);
+    entry.set_dropped_voxels(surface.components->dropped_voxels);
+    entry.set_pruned_voxels(surface.components->pruned_voxels);
+  }
+  if (surface.repair) {
+    const auto& r = *surface.repair;
+    auto* repair = entry.mutable_repair();
+    repair->set_degenerate_triangles_removed(r.degenerate_triangles_removed);
+    repair->set_needles_before(r.needles_before);
+    repair->set_caps_before(r.caps_before);
+    repair->set_needles_after(r.needles_after);
+    repair->set_caps_after(r.caps_after);
+    repair->set_non_manifold_vertices_split(r.non_manifold_vertices_split);
+    repair->set_holes_filled(r.holes_filled);
+  }
+  if (surface.poisson) {
+    const auto& p = *surface.poisson;
+    auto* poisson = entry.mutable_poisson();
+    poisson->set_input_points(p.input_points);
+    poisson->set_used_points(p.used_points);
+    poisson->set_solver_iterations(static_cast<uint32_t>(p.solver_iterations));
+    poisson->set_solve_seconds(p.solve_seconds);
+    poisson->set_mesh_seconds(p.mesh_seconds);
+  }
+}
+
+}  // namespace
 
 v1::InputSummary make_input_summary(const VolumeSummary& summary) {
   v1::InputSummary input;
@@ -32,7 +155,19 @@ v1::InputSummary make_input_summary(const VolumeSummary& summary) {
 v1::MeshOptions make_options(const MeshParams& params) {
   v1::MeshOptions options;
   for (int32_t label : params.labels) options.add_labels(label);
-  options.set_surface(v1::SURFACE_METHOD_MARCHING_CUBES);
+  options.set_surface(to_proto(params.surface));
+  const PoissonOptions& poisson = params.poisson;
+  options.set_min_angle_deg(poisson.min_angle_deg);
+  options.set_max_edge_voxels(poisson.max_edge_voxels);
+  options.set_max_distance_voxels(poisson.max_distance_voxels);
+  options.set_min_component_voxels(poisson.min_component_voxels);
+  options.set_normals(poisson.normals == surface::NormalWeighting::kArea
+                          ? v1::NORMAL_WEIGHTING_AREA
+                          : v1::NORMAL_WEIGHTING_UNIFORM);
+  options.set_point_reduction(to_proto(poisson.point_reduction));
+  options.set_point_cell_voxels(poisson.point_cell_voxels);
+  options.set_prune_strands(poisson.prune_strands);
+
   for (auto format : params.formats)
     options.add_formats(std::string(surface::surface_format_name(format)));
   options.set_max_voxels(params.limits.max_voxels);
@@ -43,13 +178,20 @@ absl::StatusOr<MeshParams> params_from_options(const v1::MeshOptions& options) {
   MeshParams params;
   params.labels.assign(options.labels().begin(), options.labels().end());
   switch (options.surface()) {
-    case v1::SURFACE_METHOD_UNSPECIFIED:
     case v1::SURFACE_METHOD_MARCHING_CUBES:
       params.surface = SurfaceMethod::kMarchingCubes;
+      break;
+    case v1::SURFACE_METHOD_REPAIRED:
+      params.surface = SurfaceMethod::kRepaired;
+      break;
+    case v1::SURFACE_METHOD_UNSPECIFIED:
+    case v1::SURFACE_METHOD_POISSON:
+      params.surface = SurfaceMethod::kPoisson;
       break;
     default:
       return absl::InvalidArgumentError("surface: unknown surface method");
   }
+  if (auto s = read_poisson_options(options, params.poisson); !s.ok()) return s;
   if (!options.formats().empty()) {
     params.formats.clear();
     for (const auto& name : options.formats()) {
@@ -89,6 +231,8 @@ v1::Report make_report(const MeshResult& result, const MeshParams& params) {
     entry->set_volume_mm3(s.volume_mm3);
     entry->set_area_mm2(s.area_mm2);
     for (const auto& file : surface.files) entry->add_files(file);
+    entry->set_output(surface.is_output);
+    add_quality_figures(surface, *entry);
   }
   for (const auto& stage : result.stages) {
     auto* entry = report.add_stages();

@@ -15,16 +15,16 @@
 namespace labelmesh::surface {
 namespace {
 
-// The label's voxels plus one voxel of background all round, in index space.
-vtkSmartPointer<vtkImageData> padded_label_box(const volume::LabelVolume& volume,
-                                               const volume::LabelStatistics& label) {
+// The voxels of `image` inside [lo, hi] plus one voxel of background all
+// round, in index space (cropping and padding in one filter).
+vtkSmartPointer<vtkImageData> padded_box(vtkImageData* image, const std::array<int64_t, 3>& lo,
+                                         const std::array<int64_t, 3>& hi) {
   vtkNew<vtkImageConstantPad> pad;
-  pad->SetInputData(volume.voxels);
+  pad->SetInputData(image);
   pad->SetConstant(0);
-  pad->SetOutputWholeExtent(
-      static_cast<int>(label.min_index[0] - 1), static_cast<int>(label.max_index[0] + 1),
-      static_cast<int>(label.min_index[1] - 1), static_cast<int>(label.max_index[1] + 1),
-      static_cast<int>(label.min_index[2] - 1), static_cast<int>(label.max_index[2] + 1));
+  pad->SetOutputWholeExtent(static_cast<int>(lo[0] - 1), static_cast<int>(hi[0] + 1),
+                            static_cast<int>(lo[1] - 1), static_cast<int>(hi[1] + 1),
+                            static_cast<int>(lo[2] - 1), static_cast<int>(hi[2] + 1));
   pad->Update();
   return pad->GetOutput();
 }
@@ -51,7 +51,42 @@ TriangleMesh to_patient_space(vtkPolyData* contour, const volume::ImageGeometry&
   return mesh;
 }
 
+// The outward boundary of the voxels of `image` equal to `value` inside [lo, hi].
+TriangleMesh contour_value(vtkImageData* image, int32_t value, const std::array<int64_t, 3>& lo,
+                           const std::array<int64_t, 3>& hi,
+                           const volume::ImageGeometry& geometry) {
+  vtkNew<vtkDiscreteFlyingEdges3D> contour;
+  contour->SetInputData(padded_box(image, lo, hi));
+  contour->SetValue(0, value);
+  contour->ComputeNormalsOff();
+  contour->ComputeGradientsOff();
+  contour->ComputeScalarsOff();
+  contour->Update();
+  TriangleMesh mesh = to_patient_space(contour->GetOutput(), geometry);
+  // The contour's winding is consistent, so a negative enclosed volume means
+  // every triangle faces inwards (mirrored grids): flip once per surface.
+  if (signed_volume(mesh) < 0) mesh.flip_orientation();
+  return mesh;
+}
+
 }  // namespace
+
+absl::StatusOr<std::vector<TriangleMesh>> extract_component_surfaces(
+    const volume::LabelComponents& components, const std::vector<int32_t>& ids,
+    const volume::ImageGeometry& geometry, const RunContext& context) {
+  std::vector<TriangleMesh> surfaces;
+  surfaces.reserve(ids.size());
+  for (int32_t id : ids) {
+    if (auto s = context.check_stop(); !s.ok()) return s;
+    if (id < 1 || static_cast<size_t>(id) > components.components.size()) {
+      return absl::InvalidArgumentError(cat("component ", id, " does not exist"));
+    }
+    const auto& component = components.components[static_cast<size_t>(id - 1)];
+    surfaces.push_back(
+        contour_value(components.ids, id, component.min_index, component.max_index, geometry));
+  }
+  return surfaces;
+}
 
 absl::StatusOr<std::vector<LabelSurface>> extract_surfaces(
     const volume::LabelVolume& volume, const volume::VolumeStatistics& statistics,
@@ -64,18 +99,8 @@ absl::StatusOr<std::vector<LabelSurface>> extract_surfaces(
     if (label == nullptr) {
       return absl::InvalidArgumentError(cat("label ", labels[n], " is not in the volume"));
     }
-    vtkNew<vtkDiscreteFlyingEdges3D> contour;
-    contour->SetInputData(padded_label_box(volume, *label));
-    contour->SetValue(0, label->label);
-    contour->ComputeNormalsOff();
-    contour->ComputeGradientsOff();
-    contour->ComputeScalarsOff();
-    contour->Update();
-
-    LabelSurface surface{label->label, to_patient_space(contour->GetOutput(), volume.geometry)};
-    // Fix orientation once per surface: the contour's winding is consistent,
-    // so a negative enclosed volume means every triangle faces inwards.
-    if (signed_volume(surface.mesh) < 0) surface.mesh.flip_orientation();
+    LabelSurface surface{label->label, contour_value(volume.voxels, label->label, label->min_index,
+                                                     label->max_index, volume.geometry)};
     surfaces.push_back(std::move(surface));
     context.report("marching_cubes", double(n + 1) / double(labels.size()));
   }

@@ -8,6 +8,7 @@
 #include "absl/status/statusor.h"
 #include "core/run_context.h"
 #include "core/surface/triangle_mesh.h"
+#include "core/volume/label_components.h"
 #include "core/volume/label_statistics.h"
 #include "core/volume/label_volume.h"
 
@@ -26,5 +27,12 @@ struct LabelSurface {
 absl::StatusOr<std::vector<LabelSurface>> extract_surfaces(
     const volume::LabelVolume& volume, const volume::VolumeStatistics& statistics,
     const std::vector<int32_t>& labels, const RunContext& context);
+
+// Extracts the surface of each component in `ids` (1-based ids into
+// `components`), cropped to the component's box: one closed, outward surface
+// per component, identical to that component's part of the label's surface.
+absl::StatusOr<std::vector<TriangleMesh>> extract_component_surfaces(
+    const volume::LabelComponents& components, const std::vector<int32_t>& ids,
+    const volume::ImageGeometry& geometry, const RunContext& context);
 
 }  // namespace labelmesh::surface

@@ -6,41 +6,24 @@
 #include <numbers>
 #include <numeric>
 
+#include "core/geometry/disjoint_sets.h"
+#include "core/geometry/vec3.h"
+
 namespace labelmesh::surface {
 namespace {
 
-using Vec = std::array<double, 3>;
-
-Vec sub(const Vec& a, const Vec& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
-double dot(const Vec& a, const Vec& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-Vec cross(const Vec& a, const Vec& b) {
-  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
-}
-double norm(const Vec& a) { return std::sqrt(dot(a, a)); }
+using geometry::cross;
+using geometry::dot;
+using geometry::norm;
+using geometry::sub;
+using Vec = geometry::Vec3;
 
 // Angle between two edge vectors, degrees; robust near 0 and 180.
 double angle_deg(const Vec& u, const Vec& v) {
   return std::atan2(norm(cross(u, v)), dot(u, v)) * 180.0 / std::numbers::pi;
 }
 
-class DisjointSets {
- public:
-  explicit DisjointSets(size_t n) : parent_(n) { std::iota(parent_.begin(), parent_.end(), 0u); }
-  uint32_t find(uint32_t x) {
-    while (parent_[x] != x) x = parent_[x] = parent_[parent_[x]];
-    return x;
-  }
-  bool unite(uint32_t a, uint32_t b) {
-    a = find(a);
-    b = find(b);
-    if (a == b) return false;
-    parent_[b] = a;
-    return true;
-  }
-
- private:
-  std::vector<uint32_t> parent_;
-};
+using geometry::DisjointSets;
 
 // A reference point near the surface keeps the volume sum well conditioned.
 Vec centre_of(const TriangleMesh& mesh) {

@@ -15,6 +15,9 @@ struct TriangleMesh {
 
   // Reverses every triangle's winding, turning normals inside out.
   void flip_orientation();
+
+  // Adds the points and triangles of `other` (a separate piece) to this mesh.
+  void append(const TriangleMesh& other);
 };
 
 }  // namespace labelmesh::surface

@@ -1,0 +1,194 @@
+#include "core/quality_surfaces.h"
+
+#include <cmath>
+
+#include "core/surface/extract_surfaces.h"
+#include "core/surface/vertex_normals.h"
+#include "core/text.h"
+#include "core/volume/label_components.h"
+
+namespace labelmesh {
+namespace {
+
+using surface::TriangleMesh;
+
+struct Pieces {
+  ComponentCounts counts;
+  // Marching Cubes surface of each kept component.
+  std::vector<TriangleMesh> meshes;
+};
+
+absl::StatusOr<Pieces> kept_component_surfaces(const volume::LabelVolume& volume,
+                                               const volume::LabelStatistics& label,
+                                               const PoissonOptions& options,
+                                               const RunContext& context) {
+  volume::ComponentOptions component_options;
+  component_options.prune_strands = options.prune_strands;
+  auto components = volume::find_label_components(volume, label, component_options, context);
+  if (!components.ok()) return components.status();
+  const uint64_t min_voxels = options.min_component_voxels;
+  Pieces pieces;
+  pieces.counts.pruned_voxels = components->pruned_voxels;
+  std::vector<int32_t> kept;
+  for (const auto& component : components->components) {
+    if (component.voxels >= min_voxels) {
+      kept.push_back(component.id);
+    } else {
+      ++pieces.counts.dropped;
+      pieces.counts.dropped_voxels += component.voxels;
+    }
+  }
+  pieces.counts.kept = static_cast<uint32_t>(kept.size());
+  if (kept.empty()) {
+    return absl::FailedPreconditionError(
+        cat("label ", label.label, ": no component of ", min_voxels,
+            " voxels or more (min-component-voxels) is left to mesh; ", pieces.counts.dropped,
+            " smaller ones, ", pieces.counts.pruned_voxels, " voxels in one-voxel strands"));
+  }
+  auto meshes = surface::extract_component_surfaces(*components, kept, volume.geometry, context);
+  if (!meshes.ok()) return meshes.status();
+  pieces.meshes = std::move(*meshes);
+  return pieces;
+}
+
+// Progress as a fraction of the label's points, which is roughly the work.
+class PieceProgress {
+ public:
+  PieceProgress(const RunContext& context, std::string stage,
+                const std::vector<TriangleMesh>& pieces)
+      : context_(context), stage_(std::move(stage)) {
+    for (const auto& piece : pieces) total_ += double(piece.points.size());
+  }
+  void done(const TriangleMesh& piece) {
+    done_ += double(piece.points.size());
+    context_.report(stage_, total_ > 0 ? done_ / total_ : 1);
+  }
+
+ private:
+  const RunContext& context_;
+  std::string stage_;
+  double total_ = 0;
+  double done_ = 0;
+};
+
+void add_poisson_figures(surface::PoissonFigures& sum, const surface::PoissonFigures& part) {
+  sum.input_points += part.input_points;
+  sum.used_points += part.used_points;
+  sum.solver_iterations += part.solver_iterations;
+  sum.solve_seconds += part.solve_seconds;
+  sum.mesh_seconds += part.mesh_seconds;
+}
+
+void add_repair_counts(surface::RepairCounts& sum, const surface::RepairCounts& part) {
+  sum.degenerate_triangles_removed += part.degenerate_triangles_removed;
+  sum.needles_before += part.needles_before;
+  sum.caps_before += part.caps_before;
+  sum.needles_after += part.needles_after;
+  sum.caps_after += part.caps_after;
+  sum.non_manifold_vertices_split += part.non_manifold_vertices_split;
+  sum.holes_filled += part.holes_filled;
+}
+
+surface::PoissonParams poisson_params(const PoissonOptions& options, double voxel) {
+  surface::PoissonParams params;
+  params.min_angle_deg = options.min_angle_deg;
+  params.max_edge_mm = options.max_edge_voxels * voxel;
+  params.max_distance_mm = options.max_distance_voxels * voxel;
+  params.reduction = options.point_reduction;
+  params.reduction_cell_mm = options.point_cell_voxels * voxel;
+  return params;
+}
+
+}  // namespace
+
+double voxel_size_mm(const volume::ImageGeometry& geometry) {
+  return std::cbrt(geometry.voxel_volume());
+}
+
+absl::Status add_quality_surfaces(const volume::LabelVolume& volume,
+                                  const volume::LabelStatistics& label, const MeshParams& params,
+                                  const RunContext& context, std::vector<SurfaceResult>& surfaces,
+                                  std::vector<StageTiming>& stages) {
+  const double voxel = voxel_size_mm(volume.geometry);
+  absl::StatusOr<Pieces> pieces;
+  {
+    StageTimer timer(stages, "components");
+    context.report("components", 0);
+    pieces = kept_component_surfaces(volume, label, params.poisson, context);
+  }
+  if (!pieces.ok()) return pieces.status();
+  TriangleMesh marching_cubes;
+  for (const auto& piece : pieces->meshes) marching_cubes.append(piece);
+
+  SurfaceResult repaired;
+  repaired.label = label.label;
+  repaired.stage = "repaired";
+  repaired.components = pieces->counts;
+  repaired.repair.emplace();
+  {
+    StageTimer timer(stages, "repair");
+    surface::RepairParams repair_params;
+    repair_params.max_collapse_length_mm = voxel;
+    PieceProgress progress(context, "repair", pieces->meshes);
+    for (auto& piece : pieces->meshes) {
+      surface::RepairCounts counts;
+      auto fixed = surface::repair_surface(piece, repair_params, context, counts);
+      if (!fixed.ok()) return fixed.status();
+      add_repair_counts(*repaired.repair, counts);
+      progress.done(piece);
+      piece = std::move(*fixed);
+      repaired.mesh.append(piece);
+    }
+  }
+
+  SurfaceResult poisson;
+  if (params.surface == SurfaceMethod::kPoisson) {
+    poisson.label = label.label;
+    poisson.stage = "poisson";
+    poisson.components = pieces->counts;
+    poisson.poisson.emplace();
+    const auto poisson_settings = poisson_params(params.poisson, voxel);
+    PieceProgress progress(context, "poisson", pieces->meshes);
+    for (const auto& piece : pieces->meshes) {
+      surface::PoissonFigures figures;
+      auto smooth = surface::reconstruct_poisson_surface(
+          piece.points, surface::vertex_normals(piece, params.poisson.normals), poisson_settings,
+          context, figures);
+      add_stage_time(stages, "poisson_solve", figures.solve_seconds);
+      add_stage_time(stages, "poisson_mesh", figures.mesh_seconds);
+      if (!smooth.ok()) {
+        return absl::Status(smooth.status().code(), cat("label ", label.label, ": ",
+                                                        std::string(smooth.status().message())));
+      }
+      add_poisson_figures(*poisson.poisson, figures);
+      poisson.mesh.append(*smooth);
+      progress.done(piece);
+    }
+  }
+
+  SurfaceResult& output = params.surface == SurfaceMethod::kPoisson ? poisson : repaired;
+  output.is_output = true;
+  {
+    StageTimer timer(stages, "surface_statistics");
+    repaired.statistics = surface::compute_surface_statistics(repaired.mesh);
+    if (params.surface == SurfaceMethod::kPoisson)
+      poisson.statistics = surface::compute_surface_statistics(poisson.mesh);
+  }
+  {
+    StageTimer timer(stages, "surface_checks");
+    context.report("surface_checks", 0);
+    output.self_intersections = surface::count_self_intersections(output.mesh);
+    if (auto s = context.check_stop(); !s.ok()) return s;
+    output.distance_to_marching_cubes =
+        surface::surface_distance(output.mesh, marching_cubes, voxel);
+    context.report("surface_checks", 1);
+  }
+  // The repaired surface is only an intermediate when Poisson follows: its
+  // figures stay in the report, its triangles need not stay in memory.
+  if (params.surface == SurfaceMethod::kPoisson) repaired.mesh = {};
+  surfaces.push_back(std::move(repaired));
+  if (params.surface == SurfaceMethod::kPoisson) surfaces.push_back(std::move(poisson));
+  return absl::OkStatus();
+}
+
+}  // namespace labelmesh

@@ -1,0 +1,227 @@
+// The only translation unit that instantiates CGAL's Poisson reconstruction and
+// surface mesher: it is slow to compile, so nothing else includes these headers.
+#include "core/surface/poisson_surface.h"
+
+#include <chrono>
+#include <cmath>
+#include <utility>
+
+#include <CGAL/IO/facets_in_complex_2_to_triangle_mesh.h>
+#include <CGAL/Poisson_implicit_surface_3.h>
+#include <CGAL/Poisson_reconstruction_function.h>
+#include <CGAL/Surface_mesh_complex_2_in_triangulation_3.h>
+#include <CGAL/Surface_mesh_default_triangulation_3.h>
+#include <CGAL/grid_simplify_point_set.h>
+#include <CGAL/hierarchy_simplify_point_set.h>
+#include <CGAL/make_surface_mesh.h>
+#include <CGAL/property_map.h>
+#include <Eigen/IterativeLinearSolvers>
+
+#include "core/surface/cgal_mesh.h"
+#include "core/surface/surface_statistics.h"
+#include "core/text.h"
+
+namespace labelmesh::surface {
+namespace {
+
+using cgal::Kernel;
+using cgal::Point;
+using Vector = Kernel::Vector_3;
+using OrientedPoint = std::pair<Point, Vector>;
+using PointMap = CGAL::First_of_pair_property_map<OrientedPoint>;
+using NormalMap = CGAL::Second_of_pair_property_map<OrientedPoint>;
+using PoissonFunction = CGAL::Poisson_reconstruction_function<Kernel>;
+
+// Thrown from inside CGAL's loops when a stop is requested; caught below.
+struct Cancelled {};
+
+// CGAL calls this before inserting each input point into its triangulation.
+struct CancellableInsertion {
+  const RunContext* context;
+  void before_insertion() const {
+    if (context->stop_requested()) throw Cancelled{};
+  }
+};
+
+// Eigen's Jacobi preconditioner, which conjugate gradient applies once per
+// iteration: the one hook inside the solve where a stop request can be seen.
+class CancellablePreconditioner : public Eigen::DiagonalPreconditioner<double> {
+ public:
+  void set_context(const RunContext* context) { context_ = context; }
+
+  template <typename Rhs>
+  auto solve(const Eigen::MatrixBase<Rhs>& b) const {
+    if (context_ != nullptr && context_->stop_requested()) throw Cancelled{};
+    return Eigen::DiagonalPreconditioner<double>::solve(b);
+  }
+
+ private:
+  const RunContext* context_ = nullptr;
+};
+
+// Conjugate gradient to a relative residual, cancellable at every iteration;
+// a model of CGAL's SparseLinearAlgebraTraits_d.
+class CancellableSolver {
+ public:
+  using Matrix = CGAL::Eigen_sparse_symmetric_matrix<double>;
+  using Vector = CGAL::Eigen_vector<double>;
+  using NT = double;
+
+  CancellableSolver(const RunContext* context, double tolerance, int* iterations)
+      : context_(context), tolerance_(tolerance), iterations_(iterations) {}
+
+  bool linear_solver(const Matrix& a, const Vector& b, Vector& x, NT& d) {
+    d = 1;
+    // CGAL stores the lower triangle of the symmetric matrix.
+    Eigen::ConjugateGradient<Matrix::EigenType, Eigen::Lower, CancellablePreconditioner> solver;
+    solver.preconditioner().set_context(context_);
+    solver.setTolerance(tolerance_);
+    solver.compute(a.eigen_object());
+    if (solver.info() != Eigen::Success) return false;
+    x = solver.solve(b);
+    *iterations_ += static_cast<int>(solver.iterations());
+    return solver.info() == Eigen::Success;
+  }
+
+ private:
+  const RunContext* context_;
+  double tolerance_;
+  int* iterations_;
+};
+
+// The implicit function as the surface mesher sees it, polling for a stop
+// every few thousand evaluations.
+class CancellableFunction {
+ public:
+  using FT = Kernel::FT;
+  using Point = Kernel::Point_3;
+  using Cell_handle = PoissonFunction::Cell_handle;
+
+  CancellableFunction(const PoissonFunction* function, const RunContext* context)
+      : function_(function), context_(context) {}
+
+  FT operator()(const Point& p) const {
+    poll();
+    return (*function_)(p);
+  }
+  auto special_func(const Point& p) const {
+    poll();
+    return function_->special_func(p);
+  }
+
+ private:
+  void poll() const {
+    if ((++calls_ & 4095) == 0 && context_->stop_requested()) throw Cancelled{};
+  }
+  const PoissonFunction* function_;
+  const RunContext* context_;
+  mutable uint32_t calls_ = 0;
+};
+
+using Triangulation = CGAL::Surface_mesh_default_triangulation_3;
+using Complex = CGAL::Surface_mesh_complex_2_in_triangulation_3<Triangulation>;
+using ImplicitSurface = CGAL::Poisson_implicit_surface_3<Kernel, CancellableFunction>;
+using OutputMesh = cgal::Mesh;
+
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+absl::Status check_params(const PoissonParams& params) {
+  if (!(params.min_angle_deg > 0 && params.min_angle_deg <= 30)) {
+    return absl::InvalidArgumentError(
+        cat("min-angle: ", params.min_angle_deg, " is outside (0, 30] degrees"));
+  }
+  if (!(params.max_edge_mm > 0) || !std::isfinite(params.max_edge_mm))
+    return absl::InvalidArgumentError("max-edge: must be a positive length");
+  if (!(params.max_distance_mm > 0) || !std::isfinite(params.max_distance_mm))
+    return absl::InvalidArgumentError("max-distance: must be a positive length");
+  if (params.reduction == PointReduction::kGrid &&
+      (!(params.reduction_cell_mm > 0) || !std::isfinite(params.reduction_cell_mm)))
+    return absl::InvalidArgumentError("point-cell: must be a positive length");
+  return absl::OkStatus();
+}
+
+void reduce_points(std::vector<OrientedPoint>& points, const PoissonParams& params) {
+  switch (params.reduction) {
+    case PointReduction::kNone:
+      return;
+    case PointReduction::kGrid:
+      points.erase(CGAL::grid_simplify_point_set(points, params.reduction_cell_mm,
+                                                 CGAL::parameters::point_map(PointMap())),
+                   points.end());
+      return;
+    case PointReduction::kHierarchy:
+      points.erase(
+          CGAL::hierarchy_simplify_point_set(points, CGAL::parameters::point_map(PointMap())),
+          points.end());
+      return;
+  }
+}
+
+}  // namespace
+
+absl::StatusOr<TriangleMesh> reconstruct_poisson_surface(const std::vector<geometry::Vec3>& points,
+                                                         const std::vector<geometry::Vec3>& normals,
+                                                         const PoissonParams& params,
+                                                         const RunContext& context,
+                                                         PoissonFigures& figures) {
+  if (auto s = check_params(params); !s.ok()) return s;
+  if (points.size() != normals.size())
+    return absl::InternalError("poisson: one normal per point is needed");
+  std::vector<OrientedPoint> oriented;
+  oriented.reserve(points.size());
+  for (size_t i = 0; i < points.size(); ++i) {
+    const auto& p = points[i];
+    const auto& n = normals[i];
+    if (n[0] == 0 && n[1] == 0 && n[2] == 0) continue;
+    oriented.emplace_back(Point(p[0], p[1], p[2]), Vector(n[0], n[1], n[2]));
+  }
+  figures.input_points = oriented.size();
+  reduce_points(oriented, params);
+  figures.used_points = oriented.size();
+  // Fewer points than a tetrahedron's worth leave nothing to solve on.
+  if (oriented.size() < 10) {
+    return absl::InvalidArgumentError(
+        cat("poisson: ", oriented.size(), " oriented points are too few to reconstruct from"));
+  }
+
+  try {
+    auto start = std::chrono::steady_clock::now();
+    PoissonFunction function(oriented.begin(), oriented.end(), PointMap(), NormalMap(),
+                             CancellableInsertion{&context});
+    CancellableSolver solver(&context, params.solver_tolerance, &figures.solver_iterations);
+    const bool solved = function.compute_implicit_function(solver, CancellableInsertion{&context});
+    figures.solve_seconds = seconds_since(start);
+    if (!solved) return absl::InternalError("poisson: the linear solve did not converge");
+
+    start = std::chrono::steady_clock::now();
+    const Point inner = function.get_inner_point();
+    const double radius = std::sqrt(function.bounding_sphere().squared_radius());
+    // As in CGAL's examples, a ball well beyond the points. Bisection of a
+    // crossing stops at a twentieth of the distance bound (CGAL solves exactly
+    // once both ends share a tetrahedron, where the function is linear).
+    const double ball_radius = 5 * radius;
+    const double bisection_error = params.max_distance_mm / 20 / ball_radius;
+    ImplicitSurface surface(CancellableFunction(&function, &context),
+                            Kernel::Sphere_3(inner, ball_radius * ball_radius), bisection_error);
+    CGAL::Surface_mesh_default_criteria_3<Triangulation> criteria(
+        params.min_angle_deg, params.max_edge_mm / 2, params.max_distance_mm);
+    Triangulation triangulation;
+    Complex complex(triangulation);
+    CGAL::make_surface_mesh(complex, surface, criteria, CGAL::Manifold_tag());
+    OutputMesh output;
+    CGAL::facets_in_complex_2_to_triangle_mesh(complex, output);
+    figures.mesh_seconds = seconds_since(start);
+
+    TriangleMesh mesh = cgal::from_surface_mesh(output);
+    if (mesh.triangles.empty())
+      return absl::InternalError("poisson: meshing found no surface in the implicit function");
+    if (signed_volume(mesh) < 0) mesh.flip_orientation();
+    return mesh;
+  } catch (const Cancelled&) {
+    return absl::CancelledError("the run was cancelled");
+  }
+}
+
+}  // namespace labelmesh::surface

@@ -1,0 +1,64 @@
+// Poisson surface reconstruction (paper §2.3, CGAL): a smooth closed surface
+// from oriented points, meshed by Delaunay refinement with a minimum angle.
+#pragma once
+
+#include <cstddef>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "core/geometry/vec3.h"
+#include "core/run_context.h"
+#include "core/surface/triangle_mesh.h"
+
+namespace labelmesh::surface {
+
+// How the oriented points are thinned before the solve (the solve's cost grows
+// with the point count; Marching Cubes points are far denser than needed).
+enum class PointReduction {
+  kNone,
+  // One input point per cube of side `reduction_cell_mm` (CGAL grid
+  // simplification). Kept points lie on the input surface, so the reduction
+  // adds no position error; the input surface is within cell * sqrt(3) of
+  // some kept point.
+  kGrid,
+  // CGAL hierarchy simplification with its default clusters (at most 10
+  // points, variation 1/3): centroids, so points move off the input surface.
+  kHierarchy,
+};
+
+struct PoissonParams {
+  // Surface mesher criteria (CGAL Surface_mesh_default_criteria_3).
+  double min_angle_deg = 30;
+  // Upper bound on triangle edges: the surface Delaunay ball radius is bounded
+  // by half of it, and a triangle's edges never exceed twice that radius.
+  double max_edge_mm = 0;
+  // Bound on the distance between a triangle's circumcentre and the centre of
+  // its surface Delaunay ball: how far the mesh may stray from the function's
+  // zero level.
+  double max_distance_mm = 0;
+  PointReduction reduction = PointReduction::kGrid;
+  double reduction_cell_mm = 0;
+  // Relative residual at which the conjugate gradient solve stops.
+  double solver_tolerance = 1e-6;
+};
+
+struct PoissonFigures {
+  size_t input_points = 0;
+  size_t used_points = 0;
+  int solver_iterations = 0;
+  double solve_seconds = 0;  // Delaunay refinement + linear solve
+  double mesh_seconds = 0;   // surface meshing of the zero level
+};
+
+// Reconstructs one closed surface from `points` with unit `normals` (zero
+// normals are skipped). The result is outward and 2-manifold (CGAL's
+// Manifold_tag); the same input always gives the same mesh.
+// Errors: INVALID_ARGUMENT for bad parameters or too few points, INTERNAL when
+// the solve fails or meshing finds no surface, CANCELLED.
+absl::StatusOr<TriangleMesh> reconstruct_poisson_surface(const std::vector<geometry::Vec3>& points,
+                                                         const std::vector<geometry::Vec3>& normals,
+                                                         const PoissonParams& params,
+                                                         const RunContext& context,
+                                                         PoissonFigures& figures);
+
+}  // namespace labelmesh::surface

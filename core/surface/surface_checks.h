@@ -1,0 +1,31 @@
+// Geometric checks of a finished surface with CGAL: self-intersections and
+// the distance to another surface (how far a reconstruction strays from the
+// Marching Cubes surface it came from).
+#pragma once
+
+#include <cstdint>
+#include <optional>
+
+#include "core/surface/triangle_mesh.h"
+
+namespace labelmesh::surface {
+
+// Pairs of triangles that intersect other than along a shared edge or
+// vertex. nullopt when `mesh` is not a valid polygon mesh (CGAL needs one).
+std::optional<uint64_t> count_self_intersections(const TriangleMesh& mesh);
+
+struct SurfaceDistance {
+  // Largest distance from a sample on either surface to the other surface.
+  double hausdorff_mm = 0;
+  // Mean over the samples of both surfaces.
+  double mean_mm = 0;
+};
+
+// Symmetric distance between `a` and `b`, sampled at every vertex and on a
+// barycentric grid in every triangle longer than `sample_spacing_mm`, with
+// that spacing (deterministic; uses two threads). The Hausdorff figure is a lower bound that is
+// tight to within about the sample spacing times the surfaces' curvature.
+SurfaceDistance surface_distance(const TriangleMesh& a, const TriangleMesh& b,
+                                 double sample_spacing_mm);
+
+}  // namespace labelmesh::surface

@@ -1,0 +1,178 @@
+#include "core/volume/label_components.h"
+
+#include <algorithm>
+#include <limits>
+
+#include <vtkPointData.h>
+
+#include "core/geometry/disjoint_sets.h"
+#include "core/volume/voxel_access.h"
+
+namespace labelmesh::volume {
+namespace {
+
+constexpr uint32_t kBackground = std::numeric_limits<uint32_t>::max();
+
+// The label's bounding box padded by one voxel, so neighbour lookups of label
+// voxels never leave it.
+struct Box {
+  std::array<int64_t, 3> origin;  // index of the box's first voxel in the volume
+  std::array<int64_t, 3> size;
+  int64_t count() const { return size[0] * size[1] * size[2]; }
+  int64_t index(int64_t i, int64_t j, int64_t k) const { return i + size[0] * (j + size[1] * k); }
+};
+
+template <typename T>
+void fill_mask(const T* voxels, const ImageGeometry& geometry, int32_t label, const Box& box,
+               std::vector<uint8_t>& mask) {
+  const int64_t nx = geometry.dims[0], ny = geometry.dims[1];
+  for (int64_t k = 1; k + 1 < box.size[2]; ++k) {
+    for (int64_t j = 1; j + 1 < box.size[1]; ++j) {
+      // Index of box voxel (0, j, k) in the volume; i >= 1 keeps it inside.
+      const int64_t row = nx * (box.origin[1] + j + ny * (box.origin[2] + k)) + box.origin[0];
+      for (int64_t i = 1; i + 1 < box.size[0]; ++i) {
+        mask[static_cast<size_t>(box.index(i, j, k))] =
+            static_cast<int32_t>(voxels[row + i]) == label ? 1 : 0;
+      }
+    }
+  }
+}
+
+// Removes, repeatedly, voxels with at most one face neighbour: strands one
+// voxel thick, which no smooth surface at this resolution can follow.
+uint64_t prune_strands(const Box& box, std::vector<uint8_t>& mask) {
+  const int64_t steps[6] = {
+      1, -1, box.size[0], -box.size[0], box.size[0] * box.size[1], -box.size[0] * box.size[1]};
+  auto face_neighbours = [&](int64_t n) {
+    int count = 0;
+    for (int64_t step : steps) count += mask[static_cast<size_t>(n + step)];
+    return count;
+  };
+  std::vector<int64_t> queue;
+  for (int64_t n = 0; n < box.count(); ++n) {
+    if (mask[static_cast<size_t>(n)] && face_neighbours(n) <= 1) queue.push_back(n);
+  }
+  uint64_t pruned = 0;
+  while (!queue.empty()) {
+    const int64_t n = queue.back();
+    queue.pop_back();
+    if (!mask[static_cast<size_t>(n)] || face_neighbours(n) > 1) continue;
+    mask[static_cast<size_t>(n)] = 0;
+    ++pruned;
+    for (int64_t step : steps) {
+      const int64_t m = n + step;
+      if (mask[static_cast<size_t>(m)] && face_neighbours(m) <= 1) queue.push_back(m);
+    }
+  }
+  return pruned;
+}
+
+// Provisional set per voxel, united with the 13 neighbours already visited
+// (the half of the 26-neighbourhood that precedes it in memory order).
+absl::Status label_mask(const Box& box, const std::vector<uint8_t>& mask,
+                        std::vector<uint32_t>& sets_of_voxels, geometry::DisjointSets& sets,
+                        const RunContext& context) {
+  for (int64_t k = 1; k + 1 < box.size[2]; ++k) {
+    if (auto s = context.check_stop(); !s.ok()) return s;
+    for (int64_t j = 1; j + 1 < box.size[1]; ++j) {
+      for (int64_t i = 1; i + 1 < box.size[0]; ++i) {
+        const int64_t n = box.index(i, j, k);
+        if (!mask[static_cast<size_t>(n)]) continue;
+        uint32_t set = kBackground;
+        for (int64_t dk = -1; dk <= 0; ++dk) {
+          for (int64_t dj = -1; dj <= 1; ++dj) {
+            for (int64_t di = -1; di <= 1; ++di) {
+              if (dk == 0 && (dj > 0 || (dj == 0 && di >= 0))) continue;
+              const uint32_t other =
+                  sets_of_voxels[static_cast<size_t>(box.index(i + di, j + dj, k + dk))];
+              if (other == kBackground) continue;
+              if (set == kBackground) {
+                set = other;
+              } else {
+                sets.unite(set, other);
+              }
+            }
+          }
+        }
+        if (set == kBackground) set = sets.add();
+        sets_of_voxels[static_cast<size_t>(n)] = set;
+      }
+    }
+    context.report("components", 0.8 * double(k) / double(box.size[2]));
+  }
+  return absl::OkStatus();
+}
+
+}  // namespace
+
+absl::StatusOr<LabelComponents> find_label_components(const LabelVolume& volume,
+                                                      const LabelStatistics& label,
+                                                      const ComponentOptions& options,
+                                                      const RunContext& context) {
+  Box box;
+  for (int axis = 0; axis < 3; ++axis) {
+    box.origin[axis] = label.min_index[axis] - 1;
+    box.size[axis] = label.max_index[axis] - label.min_index[axis] + 3;
+  }
+  if (box.count() >= int64_t{1} << 32) {
+    return absl::InvalidArgumentError("label components: the label's bounding box is too large");
+  }
+  std::vector<uint8_t> mask(static_cast<size_t>(box.count()), 0);
+  const bool typed = visit_voxels(volume.voxels, [&](const auto* voxels, size_t) {
+    fill_mask(voxels, volume.geometry, label.label, box, mask);
+  });
+  if (!typed) return absl::InternalError("label components: unsupported voxel type in memory");
+  LabelComponents result;
+  if (options.prune_strands) result.pruned_voxels = prune_strands(box, mask);
+
+  std::vector<uint32_t> sets_of_voxels(mask.size(), kBackground);
+  geometry::DisjointSets sets;
+  if (auto s = label_mask(box, mask, sets_of_voxels, sets, context); !s.ok()) return s;
+
+  // Second pass: compact ids in order of first appearance, with counts and boxes.
+  result.ids = vtkSmartPointer<vtkImageData>::New();
+  result.ids->SetExtent(
+      static_cast<int>(box.origin[0]), static_cast<int>(box.origin[0] + box.size[0] - 1),
+      static_cast<int>(box.origin[1]), static_cast<int>(box.origin[1] + box.size[1] - 1),
+      static_cast<int>(box.origin[2]), static_cast<int>(box.origin[2] + box.size[2] - 1));
+  result.ids->SetSpacing(volume.voxels->GetSpacing());
+  result.ids->SetOrigin(volume.voxels->GetOrigin());
+  result.ids->AllocateScalars(VTK_INT, 1);
+  auto* ids = static_cast<int32_t*>(result.ids->GetScalarPointer());
+  std::vector<int32_t> id_of_root(sets.size(), 0);
+  int64_t n = 0;
+  for (int64_t k = 0; k < box.size[2]; ++k) {
+    for (int64_t j = 0; j < box.size[1]; ++j) {
+      for (int64_t i = 0; i < box.size[0]; ++i, ++n) {
+        const uint32_t set = sets_of_voxels[static_cast<size_t>(n)];
+        if (set == kBackground) {
+          ids[n] = 0;
+          continue;
+        }
+        int32_t& id = id_of_root[sets.find(set)];
+        if (id == 0) {
+          LabelComponent component;
+          component.id = static_cast<int32_t>(result.components.size() + 1);
+          component.min_index = {std::numeric_limits<int64_t>::max(),
+                                 std::numeric_limits<int64_t>::max(),
+                                 std::numeric_limits<int64_t>::max()};
+          component.max_index = {-1, -1, -1};
+          result.components.push_back(component);
+          id = component.id;
+        }
+        ids[n] = id;
+        auto& component = result.components[static_cast<size_t>(id - 1)];
+        ++component.voxels;
+        const std::array<int64_t, 3> at{box.origin[0] + i, box.origin[1] + j, box.origin[2] + k};
+        for (int axis = 0; axis < 3; ++axis) {
+          component.min_index[axis] = std::min(component.min_index[axis], at[axis]);
+          component.max_index[axis] = std::max(component.max_index[axis], at[axis]);
+        }
+      }
+    }
+  }
+  context.report("components", 1);
+  return result;
+}
+
+}  // namespace labelmesh::volume
