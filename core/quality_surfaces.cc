@@ -150,6 +150,15 @@ absl::Status add_quality_surfaces(const volume::LabelVolume& volume,
     const auto poisson_settings = poisson_params(params.poisson, voxel);
     PieceProgress progress(context, "poisson", pieces->meshes);
     for (const auto& piece : pieces->meshes) {
+      // A hollow component has several boundary surfaces; CGAL's surface
+      // mesher output for it is not handled yet (it crashed): refuse clearly.
+      if (const uint32_t shells = surface::compute_surface_statistics(piece).components;
+          shells > 1) {
+        return absl::UnimplementedError(
+            cat("label ", label.label, ": a component with a cavity (", shells,
+                " boundary surfaces) cannot be reconstructed with Poisson yet; use --surface "
+                "repaired"));
+      }
       surface::PoissonFigures figures;
       auto smooth = surface::reconstruct_poisson_surface(
           piece.points, surface::vertex_normals(piece, params.poisson.normals), poisson_settings,

@@ -9,9 +9,9 @@ bash scripts/install-deps.sh
 bash scripts/build.sh release
 labelmesh=build/release/client/labelmesh
 mkdir -p "$out"
-"$labelmesh" phantom nested-spheres --out "$out/nested-spheres.nii.gz"
-"$labelmesh" info "$out/nested-spheres.nii.gz"
-"$labelmesh" mesh "$out/nested-spheres.nii.gz" --out "$out/meshes" --formats stl,vtp,ply
+"$labelmesh" phantom oblique-ellipsoid --out "$out/ellipsoid.nii.gz"
+"$labelmesh" info "$out/ellipsoid.nii.gz"
+"$labelmesh" mesh "$out/ellipsoid.nii.gz" --out "$out/meshes" --formats stl,vtp,ply
 echo
 echo "meshes: $(ls "$out"/meshes/surface-label*.* | tr '\n' ' ')"
 echo "report: $out/meshes/report.json"

@@ -2,13 +2,16 @@
 // surface mesher: it is slow to compile, so nothing else includes these headers.
 #include "core/surface/poisson_surface.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <unordered_map>
 #include <utility>
 
-#include <CGAL/IO/facets_in_complex_2_to_triangle_mesh.h>
 #include <CGAL/Poisson_implicit_surface_3.h>
 #include <CGAL/Poisson_reconstruction_function.h>
+#include <CGAL/Polygon_mesh_processing/orient_polygon_soup.h>
+#include <CGAL/Polygon_mesh_processing/orientation.h>
 #include <CGAL/Surface_mesh_complex_2_in_triangulation_3.h>
 #include <CGAL/Surface_mesh_default_triangulation_3.h>
 #include <CGAL/grid_simplify_point_set.h>
@@ -18,7 +21,6 @@
 #include <Eigen/IterativeLinearSolvers>
 
 #include "core/surface/cgal_mesh.h"
-#include "core/surface/surface_statistics.h"
 #include "core/text.h"
 
 namespace labelmesh::surface {
@@ -123,6 +125,47 @@ using Complex = CGAL::Surface_mesh_complex_2_in_triangulation_3<Triangulation>;
 using ImplicitSurface = CGAL::Poisson_implicit_surface_3<Kernel, CancellableFunction>;
 using OutputMesh = cgal::Mesh;
 
+// The triangles of the restricted Delaunay surface, in the triangulation's
+// own (deterministic) vertex order, oriented outward by CGAL (which handles
+// nested components), and sorted so the order never depends on addresses.
+absl::StatusOr<TriangleMesh> complex_to_mesh(const Complex& complex, const Triangulation& tr) {
+  namespace PMP = CGAL::Polygon_mesh_processing;
+  std::vector<std::array<Triangulation::Vertex_handle, 3>> facets;
+  for (auto f = tr.finite_facets_begin(); f != tr.finite_facets_end(); ++f) {
+    if (!complex.is_in_complex(*f)) continue;
+    const auto cell = f->first;
+    const int i = f->second;
+    facets.push_back({cell->vertex(tr.vertex_triple_index(i, 0)),
+                      cell->vertex(tr.vertex_triple_index(i, 1)),
+                      cell->vertex(tr.vertex_triple_index(i, 2))});
+  }
+  std::unordered_map<Triangulation::Vertex_handle, size_t> index;
+  for (const auto& facet : facets) {
+    for (auto v : facet) index.emplace(v, 0);
+  }
+  std::vector<Point> points;
+  for (auto v = tr.finite_vertices_begin(); v != tr.finite_vertices_end(); ++v) {
+    auto found = index.find(v);
+    if (found == index.end()) continue;
+    found->second = points.size();
+    points.push_back(v->point());
+  }
+  std::vector<std::array<size_t, 3>> triangles;
+  triangles.reserve(facets.size());
+  for (const auto& f : facets) triangles.push_back({index[f[0]], index[f[1]], index[f[2]]});
+  PMP::orient_polygon_soup(points, triangles);
+  if (!PMP::is_polygon_soup_a_polygon_mesh(triangles))
+    return absl::InternalError("poisson: the meshed surface is not a manifold");
+  OutputMesh mesh;
+  PMP::polygon_soup_to_polygon_mesh(points, triangles, mesh);
+  PMP::orient_to_bound_a_volume(mesh);
+  TriangleMesh result = cgal::from_surface_mesh(mesh);
+  for (auto& t : result.triangles)
+    std::rotate(t.begin(), std::min_element(t.begin(), t.end()), t.end());
+  std::sort(result.triangles.begin(), result.triangles.end());
+  return result;
+}
+
 double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
@@ -210,14 +253,10 @@ absl::StatusOr<TriangleMesh> reconstruct_poisson_surface(const std::vector<geome
     Triangulation triangulation;
     Complex complex(triangulation);
     CGAL::make_surface_mesh(complex, surface, criteria, CGAL::Manifold_tag());
-    OutputMesh output;
-    CGAL::facets_in_complex_2_to_triangle_mesh(complex, output);
-    figures.mesh_seconds = seconds_since(start);
-
-    TriangleMesh mesh = cgal::from_surface_mesh(output);
-    if (mesh.triangles.empty())
+    auto mesh = complex_to_mesh(complex, triangulation);
+    if (mesh.ok() && mesh->triangles.empty())
       return absl::InternalError("poisson: meshing found no surface in the implicit function");
-    if (signed_volume(mesh) < 0) mesh.flip_orientation();
+    figures.mesh_seconds = seconds_since(start);
     return mesh;
   } catch (const Cancelled&) {
     return absl::CancelledError("the run was cancelled");

@@ -39,8 +39,9 @@ std::string slurp(const std::filesystem::path& path) {
 TEST(Cli, MeshWritesSurfacesAndReport) {
   const auto dir = testing::scratch_dir("cli-mesh");
   ASSERT_EQ(run_cli("phantom nested-spheres --out " + (dir / "nested.nrrd").string()).exit_code, 0);
-  const CliRun run = run_cli("mesh " + (dir / "nested.nrrd").string() + " --out " +
-                             (dir / "out").string() + " --labels 1,3 --formats stl,ply,off");
+  const CliRun run =
+      run_cli("mesh " + (dir / "nested.nrrd").string() + " --out " + (dir / "out").string() +
+              " --labels 1,3 --surface mc --formats stl,ply,off");
   ASSERT_EQ(run.exit_code, 0) << run.output;
   for (const char* name : {"surface-label1.stl", "surface-label1.ply", "surface-label3.off"}) {
     EXPECT_TRUE(std::filesystem::exists(dir / "out" / name)) << name;
@@ -82,8 +83,43 @@ TEST(Cli, JsonReportOnStdout) {
   ASSERT_EQ(run.exit_code, 0);
   v1::Report report;
   ASSERT_TRUE(google::protobuf::util::JsonStringToMessage(run.output, &report).ok()) << run.output;
-  ASSERT_EQ(report.surfaces_size(), 1);
-  EXPECT_EQ(report.surfaces(0).euler_characteristic(), 0);
+  // Poisson by default: the report lists the Marching Cubes, repaired and
+  // Poisson stages (Table 2's columns); only the last is the output.
+  ASSERT_EQ(report.surfaces_size(), 3);
+  EXPECT_EQ(report.surfaces(0).stage(), "marching_cubes");
+  EXPECT_EQ(report.surfaces(1).stage(), "repaired");
+  const auto& poisson = report.surfaces(2);
+  EXPECT_EQ(poisson.stage(), "poisson");
+  EXPECT_TRUE(poisson.output());
+  EXPECT_FALSE(report.surfaces(0).output());
+  EXPECT_EQ(poisson.euler_characteristic(), 0);
+  EXPECT_GE(poisson.min_angle_deg(), 29.99);
+  ASSERT_TRUE(poisson.has_self_intersections());
+  EXPECT_EQ(poisson.self_intersections(), 0u);
+  ASSERT_TRUE(poisson.has_hausdorff_mm());
+  EXPECT_LT(poisson.hausdorff_mm(), 1.5);
+  EXPECT_FALSE(report.surfaces(0).has_hausdorff_mm());
+  EXPECT_EQ(poisson.components_kept(), 1u);
+  EXPECT_GT(poisson.poisson().used_points(), 100u);
+  EXPECT_EQ(report.options().surface(), v1::SURFACE_METHOD_POISSON);
+  EXPECT_EQ(report.options().min_angle_deg(), 30);
+  EXPECT_TRUE(std::filesystem::exists(dir / "o" / "surface-label1.stl"));
+}
+
+TEST(Cli, BadPoissonOptionsAreUsageErrors) {
+  const auto dir = testing::scratch_dir("cli-poisson-options");
+  ASSERT_EQ(run_cli("phantom sphere --out " + (dir / "s.nii").string()).exit_code, 0);
+  const std::string mesh = "mesh " + (dir / "s.nii").string() + " --out " + (dir / "o").string();
+  const CliRun angle = run_cli(mesh + " --min-angle 35");
+  EXPECT_EQ(angle.exit_code, 2);
+  EXPECT_NE(angle.output.find("min_angle_deg"), std::string::npos) << angle.output;
+  EXPECT_EQ(run_cli(mesh + " --max-edge 0").exit_code, 2);
+  EXPECT_EQ(run_cli(mesh + " --max-distance -1").exit_code, 2);
+  EXPECT_EQ(run_cli(mesh + " --point-reduction octree").exit_code, 2);
+  // Every component under the size threshold: nothing left to mesh.
+  const CliRun nothing = run_cli(mesh + " --min-component-voxels 100000");
+  EXPECT_EQ(nothing.exit_code, 4);
+  EXPECT_NE(nothing.output.find("min-component-voxels"), std::string::npos) << nothing.output;
 }
 
 TEST(Cli, InfoJsonOnRealData) {

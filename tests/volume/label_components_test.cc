@@ -1,0 +1,79 @@
+#include "core/volume/label_components.h"
+
+#include <gtest/gtest.h>
+
+#include "core/volume/label_statistics.h"
+#include "support/label_grid.h"
+
+namespace labelmesh::volume {
+namespace {
+
+LabelComponents components_of(const LabelVolume& v, int32_t label, bool prune) {
+  const auto stats = compute_label_statistics(v);
+  const auto* entry = stats.find(label);
+  EXPECT_NE(entry, nullptr);
+  ComponentOptions options;
+  options.prune_strands = prune;
+  auto found = find_label_components(v, *entry, options, RunContext{});
+  EXPECT_TRUE(found.ok()) << found.status();
+  return found.ok() ? std::move(*found) : LabelComponents{};
+}
+
+bool in_box(int i, int j, int k, int lo, int hi) {
+  return i >= lo && i <= hi && j >= lo && j <= hi && k >= lo && k <= hi;
+}
+
+TEST(LabelComponents, SeparateBlocksAreSeparateAndCornersJoin) {
+  // Two 3x3x3 blocks apart, plus a single voxel touching the first by a corner.
+  const auto v = testing::label_grid({14, 14, 14}, [](int i, int j, int k) -> uint8_t {
+    if (in_box(i, j, k, 1, 3) || in_box(i, j, k, 8, 10)) return 1;
+    return (i == 4 && j == 4 && k == 4) ? 1 : 0;
+  });
+  const auto found = components_of(v, 1, /*prune=*/false);
+  ASSERT_EQ(found.components.size(), 2u);
+  EXPECT_EQ(found.components[0].voxels, 28u);  // 27 + the corner voxel
+  EXPECT_EQ(found.components[1].voxels, 27u);
+  EXPECT_EQ(found.components[1].min_index, (std::array<int64_t, 3>{8, 8, 8}));
+  EXPECT_EQ(found.components[1].max_index, (std::array<int64_t, 3>{10, 10, 10}));
+  EXPECT_EQ(found.pruned_voxels, 0u);
+  // The id image covers the label's box plus one voxel and holds ids 1 and 2.
+  int extent[6];
+  found.ids->GetExtent(extent);
+  EXPECT_EQ(extent[0], 0);
+  EXPECT_EQ(extent[1], 11);
+  EXPECT_EQ(*static_cast<int32_t*>(found.ids->GetScalarPointer(9, 9, 9)), 2);
+  EXPECT_EQ(*static_cast<int32_t*>(found.ids->GetScalarPointer(4, 4, 4)), 1);
+  EXPECT_EQ(*static_cast<int32_t*>(found.ids->GetScalarPointer(6, 6, 6)), 0);
+}
+
+TEST(LabelComponents, OneVoxelStrandsArePruned) {
+  // A 5x5x5 block with a 3-voxel strand sticking out along x, and a separate
+  // 1-voxel-thick line of 4 voxels.
+  const auto v = testing::label_grid({16, 12, 12}, [](int i, int j, int k) -> uint8_t {
+    if (in_box(i, j, k, 1, 5)) return 1;
+    if (j == 3 && k == 3 && i >= 6 && i <= 8) return 1;   // strand on the block
+    if (i == 12 && j == 8 && k >= 2 && k <= 5) return 1;  // lone line
+    return 0;
+  });
+  const auto kept = components_of(v, 1, /*prune=*/false);
+  EXPECT_EQ(kept.components.size(), 2u);
+  EXPECT_EQ(kept.pruned_voxels, 0u);
+  const auto pruned = components_of(v, 1, /*prune=*/true);
+  ASSERT_EQ(pruned.components.size(), 1u);
+  EXPECT_EQ(pruned.pruned_voxels, 7u);
+  EXPECT_EQ(pruned.components[0].voxels, 125u);
+  EXPECT_EQ(pruned.components[0].max_index, (std::array<int64_t, 3>{5, 5, 5}));
+}
+
+TEST(LabelComponents, CancelledRunStops) {
+  const auto v = testing::label_grid({8, 8, 8}, [](int, int, int) -> uint8_t { return 1; });
+  const auto stats = compute_label_statistics(v);
+  std::atomic<bool> stop{true};
+  RunContext context;
+  context.stop = &stop;
+  auto found = find_label_components(v, stats.labels[0], ComponentOptions{}, context);
+  EXPECT_EQ(found.status().code(), absl::StatusCode::kCancelled);
+}
+
+}  // namespace
+}  // namespace labelmesh::volume
