@@ -1,5 +1,6 @@
 #include "core/pipeline.h"
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 
@@ -106,6 +107,9 @@ absl::Status write_results(MeshResult& result, const MeshParams& params, const s
   if (error) return absl::InternalError(cat(out_dir, ": cannot create the directory"));
   {
     StageTimer timer(result.stages, "write");
+    // Only output stages are written; progress counts those.
+    const auto outputs = std::count_if(result.surfaces.begin(), result.surfaces.end(),
+                                       [](const SurfaceResult& s) { return s.is_output; });
     size_t done = 0;
     for (auto& surface : result.surfaces) {
       if (auto s = context.check_stop(); !s.ok()) return s;
@@ -118,7 +122,7 @@ absl::Status write_results(MeshResult& result, const MeshParams& params, const s
         if (auto s = surface::write_surface(surface.mesh, path, format); !s.ok()) return s;
         surface.files.push_back(name);
       }
-      context.report("write", double(++done) / double(result.surfaces.size()));
+      context.report("write", double(++done) / double(outputs));
     }
   }
   const auto report_path = (std::filesystem::path(out_dir) / "report.json").string();

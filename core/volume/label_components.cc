@@ -3,8 +3,6 @@
 #include <algorithm>
 #include <limits>
 
-#include <vtkPointData.h>
-
 #include "core/geometry/disjoint_sets.h"
 #include "core/volume/voxel_access.h"
 
