@@ -86,6 +86,13 @@ CommandRunner add_mesh_command(CLI::App& app) {
       ->capture_default_str();
   mesh->add_flag("--keep-strands", options->keep_strands,
                  "Keep strands one voxel thick (repaired, poisson); by default they are pruned");
+  mesh->add_option("--smoothing-iterations", poisson.smoothing.iterations,
+                   "Poisson: windowed-sinc smoothing of the repaired surface before "
+                   "reconstruction, filter iterations (0: off)")
+      ->capture_default_str();
+  mesh->add_option("--smoothing-pass-band", poisson.smoothing.pass_band,
+                   "Poisson: smoothing pass band in (0, 2); lower smooths more")
+      ->capture_default_str();
   mesh->add_option("--normals", options->normals,
                    "Poisson: vertex normals from incident triangles, uniform or area weighted")
       ->check(CLI::IsMember({"uniform", "area"}))
@@ -120,6 +127,8 @@ CommandRunner add_mesh_command(CLI::App& app) {
     proto.set_min_component_voxels(poisson.min_component_voxels);
     proto.set_point_cell_voxels(poisson.point_cell_voxels);
     proto.set_prune_strands(!options->keep_strands);
+    proto.set_smoothing_iterations(poisson.smoothing.iterations);
+    proto.set_smoothing_pass_band(poisson.smoothing.pass_band);
 
     proto.set_normals(options->normals == "area" ? v1::NORMAL_WEIGHTING_AREA
                                                  : v1::NORMAL_WEIGHTING_UNIFORM);

@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "core/surface/extract_surfaces.h"
+#include "core/surface/smooth_surface.h"
 #include "core/surface/vertex_normals.h"
 #include "core/text.h"
 #include "core/volume/label_components.h"
@@ -150,19 +151,16 @@ absl::Status add_quality_surfaces(const volume::LabelVolume& volume,
     const auto poisson_settings = poisson_params(params.poisson, voxel);
     PieceProgress progress(context, "poisson", pieces->meshes);
     for (const auto& piece : pieces->meshes) {
-      // A hollow component has several boundary surfaces; CGAL's surface
-      // mesher output for it is not handled yet (it crashed): refuse clearly.
-      if (const uint32_t shells = surface::compute_surface_statistics(piece).components;
-          shells > 1) {
-        return absl::UnimplementedError(
-            cat("label ", label.label, ": a component with a cavity (", shells,
-                " boundary surfaces) cannot be reconstructed with Poisson yet; use --surface "
-                "repaired"));
+      absl::StatusOr<TriangleMesh> samples;
+      {
+        StageTimer timer(stages, "poisson_smoothing");
+        samples = surface::smooth_surface(piece, params.poisson.smoothing, context);
       }
+      if (!samples.ok()) return samples.status();
       surface::PoissonFigures figures;
       auto smooth = surface::reconstruct_poisson_surface(
-          piece.points, surface::vertex_normals(piece, params.poisson.normals), poisson_settings,
-          context, figures);
+          samples->points, surface::vertex_normals(*samples, params.poisson.normals),
+          poisson_settings, context, figures);
       add_stage_time(stages, "poisson_solve", figures.solve_seconds);
       add_stage_time(stages, "poisson_mesh", figures.mesh_seconds);
       if (!smooth.ok()) {

@@ -58,6 +58,20 @@ absl::Status read_poisson_options(const v1::MeshOptions& options, PoissonOptions
       return s;
   }
   if (options.has_prune_strands()) poisson.prune_strands = options.prune_strands();
+  if (options.has_smoothing_iterations()) {
+    poisson.smoothing.iterations = options.smoothing_iterations();
+    if (poisson.smoothing.iterations < 0 || poisson.smoothing.iterations > 200) {
+      return absl::InvalidArgumentError(
+          cat("smoothing_iterations: ", poisson.smoothing.iterations, " is outside 0..200"));
+    }
+  }
+  if (options.has_smoothing_pass_band()) {
+    poisson.smoothing.pass_band = options.smoothing_pass_band();
+    if (!(poisson.smoothing.pass_band > 0 && poisson.smoothing.pass_band < 2)) {
+      return absl::InvalidArgumentError(
+          cat("smoothing_pass_band: ", poisson.smoothing.pass_band, " is outside (0, 2)"));
+    }
+  }
 
   if (options.has_min_component_voxels())
     poisson.min_component_voxels = options.min_component_voxels();
@@ -98,6 +112,7 @@ void add_quality_figures(const SurfaceResult& surface, v1::SurfaceSummary& entry
   if (surface.distance_to_marching_cubes) {
     entry.set_hausdorff_mm(surface.distance_to_marching_cubes->hausdorff_mm);
     entry.set_mean_distance_mm(surface.distance_to_marching_cubes->mean_mm);
+    for (double c : surface.distance_to_marching_cubes->hausdorff_at) entry.add_hausdorff_at(c);
   }
   if (surface.components) {
     entry.set_components_kept(surface.components->kept);
@@ -167,6 +182,8 @@ v1::MeshOptions make_options(const MeshParams& params) {
   options.set_point_reduction(to_proto(poisson.point_reduction));
   options.set_point_cell_voxels(poisson.point_cell_voxels);
   options.set_prune_strands(poisson.prune_strands);
+  options.set_smoothing_iterations(poisson.smoothing.iterations);
+  options.set_smoothing_pass_band(poisson.smoothing.pass_band);
 
   for (auto format : params.formats)
     options.add_formats(std::string(surface::surface_format_name(format)));

@@ -61,6 +61,7 @@ std::vector<Point> sample_points(const TriangleMesh& mesh, double spacing) {
 
 struct OneSided {
   double max_squared = 0;
+  Point farthest = Point(0, 0, 0);
   double sum = 0;
   size_t count = 0;
 };
@@ -72,7 +73,10 @@ OneSided distances_to(const std::vector<Point>& samples, const Triangles& target
   tree.accelerate_distance_queries();
   for (const Point& p : samples) {
     const double squared = CGAL::to_double(tree.squared_distance(p));
-    result.max_squared = std::max(result.max_squared, squared);
+    if (squared > result.max_squared) {
+      result.max_squared = squared;
+      result.farthest = p;
+    }
     result.sum += std::sqrt(squared);
     ++result.count;
   }
@@ -99,7 +103,9 @@ SurfaceDistance surface_distance(const TriangleMesh& a, const TriangleMesh& b,
   const OneSided b_to_a = distances_to(sample_points(b, sample_spacing_mm), to_triangles(a));
   forward.join();
   SurfaceDistance distance;
-  distance.hausdorff_mm = std::sqrt(std::max(a_to_b.max_squared, b_to_a.max_squared));
+  const OneSided& worse = a_to_b.max_squared >= b_to_a.max_squared ? a_to_b : b_to_a;
+  distance.hausdorff_mm = std::sqrt(worse.max_squared);
+  distance.hausdorff_at = {worse.farthest.x(), worse.farthest.y(), worse.farthest.z()};
   const size_t count = a_to_b.count + b_to_a.count;
   distance.mean_mm = count > 0 ? (a_to_b.sum + b_to_a.sum) / double(count) : 0;
   return distance;

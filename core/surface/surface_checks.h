@@ -3,6 +3,7 @@
 // Marching Cubes surface it came from).
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <optional>
 
@@ -19,6 +20,9 @@ struct SurfaceDistance {
   double hausdorff_mm = 0;
   // Mean over the samples of both surfaces.
   double mean_mm = 0;
+  // The sample where the Hausdorff distance is reached (LPS, mm): where to
+  // look when a reconstruction strays.
+  std::array<double, 3> hausdorff_at{0, 0, 0};
 };
 
 // Symmetric distance between `a` and `b`, sampled at every vertex and on a

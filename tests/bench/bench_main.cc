@@ -1,7 +1,9 @@
 // labelmesh_bench [FILE...]: per-stage seconds, voxels per second and peak
 // RSS for reading and Marching Cubes, beside the baselines they are held to:
 // a plain decompress + scan of the voxels, and VTK's discrete flying edges
-// run directly on the whole volume. Prints figures; never fails on time.
+// run directly on the whole volume. Then the quality-surface pipeline (MC,
+// repair, smoothing, Poisson solve and meshing, checks) on the liver's label
+// 255 and a 256^3 sphere, stage by stage. Prints figures; never fails on time.
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -15,11 +17,14 @@
 #include <vtkNew.h>
 #include <vtkPolyData.h>
 
+#include "core/pipeline.h"
 #include "core/surface/extract_surfaces.h"
 #include "core/surface/surface_statistics.h"
 #include "core/volume/label_statistics.h"
 #include "core/volume/payload_stream.h"
+#include "core/volume/phantom.h"
 #include "core/volume/read_label_volume.h"
+#include "core/volume/write_label_volume.h"
 
 namespace {
 
@@ -116,6 +121,66 @@ int bench_file(const std::string& path) {
   return 0;
 }
 
+// The default Poisson pipeline on `labels` of `path`, stage by stage.
+int bench_quality_surface(const std::string& path, const std::vector<int32_t>& labels) {
+  labelmesh::MeshParams params;
+  params.labels = labels;
+  const auto start = Clock::now();
+  auto result = labelmesh::run_pipeline(path, params, labelmesh::RunContext{});
+  const double total = seconds_since(start);
+  if (!result.ok()) {
+    std::fprintf(stderr, "%s\n", std::string(result.status().message()).c_str());
+    return 1;
+  }
+  std::printf("%s, labels", path.c_str());
+  for (int32_t label : labels) std::printf(" %d", label);
+  std::printf(": poisson pipeline %.2f s (target <= 10 s on the liver)\n", total);
+  for (const auto& stage : result->stages)
+    std::printf("  %-27s %8.3f s\n", stage.name.c_str(), stage.seconds);
+  for (const auto& surface : result->surfaces) {
+    if (!surface.is_output) continue;
+    const auto& st = surface.statistics;
+    std::printf("  label %d: %u nodes, %u triangles, angles %.2f-%.2f deg", surface.label, st.nodes,
+                st.triangles, st.min_angle_deg, st.max_angle_deg);
+    if (surface.poisson) {
+      std::printf(", %zu of %zu points, %d CG iterations", surface.poisson->used_points,
+                  surface.poisson->input_points, surface.poisson->solver_iterations);
+    }
+    if (surface.distance_to_marching_cubes) {
+      std::printf(", Hausdorff %.3f mm, mean %.3f mm",
+                  surface.distance_to_marching_cubes->hausdorff_mm,
+                  surface.distance_to_marching_cubes->mean_mm);
+    }
+    std::printf("\n");
+  }
+  std::printf("  peak RSS                    %8.1f MiB (target <= 1024 on the liver)\n",
+              peak_rss_mib());
+  return 0;
+}
+
+// A sphere phantom filling a 256^3 grid (radius 125 voxels), written to /tmp.
+std::string write_large_sphere() {
+  const auto phantom =
+      labelmesh::volume::make_phantom(labelmesh::volume::PhantomShape::kSphere, 6.25);
+  const std::string path = "/tmp/labelmesh-bench-sphere256.nii.gz";
+  if (!labelmesh::volume::write_label_volume(phantom.volume, path).ok()) return "";
+  return path;
+}
+
+// Runs `job` in a child process, so that its peak RSS is its own.
+template <typename F>
+bool in_child(F&& job) {
+  const pid_t child = fork();
+  if (child == 0) {
+    const int code = job();
+    std::fflush(stdout);
+    _exit(code);
+  }
+  int status = 0;
+  waitpid(child, &status, 0);
+  return WIFEXITED(status) && WEXITSTATUS(status) == 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -127,16 +192,13 @@ int main(int argc, char** argv) {
   }
   int failures = 0;
   for (const auto& file : files) {
-    // One child per file, so each peak RSS is that file's own.
-    const pid_t child = fork();
-    if (child == 0) {
-      const int code = bench_file(file);
-      std::fflush(stdout);
-      _exit(code);
-    }
-    int status = 0;
-    waitpid(child, &status, 0);
-    if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) ++failures;
+    if (!in_child([&] { return bench_file(file); })) ++failures;
+  }
+  if (argc == 1) {
+    const std::string liver = files[0];
+    if (!in_child([&] { return bench_quality_surface(liver, {255}); })) ++failures;
+    const std::string sphere = write_large_sphere();
+    if (sphere.empty() || !in_child([&] { return bench_quality_surface(sphere, {1}); })) ++failures;
   }
   return failures == 0 ? 0 : 1;
 }

@@ -116,6 +116,10 @@ TEST(Cli, BadPoissonOptionsAreUsageErrors) {
   EXPECT_EQ(run_cli(mesh + " --max-edge 0").exit_code, 2);
   EXPECT_EQ(run_cli(mesh + " --max-distance -1").exit_code, 2);
   EXPECT_EQ(run_cli(mesh + " --point-reduction octree").exit_code, 2);
+  const CliRun band = run_cli(mesh + " --smoothing-pass-band 2.5");
+  EXPECT_EQ(band.exit_code, 2);
+  EXPECT_NE(band.output.find("smoothing_pass_band"), std::string::npos) << band.output;
+  EXPECT_EQ(run_cli(mesh + " --smoothing-iterations -3").exit_code, 2);
   // Every component under the size threshold: nothing left to mesh.
   const CliRun nothing = run_cli(mesh + " --min-component-voxels 100000");
   EXPECT_EQ(nothing.exit_code, 4);

@@ -77,13 +77,15 @@ TEST(PoissonSurface, SphereIsSmootherThanMarchingCubes) {
   EXPECT_EQ(smooth->statistics.euler_characteristic, 2);
   const double mc_error = rms_radial_error(mc_surface->mesh, phantom.centre, 20);
   const double poisson_error = rms_radial_error(smooth->mesh, phantom.centre, 20);
-  // Measured: 0.208 voxel for Marching Cubes (the staircase), 0.137 for Poisson.
+  // The targets: under 0.1 voxel and under half the staircase's
+  // error. Measured: 0.208 voxel for Marching Cubes, 0.094 for Poisson from
+  // the smoothed samples (0.141 without smoothing).
   EXPECT_GT(mc_error, 0.18);
-  EXPECT_LT(poisson_error, 0.15);
-  EXPECT_LT(poisson_error, 0.75 * mc_error);
-  // Measured -2.3 %: with 8-voxel edges on a 20-voxel sphere, the flat
+  EXPECT_LT(poisson_error, 0.1);
+  EXPECT_LT(poisson_error, 0.5 * mc_error);
+  // Measured -3.0 %: with 8-voxel edges on a 20-voxel sphere, the flat
   // triangles cut inside the curve (see README on --max-edge for small organs).
-  EXPECT_NEAR(smooth->statistics.volume_mm3 / phantom.truth[0].volume_mm3, 1.0, 0.03);
+  EXPECT_NEAR(smooth->statistics.volume_mm3 / phantom.truth[0].volume_mm3, 1.0, 0.035);
   ASSERT_TRUE(smooth->distance_to_marching_cubes.has_value());
   EXPECT_LT(smooth->distance_to_marching_cubes->hausdorff_mm, 1.0);
   EXPECT_LT(smooth->distance_to_marching_cubes->mean_mm, 0.3);
@@ -195,12 +197,29 @@ TEST(PoissonSurface, RepairedStageWritesTheRepairedSurface) {
   ASSERT_NE(smooth, nullptr);
   expect_quality_surface(*smooth);
   EXPECT_EQ(smooth->statistics.euler_characteristic, 2);
-  // Hollow components (the shells) are refused with a clear error for now.
-  MeshParams shell;
-  shell.labels = {2};
-  const auto refused = run_pipeline(path, shell, RunContext{});
-  EXPECT_EQ(refused.status().code(), absl::StatusCode::kUnimplemented);
-  EXPECT_NE(std::string(refused.status().message()).find("label 2"), std::string::npos);
+}
+
+TEST(PoissonSurface, HollowComponentsKeepTheirCavity) {
+  // Labels 2 and 3 are shells: one component each, bounded by two surfaces.
+  const auto path = phantom_file(PhantomShape::kNestedSpheres, "shells.nii.gz");
+  const auto phantom = make_phantom(PhantomShape::kNestedSpheres);
+  MeshParams params;
+  params.labels = {2, 3};
+  const MeshResult result = mesh_file(path, params);
+  for (int32_t label : {2, 3}) {
+    const SurfaceResult* shell = find_stage(result, label, "poisson");
+    ASSERT_NE(shell, nullptr);
+    expect_quality_surface(*shell);
+    ASSERT_TRUE(shell->components.has_value());
+    EXPECT_EQ(shell->components->kept, 1u);
+    // Outer and inner sphere: two closed surfaces, the inner one facing the
+    // cavity, so the enclosed volume is the shell's.
+    EXPECT_EQ(shell->statistics.components, 2u);
+    EXPECT_EQ(shell->statistics.euler_characteristic, 4);
+    // Measured -4.0 % (label 2) and -2.0 % (label 3): 8-voxel edges on
+    // spheres of radius 6 to 18 voxels cut inside both curves.
+    EXPECT_NEAR(shell->statistics.volume_mm3 / phantom.truth[label - 1].volume_mm3, 1.0, 0.06);
+  }
 }
 
 TEST(PoissonSurfaceRealData, LiverMeetsTheQualityTargets) {
@@ -214,8 +233,9 @@ TEST(PoissonSurfaceRealData, LiverMeetsTheQualityTargets) {
   const double voxel_volume_mm3 = 1605456.467;  // 6,322,002 voxels
   EXPECT_NEAR(smooth->statistics.volume_mm3 / voxel_volume_mm3, 1.0, 0.01);
   ASSERT_TRUE(smooth->distance_to_marching_cubes.has_value());
-  // Measured 1.58 mm (the target of one voxel diagonal, 1.1 mm, is
-  // not met: see README, "Poisson fidelity") and a mean of 0.22 mm.
+  // Measured 1.72 mm at a sharp 90-degree edge of the segmentation (the
+  // issue's target of one voxel diagonal, 1.1 mm, is not met: see README,
+  // "Poisson fidelity") and a mean of 0.25 mm.
   EXPECT_LT(smooth->distance_to_marching_cubes->hausdorff_mm, 2.0);
   EXPECT_LT(smooth->distance_to_marching_cubes->mean_mm, 0.3);
   ASSERT_TRUE(smooth->components.has_value());

@@ -1,0 +1,28 @@
+// Low-pass smoothing of a staircase surface before Poisson reconstruction:
+// VTK's windowed-sinc filter (Taubin, Zhang & Golub, "Optimal surface
+// smoothing as filter design", 1996), which removes the voxel-scale ripple
+// without the shrinkage of plain Laplacian smoothing.
+#pragma once
+
+#include "absl/status/statusor.h"
+#include "core/run_context.h"
+#include "core/surface/triangle_mesh.h"
+
+namespace labelmesh::surface {
+
+struct SmoothingParams {
+  // Filter iterations (the degree of the Chebyshev approximation); 0 turns
+  // smoothing off. More iterations give a sharper cut-off, not more smoothing.
+  int iterations = 20;
+  // Pass band in (0, 2): lower removes longer wavelengths. 0.1 flattens the
+  // one-voxel staircase and keeps features a few voxels across.
+  double pass_band = 0.1;
+};
+
+// The same triangles with moved points. Connectivity, orientation and the
+// number of points never change. Errors: INVALID_ARGUMENT for bad parameters,
+// CANCELLED.
+absl::StatusOr<TriangleMesh> smooth_surface(const TriangleMesh& mesh, const SmoothingParams& params,
+                                            const RunContext& context);
+
+}  // namespace labelmesh::surface
