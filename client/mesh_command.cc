@@ -23,6 +23,9 @@ struct MeshCommandOptions {
   std::string normals = "uniform";
   std::string point_reduction = "grid";
   bool keep_strands = false;
+  std::string volume = "none";
+  volume_mesh::TetgenParams tetgen;
+  bool tet_split_boundary = false;
   std::vector<std::string> formats{"stl", "vtp"};
   uint64_t max_voxels = volume::ReadLimits{}.max_voxels;
   bool json = false;
@@ -51,6 +54,16 @@ void print_summary(const MeshResult& result, const std::string& out_dir) {
                     .c_str(),
                 optional_figure(distance.has_value(), distance ? distance->hausdorff_mm : 0, "%.3f")
                     .c_str());
+  }
+  if (result.volume) {
+    const auto& v = *result.volume;
+    const auto& q = v.summary;
+    std::printf(
+        "volume (%s): %zu nodes, %zu tetrahedra; quality Q min %.3f mean %.3f; dihedral %.1f-%.1f "
+        "deg; invalid %lld, very bad %lld, questionable %lld, good %lld\n",
+        v.mesher.c_str(), v.mesh.points.size(), v.mesh.tetrahedra.size(), q.count ? q.min : 0,
+        q.mean, q.count ? q.min_dihedral_deg : 0, q.count ? q.max_dihedral_deg : 0,
+        (long long)q.invalid, (long long)q.very_bad, (long long)q.questionable, (long long)q.good);
   }
   std::printf("meshes and report.json written to %s\n", out_dir.c_str());
 }
@@ -104,11 +117,30 @@ CommandRunner add_mesh_command(CLI::App& app) {
   mesh->add_option("--point-cell", poisson.point_cell_voxels,
                    "Poisson: grid cell of the point reduction, voxels")
       ->capture_default_str();
-  mesh->add_option("--formats", options->formats,
-                   "Surface files per label: stl, ply, obj, off, vtp")
-      ->delimiter(',')
-      ->check(CLI::IsMember({"stl", "ply", "obj", "off", "vtp"}))
+  mesh->add_option("--volume", options->volume,
+                   "Volume mesh: none, or tet (TetGen on each label's output surface)")
+      ->check(CLI::IsMember({"none", "tet"}))
       ->capture_default_str();
+  auto& tetgen = options->tetgen;
+  mesh->add_option("--tet-radius-edge", tetgen.radius_edge_ratio,
+                   "Tet: largest circumradius / shortest edge (TetGen -q), at least 1")
+      ->capture_default_str();
+  mesh->add_option("--tet-min-dihedral", tetgen.min_dihedral_deg,
+                   "Tet: smallest dihedral angle TetGen refines for, degrees (at most 30)")
+      ->capture_default_str();
+  mesh->add_option("--tet-max-volume", tetgen.max_volume_mm3,
+                   "Tet: largest tetrahedron volume, mm^3 (TetGen -a); 0 for no bound")
+      ->capture_default_str();
+  mesh->add_flag("--tet-split-boundary", options->tet_split_boundary,
+                 "Tet: let TetGen add points on the surface (by default it keeps the surface "
+                 "triangles, -Y)");
+  mesh->add_option("--formats", options->formats,
+                   "Files to write: surfaces per label (stl, ply, obj, off, vtp) and, with "
+                   "--volume, one volume mesh (vtu, msh, mesh, inp, node); default stl,vtp "
+                   "(and vtu with --volume)")
+      ->delimiter(',')
+      ->check(
+          CLI::IsMember({"stl", "ply", "obj", "off", "vtp", "vtu", "msh", "mesh", "inp", "node"}));
   mesh->add_option("--max-voxels", options->max_voxels, "Refuse volumes with more voxels than this")
       ->capture_default_str();
   mesh->add_flag("--json", options->json,
@@ -136,6 +168,13 @@ CommandRunner add_mesh_command(CLI::App& app) {
                                   ? v1::POINT_REDUCTION_HIERARCHY
                               : options->point_reduction == "none" ? v1::POINT_REDUCTION_NONE
                                                                    : v1::POINT_REDUCTION_GRID);
+    if (options->volume == "tet") {
+      proto.set_volume(v1::VOLUME_METHOD_TETGEN);
+      proto.set_tet_radius_edge(options->tetgen.radius_edge_ratio);
+      proto.set_tet_min_dihedral_deg(options->tetgen.min_dihedral_deg);
+      proto.set_tet_max_volume_mm3(options->tetgen.max_volume_mm3);
+      proto.set_tet_keep_boundary(!options->tet_split_boundary);
+    }
     for (const auto& format : options->formats) proto.add_formats(format);
     proto.set_max_voxels(options->max_voxels);
     auto params = params_from_options(proto);

@@ -10,6 +10,8 @@
 #include "core/surface/vertex_normals.h"
 #include "core/surface/write_surface.h"
 #include "core/volume/volume_header.h"
+#include "core/volume_mesh/tetrahedralize.h"
+#include "core/volume_mesh/write_volume_mesh.h"
 
 namespace labelmesh {
 
@@ -46,6 +48,12 @@ struct PoissonOptions {
   double point_cell_voxels = 1;
 };
 
+enum class VolumeMethod {
+  kNone,
+  // TetGen on each label's output surface (paper §2.4.2), one region per label.
+  kTetgen,
+};
+
 struct MeshParams {
   // Labels to mesh; empty means every non-zero label in the volume.
   std::vector<int32_t> labels;
@@ -54,6 +62,10 @@ struct MeshParams {
   // Surface files to write per label.
   std::vector<surface::SurfaceFormat> formats{surface::SurfaceFormat::kStl,
                                               surface::SurfaceFormat::kVtp};
+  VolumeMethod volume = VolumeMethod::kNone;
+  volume_mesh::TetgenParams tetgen;
+  // Volume mesh files (when `volume` is not kNone).
+  std::vector<volume_mesh::VolumeFormat> volume_formats{volume_mesh::VolumeFormat::kVtu};
   // Size limits applied to the input before anything is allocated.
   volume::ReadLimits limits;
 };

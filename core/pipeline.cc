@@ -10,6 +10,7 @@
 #include "core/surface/write_surface.h"
 #include "core/text.h"
 #include "core/volume/read_label_volume.h"
+#include "core/volume_mesh/write_volume_mesh.h"
 
 namespace labelmesh {
 namespace {
@@ -86,16 +87,32 @@ absl::StatusOr<MeshResult> run_pipeline(const std::string& path, const MeshParam
       result.surfaces.push_back(std::move(surface));
     }
   }
-  if (params.surface == SurfaceMethod::kMarchingCubes) return result;
-  // The Marching Cubes surfaces were kept for their figures only.
-  for (auto& surface : result.surfaces) surface.mesh = {};
-  for (int32_t label : *labels) {
-    const auto* statistics = result.input.statistics.find(label);
-    if (auto s = add_quality_surfaces(*volume, *statistics, params, context, result.surfaces,
-                                      result.stages);
-        !s.ok()) {
-      return s;
+  if (params.surface != SurfaceMethod::kMarchingCubes) {
+    // The Marching Cubes surfaces were kept for their figures only.
+    for (auto& surface : result.surfaces) surface.mesh = {};
+    for (int32_t label : *labels) {
+      const auto* statistics = result.input.statistics.find(label);
+      if (auto s = add_quality_surfaces(*volume, *statistics, params, context, result.surfaces,
+                                        result.stages);
+          !s.ok()) {
+        return s;
+      }
     }
+  }
+  if (params.volume == VolumeMethod::kTetgen) {
+    std::vector<LabelBoundary> boundaries;
+    for (const auto& surface : result.surfaces) {
+      if (surface.is_output)
+        boundaries.push_back({surface.label, &surface.mesh, surface.self_intersections});
+    }
+    absl::StatusOr<VolumeResult> tets;
+    {
+      StageTimer timer(result.stages, "tetgen");
+      context.report("tetgen", 0);
+      tets = tetrahedralize_labels(boundaries, params.tetgen, context);
+    }
+    if (!tets.ok()) return tets.status();
+    result.volume = std::move(*tets);
   }
   return result;
 }
@@ -123,6 +140,22 @@ absl::Status write_results(MeshResult& result, const MeshParams& params, const s
         surface.files.push_back(name);
       }
       context.report("write", double(++done) / double(outputs));
+    }
+  }
+  if (result.volume) {
+    StageTimer timer(result.stages, "write_volume");
+    result.volume->files.clear();
+    for (auto format : params.volume_formats) {
+      const std::string name = cat("volume.", volume_mesh::volume_format_name(format));
+      const auto path = (std::filesystem::path(out_dir) / name).string();
+      if (auto s = volume_mesh::write_volume_mesh(result.volume->mesh, result.volume->quality, path,
+                                                  format);
+          !s.ok())
+        return s;
+      result.volume->files.push_back(name);
+      // TetGen's pair: the .ele beside the .node.
+      if (format == volume_mesh::VolumeFormat::kTetgen)
+        result.volume->files.push_back("volume.ele");
     }
   }
   const auto report_path = (std::filesystem::path(out_dir) / "report.json").string();

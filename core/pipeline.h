@@ -17,6 +17,7 @@
 #include "core/surface/triangle_mesh.h"
 #include "core/volume/label_statistics.h"
 #include "core/volume/label_volume.h"
+#include "core/volume_meshes.h"
 
 namespace labelmesh {
 
@@ -63,6 +64,8 @@ struct SurfaceResult {
 struct MeshResult {
   VolumeSummary input;
   std::vector<SurfaceResult> surfaces;
+  // When a volume method was asked for.
+  std::optional<VolumeResult> volume;
   std::vector<StageTiming> stages;
 };
 
@@ -77,8 +80,9 @@ absl::StatusOr<VolumeSummary> summarise_volume(const std::string& path,
 absl::StatusOr<MeshResult> run_pipeline(const std::string& path, const MeshParams& params,
                                         const RunContext& context);
 
-// Writes surface-label<N>.<ext> per surface and format, then report.json, in
-// `out_dir` (created if missing). Fills each surface's `files`.
+// Writes surface-label<N>.<ext> per surface and format, volume.<ext> per
+// volume format, then report.json, in `out_dir` (created if missing). Fills
+// each result's `files`.
 absl::Status write_results(MeshResult& result, const MeshParams& params, const std::string& out_dir,
                            const RunContext& context);
 

@@ -107,6 +107,61 @@ absl::Status read_poisson_options(const v1::MeshOptions& options, PoissonOptions
   return absl::OkStatus();
 }
 
+absl::Status read_volume_options(const v1::MeshOptions& options, MeshParams& params) {
+  switch (options.volume()) {
+    case v1::VOLUME_METHOD_UNSPECIFIED:
+    case v1::VOLUME_METHOD_NONE:
+      params.volume = VolumeMethod::kNone;
+      break;
+    case v1::VOLUME_METHOD_TETGEN:
+      params.volume = VolumeMethod::kTetgen;
+      break;
+    default:
+      return absl::InvalidArgumentError("volume: unknown volume method");
+  }
+  auto& tetgen = params.tetgen;
+  if (options.has_tet_radius_edge()) tetgen.radius_edge_ratio = options.tet_radius_edge();
+  if (options.has_tet_min_dihedral_deg()) tetgen.min_dihedral_deg = options.tet_min_dihedral_deg();
+  if (options.has_tet_max_volume_mm3()) tetgen.max_volume_mm3 = options.tet_max_volume_mm3();
+  if (options.has_tet_keep_boundary()) tetgen.keep_boundary = options.tet_keep_boundary();
+  // The ranges are TetGen's; tetrahedralize() checks them with the same
+  // option names, but a job should be refused before any work is done.
+  if (!(tetgen.radius_edge_ratio >= 1 && tetgen.radius_edge_ratio <= 100))
+    return absl::InvalidArgumentError(
+        cat("tet_radius_edge: ", tetgen.radius_edge_ratio, " is outside [1, 100]"));
+  if (!(tetgen.min_dihedral_deg >= 0 && tetgen.min_dihedral_deg <= 30))
+    return absl::InvalidArgumentError(
+        cat("tet_min_dihedral_deg: ", tetgen.min_dihedral_deg, " is outside [0, 30]"));
+  if (!(tetgen.max_volume_mm3 >= 0) || !std::isfinite(tetgen.max_volume_mm3))
+    return absl::InvalidArgumentError(
+        cat("tet_max_volume_mm3: ", tetgen.max_volume_mm3, " is not a volume"));
+  return absl::OkStatus();
+}
+
+v1::VolumeMeshSummary make_volume_summary(const VolumeResult& volume) {
+  v1::VolumeMeshSummary entry;
+  entry.set_mesher(volume.mesher);
+  entry.set_nodes(volume.mesh.points.size());
+  entry.set_tetrahedra(volume.mesh.tetrahedra.size());
+  entry.set_steiner_points(volume.steiner_points);
+  const auto& q = volume.summary;
+  if (q.count > 0) {
+    entry.set_tetra_quality_min(q.min);
+    entry.set_tetra_quality_mean(q.mean);
+    entry.set_min_dihedral_deg(q.min_dihedral_deg);
+    entry.set_max_dihedral_deg(q.max_dihedral_deg);
+  }
+  auto* categories = entry.mutable_categories();
+  categories->set_invalid(q.invalid);
+  categories->set_very_bad(q.very_bad);
+  categories->set_questionable(q.questionable);
+  categories->set_good(q.good);
+  entry.set_conforming(false);
+  entry.set_seconds(volume.seconds);
+  for (const auto& file : volume.files) entry.add_files(file);
+  return entry;
+}
+
 void add_quality_figures(const SurfaceResult& surface, v1::SurfaceSummary& entry) {
   if (surface.self_intersections) entry.set_self_intersections(*surface.self_intersections);
   if (surface.distance_to_marching_cubes) {
@@ -187,6 +242,17 @@ v1::MeshOptions make_options(const MeshParams& params) {
 
   for (auto format : params.formats)
     options.add_formats(std::string(surface::surface_format_name(format)));
+  if (params.volume == VolumeMethod::kTetgen) {
+    options.set_volume(v1::VOLUME_METHOD_TETGEN);
+    for (auto format : params.volume_formats)
+      options.add_formats(std::string(volume_mesh::volume_format_name(format)));
+  } else {
+    options.set_volume(v1::VOLUME_METHOD_NONE);
+  }
+  options.set_tet_radius_edge(params.tetgen.radius_edge_ratio);
+  options.set_tet_min_dihedral_deg(params.tetgen.min_dihedral_deg);
+  options.set_tet_max_volume_mm3(params.tetgen.max_volume_mm3);
+  options.set_tet_keep_boundary(params.tetgen.keep_boundary);
   options.set_max_voxels(params.limits.max_voxels);
   return options;
 }
@@ -209,15 +275,29 @@ absl::StatusOr<MeshParams> params_from_options(const v1::MeshOptions& options) {
       return absl::InvalidArgumentError("surface: unknown surface method");
   }
   if (auto s = read_poisson_options(options, params.poisson); !s.ok()) return s;
+  if (auto s = read_volume_options(options, params); !s.ok()) return s;
   if (!options.formats().empty()) {
+    // One list for both kinds: each name is either a surface or a volume format.
     params.formats.clear();
+    std::vector<volume_mesh::VolumeFormat> volume_formats;
     for (const auto& name : options.formats()) {
-      auto format = surface::surface_format_from_name(name);
-      if (!format) {
+      if (auto format = surface::surface_format_from_name(name)) {
+        params.formats.push_back(*format);
+      } else if (auto volume_format = volume_mesh::volume_format_from_name(name)) {
+        volume_formats.push_back(*volume_format);
+      } else {
         return absl::InvalidArgumentError(
-            cat("formats: '", name, "' is not one of stl, ply, obj, off, vtp"));
+            cat("formats: '", name,
+                "' is not one of stl, ply, obj, off, vtp (surfaces), vtu, msh, mesh, inp, node "
+                "(volumes)"));
       }
-      params.formats.push_back(*format);
+    }
+    if (!volume_formats.empty()) {
+      if (params.volume == VolumeMethod::kNone) {
+        return absl::InvalidArgumentError(
+            "formats: a volume format was asked for without a volume method (volume: tet)");
+      }
+      params.volume_formats = std::move(volume_formats);
     }
   }
   if (options.max_voxels() > 0) params.limits.max_voxels = options.max_voxels();
@@ -251,6 +331,7 @@ v1::Report make_report(const MeshResult& result, const MeshParams& params) {
     entry->set_output(surface.is_output);
     add_quality_figures(surface, *entry);
   }
+  if (result.volume) *report.mutable_volume() = make_volume_summary(*result.volume);
   for (const auto& stage : result.stages) {
     auto* entry = report.add_stages();
     entry->set_name(stage.name);

@@ -106,6 +106,37 @@ TEST(Cli, JsonReportOnStdout) {
   EXPECT_TRUE(std::filesystem::exists(dir / "o" / "surface-label1.stl"));
 }
 
+TEST(Cli, TetrahedralMeshFilesForSolvers) {
+  const auto dir = testing::scratch_dir("cli-volume");
+  ASSERT_EQ(run_cli("phantom sphere --out " + (dir / "s.nii.gz").string()).exit_code, 0);
+  const std::string mesh =
+      "mesh " + (dir / "s.nii.gz").string() + " --out " + (dir / "o").string() + " --json";
+  const CliRun run = run_cli(mesh + " --volume tet --formats stl,vtu,msh,inp,mesh 2>/dev/null");
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  v1::Report report;
+  ASSERT_TRUE(google::protobuf::util::JsonStringToMessage(run.output, &report).ok()) << run.output;
+  ASSERT_TRUE(report.has_volume());
+  EXPECT_EQ(report.volume().mesher(), "tetgen");
+  EXPECT_GT(report.volume().tetrahedra(), 500u);
+  EXPECT_EQ(report.volume().categories().invalid(), 0u);
+  EXPECT_EQ(report.volume().categories().good() + report.volume().categories().questionable() +
+                report.volume().categories().very_bad(),
+            report.volume().tetrahedra());
+  EXPECT_GT(report.volume().tetra_quality_min(), 0);
+  EXPECT_FALSE(report.volume().conforming());
+  EXPECT_EQ(report.options().volume(), v1::VOLUME_METHOD_TETGEN);
+  ASSERT_EQ(report.volume().files_size(), 4);
+  for (const char* name : {"volume.vtu", "volume.msh", "volume.inp", "volume.mesh"})
+    EXPECT_TRUE(std::filesystem::exists(dir / "o" / name)) << name;
+  // A volume format needs a volume method; TetGen options are checked first.
+  const CliRun no_volume = run_cli(mesh + " --formats vtu");
+  EXPECT_EQ(no_volume.exit_code, 2);
+  EXPECT_NE(no_volume.output.find("volume"), std::string::npos) << no_volume.output;
+  const CliRun ratio = run_cli(mesh + " --volume tet --tet-radius-edge 0.5");
+  EXPECT_EQ(ratio.exit_code, 2);
+  EXPECT_NE(ratio.output.find("tet_radius_edge"), std::string::npos) << ratio.output;
+}
+
 TEST(Cli, BadPoissonOptionsAreUsageErrors) {
   const auto dir = testing::scratch_dir("cli-poisson-options");
   ASSERT_EQ(run_cli("phantom sphere --out " + (dir / "s.nii").string()).exit_code, 0);

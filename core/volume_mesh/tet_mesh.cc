@@ -1,0 +1,94 @@
+#include "core/volume_mesh/tet_mesh.h"
+
+#include <algorithm>
+#include <tuple>
+
+#include "core/geometry/vec3.h"
+#include "core/text.h"
+
+namespace labelmesh::volume_mesh {
+
+void TetMesh::append(const TetMesh& other) {
+  const auto offset = static_cast<uint32_t>(points.size());
+  points.insert(points.end(), other.points.begin(), other.points.end());
+  tetrahedra.reserve(tetrahedra.size() + other.tetrahedra.size());
+  for (const auto& t : other.tetrahedra)
+    tetrahedra.push_back({t[0] + offset, t[1] + offset, t[2] + offset, t[3] + offset});
+  labels.insert(labels.end(), other.labels.begin(), other.labels.end());
+}
+
+double signed_volume(const TetMesh& mesh, size_t t) {
+  using geometry::cross, geometry::dot, geometry::sub;
+  const auto& v = mesh.tetrahedra[t];
+  const auto& p0 = mesh.points[v[0]];
+  return dot(sub(mesh.points[v[1]], p0),
+             cross(sub(mesh.points[v[2]], p0), sub(mesh.points[v[3]], p0))) /
+         6.0;
+}
+
+const std::array<uint8_t, 3>& outward_face(uint8_t across) {
+  // With node 3 on the positive side of triangle 0,1,2, each face below has its right-hand
+  // normal pointing away from the node it omits.
+  static constexpr std::array<std::array<uint8_t, 3>, 4> kFaces{
+      {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}}};
+  return kFaces[across];
+}
+
+std::vector<BoundaryFace> label_boundary_faces(const TetMesh& mesh) {
+  struct Entry {
+    int32_t label;
+    std::array<uint32_t, 3> key;  // sorted point indices
+    uint32_t tet;
+    uint8_t across;
+  };
+  std::vector<Entry> entries;
+  entries.reserve(4 * mesh.tetrahedra.size());
+  for (size_t t = 0; t < mesh.tetrahedra.size(); ++t) {
+    for (uint8_t across = 0; across < 4; ++across) {
+      const auto& local = outward_face(across);
+      std::array<uint32_t, 3> key{mesh.tetrahedra[t][local[0]], mesh.tetrahedra[t][local[1]],
+                                  mesh.tetrahedra[t][local[2]]};
+      std::sort(key.begin(), key.end());
+      entries.push_back({mesh.labels[t], key, static_cast<uint32_t>(t), across});
+    }
+  }
+  std::sort(entries.begin(), entries.end(), [](const Entry& a, const Entry& b) {
+    return std::tie(a.label, a.key, a.tet, a.across) < std::tie(b.label, b.key, b.tet, b.across);
+  });
+  std::vector<BoundaryFace> faces;
+  for (size_t i = 0; i < entries.size();) {
+    size_t j = i + 1;
+    while (j < entries.size() && entries[j].label == entries[i].label &&
+           entries[j].key == entries[i].key)
+      ++j;
+    if (j - i == 1) {
+      const Entry& e = entries[i];
+      const auto& local = outward_face(e.across);
+      const auto& tet = mesh.tetrahedra[e.tet];
+      faces.push_back({e.tet, e.label, e.across, {tet[local[0]], tet[local[1]], tet[local[2]]}});
+    }
+    i = j;
+  }
+  std::sort(faces.begin(), faces.end(), [](const BoundaryFace& a, const BoundaryFace& b) {
+    return std::tie(a.label, a.tet, a.across) < std::tie(b.label, b.tet, b.across);
+  });
+  return faces;
+}
+
+absl::Status check_tet_mesh(const TetMesh& mesh) {
+  if (mesh.labels.size() != mesh.tetrahedra.size()) {
+    return absl::InvalidArgumentError(cat("the mesh has ", mesh.tetrahedra.size(),
+                                          " tetrahedra but ", mesh.labels.size(), " labels"));
+  }
+  for (size_t t = 0; t < mesh.tetrahedra.size(); ++t) {
+    for (uint32_t v : mesh.tetrahedra[t]) {
+      if (v >= mesh.points.size()) {
+        return absl::InvalidArgumentError(cat("tetrahedron ", t, " names point ", v,
+                                              " but the mesh has ", mesh.points.size(), " points"));
+      }
+    }
+  }
+  return absl::OkStatus();
+}
+
+}  // namespace labelmesh::volume_mesh

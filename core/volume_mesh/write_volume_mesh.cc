@@ -1,0 +1,333 @@
+#include "core/volume_mesh/write_volume_mesh.h"
+
+#include <algorithm>
+#include <array>
+#include <charconv>
+#include <cstdint>
+#include <fstream>
+#include <set>
+#include <string>
+#include <type_traits>
+#include <utility>
+
+#include <vtkCellArray.h>
+#include <vtkCellData.h>
+#include <vtkCellType.h>
+#include <vtkDoubleArray.h>
+#include <vtkExecutive.h>
+#include <vtkIntArray.h>
+#include <vtkNew.h>
+#include <vtkPoints.h>
+#include <vtkUnstructuredGrid.h>
+#include <vtkXMLUnstructuredGridWriter.h>
+
+#include "core/text.h"
+#include "core/vtk_error_flag.h"
+
+namespace labelmesh::volume_mesh {
+namespace {
+
+// Buffered text output that remembers failure; finish() reports it naming the file.
+class TextFile {
+ public:
+  explicit TextFile(std::string path)
+      : path_(std::move(path)), out_(path_, std::ios::binary | std::ios::trunc) {}
+
+  TextFile& operator<<(std::string_view text) {
+    buffer_.append(text);
+    if (buffer_.size() > (1u << 20)) flush();
+    return *this;
+  }
+  TextFile& operator<<(char c) {
+    buffer_.push_back(c);
+    return *this;
+  }
+  // Integers in decimal; reals in the shortest form that reads back to the same double.
+  template <typename T>
+  requires std::is_arithmetic_v<T> TextFile& operator<<(T value) {
+    char digits[32];
+    const auto result = std::to_chars(digits, digits + sizeof digits, value);
+    return *this << std::string_view(digits, static_cast<size_t>(result.ptr - digits));
+  }
+
+  absl::Status finish() {
+    flush();
+    out_.close();
+    if (!out_) return absl::InternalError(cat(path_, ": could not write the volume mesh"));
+    return absl::OkStatus();
+  }
+
+ private:
+  void flush() {
+    if (out_) out_.write(buffer_.data(), static_cast<std::streamsize>(buffer_.size()));
+    buffer_.clear();
+  }
+
+  std::string path_;
+  std::ofstream out_;
+  std::string buffer_;
+};
+
+std::vector<int32_t> distinct_labels(const TetMesh& mesh) {
+  std::vector<int32_t> labels = mesh.labels;
+  std::sort(labels.begin(), labels.end());
+  labels.erase(std::unique(labels.begin(), labels.end()), labels.end());
+  return labels;
+}
+
+absl::Status check_positive_labels(const TetMesh& mesh, const std::string& path,
+                                   std::string_view format) {
+  for (int32_t label : mesh.labels) {
+    if (label <= 0) {
+      return absl::InvalidArgumentError(
+          cat(path, ": label ", label, " is not positive; ", format, " needs labels above 0"));
+    }
+  }
+  return absl::OkStatus();
+}
+
+absl::Status write_vtu(const TetMesh& mesh, const std::vector<double>& quality,
+                       const std::string& path) {
+  vtkNew<vtkPoints> points;
+  points->SetDataTypeToDouble();
+  points->SetNumberOfPoints(static_cast<vtkIdType>(mesh.points.size()));
+  for (size_t i = 0; i < mesh.points.size(); ++i)
+    points->SetPoint(static_cast<vtkIdType>(i), mesh.points[i].data());
+  vtkNew<vtkCellArray> cells;
+  cells->AllocateExact(static_cast<vtkIdType>(mesh.tetrahedra.size()),
+                       static_cast<vtkIdType>(4 * mesh.tetrahedra.size()));
+  for (const auto& t : mesh.tetrahedra) {
+    const vtkIdType ids[4] = {t[0], t[1], t[2], t[3]};
+    cells->InsertNextCell(4, ids);
+  }
+  vtkNew<vtkUnstructuredGrid> grid;
+  grid->SetPoints(points);
+  grid->SetCells(VTK_TETRA, cells);
+  vtkNew<vtkIntArray> labels;
+  labels->SetName("label");
+  labels->SetNumberOfValues(static_cast<vtkIdType>(mesh.labels.size()));
+  for (size_t i = 0; i < mesh.labels.size(); ++i)
+    labels->SetValue(static_cast<vtkIdType>(i), mesh.labels[i]);
+  grid->GetCellData()->AddArray(labels);
+  if (!quality.empty()) {
+    vtkNew<vtkDoubleArray> values;
+    values->SetName("quality");
+    values->SetNumberOfValues(static_cast<vtkIdType>(quality.size()));
+    for (size_t i = 0; i < quality.size(); ++i)
+      values->SetValue(static_cast<vtkIdType>(i), quality[i]);
+    grid->GetCellData()->AddArray(values);
+  }
+  vtkNew<vtkXMLUnstructuredGridWriter> writer;
+  writer->SetInputData(grid);
+  writer->SetFileName(path.c_str());
+  writer->SetDataModeToAppended();
+  writer->SetCompressorTypeToZLib();
+  vtkNew<VtkErrorFlag> flag;
+  writer->AddObserver(vtkCommand::ErrorEvent, flag);
+  // The pipeline reports a failed write too; observed, it stays off stderr.
+  writer->GetExecutive()->AddObserver(vtkCommand::ErrorEvent, flag);
+  if (writer->Write() != 1 || flag->raised) {
+    return absl::InternalError(cat(path, ": could not write the volume mesh"));
+  }
+  return absl::OkStatus();
+}
+
+// Gmsh MSH 2.2 ASCII (Gmsh reference manual, "Legacy formats: MSH file format version 2").
+absl::Status write_msh(const TetMesh& mesh, const std::vector<double>& quality,
+                       const std::string& path) {
+  if (auto status = check_positive_labels(mesh, path, "MSH"); !status.ok()) return status;
+  const auto labels = distinct_labels(mesh);
+  TextFile file(path);
+  file << "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n";
+  file << "$PhysicalNames\n" << labels.size() << '\n';
+  for (int32_t label : labels) file << "3 " << label << " \"label_" << label << "\"\n";
+  file << "$EndPhysicalNames\n";
+  file << "$Nodes\n" << mesh.points.size() << '\n';
+  for (size_t i = 0; i < mesh.points.size(); ++i) {
+    const auto& p = mesh.points[i];
+    file << i + 1 << ' ' << p[0] << ' ' << p[1] << ' ' << p[2] << '\n';
+  }
+  file << "$EndNodes\n";
+  file << "$Elements\n" << mesh.tetrahedra.size() << '\n';
+  for (size_t i = 0; i < mesh.tetrahedra.size(); ++i) {
+    const auto& t = mesh.tetrahedra[i];
+    const int32_t label = mesh.labels[i];
+    // Type 4 is the 4-node tetrahedron; its two tags are the physical and elementary entity.
+    file << i + 1 << " 4 2 " << label << ' ' << label;
+    for (uint32_t v : t) file << ' ' << v + 1;
+    file << '\n';
+  }
+  file << "$EndElements\n";
+  if (!quality.empty()) {
+    // One string tag (the name), one real tag (the time), three integer tags (time step,
+    // components, entries).
+    file << "$ElementData\n1\n\"quality\"\n1\n0\n3\n0\n1\n" << quality.size() << '\n';
+    for (size_t i = 0; i < quality.size(); ++i) file << i + 1 << ' ' << quality[i] << '\n';
+    file << "$EndElementData\n";
+  }
+  return file.finish();
+}
+
+// Medit .mesh (INRIA, "The Medit mesh file format"), read by Mmg, Medit, meshio and TetGen.
+absl::Status write_medit(const TetMesh& mesh, const std::string& path) {
+  const auto faces = label_boundary_faces(mesh);
+  TextFile file(path);
+  file << "MeshVersionFormatted 2\n\nDimension 3\n\n";
+  file << "Vertices\n" << mesh.points.size() << '\n';
+  for (const auto& p : mesh.points) file << p[0] << ' ' << p[1] << ' ' << p[2] << " 0\n";
+  file << "\nTriangles\n" << faces.size() << '\n';
+  for (const auto& face : faces) {
+    for (uint32_t v : face.points) file << v + 1 << ' ';
+    file << face.label << '\n';
+  }
+  file << "\nTetrahedra\n" << mesh.tetrahedra.size() << '\n';
+  for (size_t i = 0; i < mesh.tetrahedra.size(); ++i) {
+    for (uint32_t v : mesh.tetrahedra[i]) file << v + 1 << ' ';
+    file << mesh.labels[i] << '\n';
+  }
+  file << "\nEnd\n";
+  return file.finish();
+}
+
+// Abaqus/CalculiX input. C3D4 interpolates u = (1-g-h-r)u1 + g u2 + h u3 + r u4 (Abaqus Theory
+// Manual, "Triangular, tetrahedral, and wedge elements"; CalculiX shape4tet.f), so its Jacobian
+// is det[p2-p1, p3-p1, p4-p1]: positive exactly for VTK ordering, which is written unchanged.
+// Faces (Abaqus Analysis User's Manual, "Three-dimensional solid element library"):
+// S1 = 1-2-3, S2 = 1-4-2, S3 = 2-4-3, S4 = 3-4-1; indexed here by the omitted local node.
+absl::Status write_abaqus(const TetMesh& mesh, const std::string& path) {
+  if (auto status = check_positive_labels(mesh, path, "INP"); !status.ok()) return status;
+  static constexpr std::array<int, 4> kFaceByOmittedNode{3, 4, 2, 1};
+  const auto labels = distinct_labels(mesh);
+  const auto faces = label_boundary_faces(mesh);
+  TextFile file(path);
+  file << "** labelmesh tetrahedral mesh: coordinates in mm (LPS), one ELSET per label\n";
+  file << "*HEADING\nlabelmesh volume mesh\n";
+  file << "*NODE\n";
+  for (size_t i = 0; i < mesh.points.size(); ++i) {
+    const auto& p = mesh.points[i];
+    file << i + 1 << ", " << p[0] << ", " << p[1] << ", " << p[2] << '\n';
+  }
+  for (int32_t label : labels) {
+    file << "*ELEMENT, TYPE=C3D4, ELSET=LABEL_" << label << '\n';
+    for (size_t i = 0; i < mesh.tetrahedra.size(); ++i) {
+      if (mesh.labels[i] != label) continue;
+      const auto& t = mesh.tetrahedra[i];
+      file << i + 1 << ", " << t[0] + 1 << ", " << t[1] + 1 << ", " << t[2] + 1 << ", " << t[3] + 1
+           << '\n';
+    }
+  }
+  // Faces come sorted by label, so each label's faces form one run.
+  for (size_t begin = 0; begin < faces.size();) {
+    const int32_t label = faces[begin].label;
+    size_t end = begin;
+    std::set<uint32_t> nodes;
+    while (end < faces.size() && faces[end].label == label) {
+      nodes.insert(faces[end].points.begin(), faces[end].points.end());
+      ++end;
+    }
+    file << "*NSET, NSET=LABEL_" << label << "_BOUNDARY\n";
+    size_t on_line = 0;
+    for (uint32_t node : nodes) {
+      // At most 16 entries per data line.
+      file << (on_line == 0 ? "" : ", ") << node + 1;
+      if (++on_line == 16) {
+        file << '\n';
+        on_line = 0;
+      }
+    }
+    if (on_line != 0) file << '\n';
+    file << "*SURFACE, TYPE=ELEMENT, NAME=LABEL_" << label << "_SURFACE\n";
+    for (size_t i = begin; i < end; ++i)
+      file << faces[i].tet + 1 << ", S" << kFaceByOmittedNode[faces[i].across] << '\n';
+    begin = end;
+  }
+  return file.finish();
+}
+
+// TetGen .node and .ele (TetGen 1.5 manual, §5.2.1 and §5.2.4). TetGen's tetrahedra have the
+// same orientation as VTK's, so corners are written unchanged.
+absl::Status write_tetgen(const TetMesh& mesh, const std::string& path) {
+  constexpr std::string_view kSuffix = ".node";
+  if (path.size() <= kSuffix.size() ||
+      std::string_view(path).substr(path.size() - kSuffix.size()) != kSuffix) {
+    return absl::InvalidArgumentError(cat(path, ": a TetGen mesh path must end in .node"));
+  }
+  const std::string ele_path = path.substr(0, path.size() - kSuffix.size()) + ".ele";
+  {
+    TextFile file(path);
+    file << "# labelmesh: points in mm (LPS), numbered from 1\n";
+    file << mesh.points.size() << " 3 0 0\n";
+    for (size_t i = 0; i < mesh.points.size(); ++i) {
+      const auto& p = mesh.points[i];
+      file << i + 1 << ' ' << p[0] << ' ' << p[1] << ' ' << p[2] << '\n';
+    }
+    if (auto status = file.finish(); !status.ok()) return status;
+  }
+  TextFile file(ele_path);
+  file << "# labelmesh: tetrahedra numbered from 1; the region attribute is the label\n";
+  file << mesh.tetrahedra.size() << " 4 1\n";
+  for (size_t i = 0; i < mesh.tetrahedra.size(); ++i) {
+    file << i + 1;
+    for (uint32_t v : mesh.tetrahedra[i]) file << ' ' << v + 1;
+    file << ' ' << mesh.labels[i] << '\n';
+  }
+  return file.finish();
+}
+
+}  // namespace
+
+std::optional<VolumeFormat> volume_format_from_name(std::string_view name) {
+  for (VolumeFormat format : all_volume_formats()) {
+    if (volume_format_name(format) == name) return format;
+  }
+  return std::nullopt;
+}
+
+std::string_view volume_format_name(VolumeFormat format) {
+  switch (format) {
+    case VolumeFormat::kVtu:
+      return "vtu";
+    case VolumeFormat::kMsh:
+      return "msh";
+    case VolumeFormat::kMedit:
+      return "mesh";
+    case VolumeFormat::kAbaqus:
+      return "inp";
+    case VolumeFormat::kTetgen:
+      return "node";
+  }
+  return "unknown";
+}
+
+const std::vector<VolumeFormat>& all_volume_formats() {
+  static const std::vector<VolumeFormat> kAll{VolumeFormat::kVtu, VolumeFormat::kMsh,
+                                              VolumeFormat::kMedit, VolumeFormat::kAbaqus,
+                                              VolumeFormat::kTetgen};
+  return kAll;
+}
+
+absl::Status write_volume_mesh(const TetMesh& mesh, const std::vector<double>& cell_quality,
+                               const std::string& path, VolumeFormat format) {
+  if (auto status = check_tet_mesh(mesh); !status.ok()) {
+    return absl::InvalidArgumentError(cat(path, ": ", std::string(status.message())));
+  }
+  if (!cell_quality.empty() && cell_quality.size() != mesh.tetrahedra.size()) {
+    return absl::InvalidArgumentError(cat(path, ": ", cell_quality.size(), " quality values for ",
+                                          mesh.tetrahedra.size(), " tetrahedra"));
+  }
+  switch (format) {
+    case VolumeFormat::kVtu:
+      return write_vtu(mesh, cell_quality, path);
+    case VolumeFormat::kMsh:
+      return write_msh(mesh, cell_quality, path);
+    case VolumeFormat::kMedit:
+      return write_medit(mesh, path);
+    case VolumeFormat::kAbaqus:
+      return write_abaqus(mesh, path);
+    case VolumeFormat::kTetgen:
+      return write_tetgen(mesh, path);
+  }
+  return absl::InternalError("unhandled volume format");
+}
+
+}  // namespace labelmesh::volume_mesh

@@ -1,0 +1,52 @@
+#include "core/volume_meshes.h"
+
+#include <chrono>
+
+#include "core/text.h"
+
+namespace labelmesh {
+namespace {
+
+quality::Tet corners(const volume_mesh::TetMesh& mesh, size_t t) {
+  const auto& tet = mesh.tetrahedra[t];
+  return {mesh.points[tet[0]], mesh.points[tet[1]], mesh.points[tet[2]], mesh.points[tet[3]]};
+}
+
+}  // namespace
+
+absl::StatusOr<VolumeResult> tetrahedralize_labels(const std::vector<LabelBoundary>& boundaries,
+                                                   const volume_mesh::TetgenParams& params,
+                                                   const RunContext& context) {
+  const auto start = std::chrono::steady_clock::now();
+  VolumeResult result;
+  for (const auto& boundary : boundaries) {
+    // TetGen's own -d check would say the same, less precisely and later.
+    if (boundary.self_intersections.value_or(0) > 0) {
+      return absl::FailedPreconditionError(
+          cat("label ", boundary.label, ": its surface has ", *boundary.self_intersections,
+              " pairs of crossing triangles; a volume mesh needs a surface that does not "
+              "intersect itself"));
+    }
+    volume_mesh::TetgenFigures figures;
+    auto tets =
+        volume_mesh::tetrahedralize(*boundary.surface, boundary.label, params, context, figures);
+    if (!tets.ok()) {
+      return absl::Status(tets.status().code(), cat("label ", boundary.label, ": ",
+                                                    std::string(tets.status().message())));
+    }
+    result.steiner_points += figures.steiner_points;
+    result.mesh.append(*tets);
+  }
+  result.quality.reserve(result.mesh.tetrahedra.size());
+  for (size_t t = 0; t < result.mesh.tetrahedra.size(); ++t) {
+    const quality::Tet tet = corners(result.mesh, t);
+    const double q = quality::tetra_quality(tet);
+    result.quality.push_back(q);
+    result.summary.add(q);
+    result.summary.add_dihedral_range(quality::tetra_dihedral_range_deg(tet));
+  }
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return result;
+}
+
+}  // namespace labelmesh
