@@ -136,8 +136,8 @@ CommandRunner add_mesh_command(CLI::App& app) {
                  "triangles, -Y)");
   mesh->add_option("--formats", options->formats,
                    "Files to write: surfaces per label (stl, ply, obj, off, vtp) and, with "
-                   "--volume, one volume mesh (vtu, msh, mesh, inp, node); default stl,vtp "
-                   "(and vtu with --volume)")
+                   "--volume, one volume mesh (vtu, msh, mesh, inp, node); default stl,vtp; "
+                   "with --volume and no volume format listed, vtu")
       ->delimiter(',')
       ->check(
           CLI::IsMember({"stl", "ply", "obj", "off", "vtp", "vtu", "msh", "mesh", "inp", "node"}));

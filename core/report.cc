@@ -124,17 +124,19 @@ absl::Status read_volume_options(const v1::MeshOptions& options, MeshParams& par
   if (options.has_tet_min_dihedral_deg()) tetgen.min_dihedral_deg = options.tet_min_dihedral_deg();
   if (options.has_tet_max_volume_mm3()) tetgen.max_volume_mm3 = options.tet_max_volume_mm3();
   if (options.has_tet_keep_boundary()) tetgen.keep_boundary = options.tet_keep_boundary();
-  // The ranges are TetGen's; tetrahedralize() checks them with the same
-  // option names, but a job should be refused before any work is done.
+  if (params.volume == VolumeMethod::kNone) return absl::OkStatus();
+  // The ranges are TetGen's, as tetrahedralize() checks them; a job should be
+  // refused here, before any surface work is done.
   if (!(tetgen.radius_edge_ratio >= 1 && tetgen.radius_edge_ratio <= 100))
     return absl::InvalidArgumentError(
         cat("tet_radius_edge: ", tetgen.radius_edge_ratio, " is outside [1, 100]"));
   if (!(tetgen.min_dihedral_deg >= 0 && tetgen.min_dihedral_deg <= 30))
     return absl::InvalidArgumentError(
         cat("tet_min_dihedral_deg: ", tetgen.min_dihedral_deg, " is outside [0, 30]"));
-  if (!(tetgen.max_volume_mm3 >= 0) || !std::isfinite(tetgen.max_volume_mm3))
+  if (!(tetgen.max_volume_mm3 == 0 ||
+        (tetgen.max_volume_mm3 >= 1e-6 && tetgen.max_volume_mm3 <= 1e12)))
     return absl::InvalidArgumentError(
-        cat("tet_max_volume_mm3: ", tetgen.max_volume_mm3, " is not a volume"));
+        cat("tet_max_volume_mm3: ", tetgen.max_volume_mm3, " is neither 0 nor in [1e-6, 1e12]"));
   return absl::OkStatus();
 }
 

@@ -1,6 +1,7 @@
 #include "core/volume_meshes.h"
 
 #include <chrono>
+#include <new>
 
 #include "core/text.h"
 
@@ -12,11 +13,9 @@ quality::Tet corners(const volume_mesh::TetMesh& mesh, size_t t) {
   return {mesh.points[tet[0]], mesh.points[tet[1]], mesh.points[tet[2]], mesh.points[tet[3]]};
 }
 
-}  // namespace
-
-absl::StatusOr<VolumeResult> tetrahedralize_labels(const std::vector<LabelBoundary>& boundaries,
-                                                   const volume_mesh::TetgenParams& params,
-                                                   const RunContext& context) {
+absl::StatusOr<VolumeResult> measure_and_join(const std::vector<LabelBoundary>& boundaries,
+                                              const volume_mesh::TetgenParams& params,
+                                              const RunContext& context) {
   const auto start = std::chrono::steady_clock::now();
   VolumeResult result;
   for (const auto& boundary : boundaries) {
@@ -47,6 +46,19 @@ absl::StatusOr<VolumeResult> tetrahedralize_labels(const std::vector<LabelBounda
   }
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;
+}
+
+}  // namespace
+
+absl::StatusOr<VolumeResult> tetrahedralize_labels(const std::vector<LabelBoundary>& boundaries,
+                                                   const volume_mesh::TetgenParams& params,
+                                                   const RunContext& context) {
+  // No exception leaves the core: a mesh too large for memory is an error.
+  try {
+    return measure_and_join(boundaries, params, context);
+  } catch (const std::bad_alloc&) {
+    return absl::ResourceExhaustedError("tetgen: out of memory joining the volume meshes");
+  }
 }
 
 }  // namespace labelmesh

@@ -37,8 +37,8 @@ struct LabelBoundary {
 
 // Tetrahedralizes each boundary with TetGen and measures every element.
 // Errors: FAILED_PRECONDITION naming the label when its surface intersects
-// itself or TetGen refuses it; INVALID_ARGUMENT for bad TetGen options;
-// CANCELLED; INTERNAL.
+// itself or TetGen refuses it; INVALID_ARGUMENT for bad TetGen options or a
+// broken surface; RESOURCE_EXHAUSTED; CANCELLED; INTERNAL.
 absl::StatusOr<VolumeResult> tetrahedralize_labels(const std::vector<LabelBoundary>& boundaries,
                                                    const volume_mesh::TetgenParams& params,
                                                    const RunContext& context);

@@ -27,8 +27,8 @@ struct TetgenParams {
   // [1e-6, 1e12].
   double max_volume_mm3 = 0;
   // Keep the boundary triangles as given (TetGen -Y): no Steiner points on the surface, so the
-  // mesh's boundary faces are exactly the input triangles and meshes of neighbouring labels
-  // that share a surface stay conforming. Refinement then happens inside only.
+  // mesh's boundary faces are exactly the input triangles. Refinement then happens inside only.
+  // (Labels meshed from their own surfaces still do not share nodes where they touch.)
   bool keep_boundary = true;
 };
 
