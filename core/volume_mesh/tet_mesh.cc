@@ -4,6 +4,7 @@
 #include <tuple>
 
 #include "core/geometry/vec3.h"
+#include "core/quality/element_quality.h"
 #include "core/text.h"
 
 namespace labelmesh::volume_mesh {
@@ -18,12 +19,9 @@ void TetMesh::append(const TetMesh& other) {
 }
 
 double signed_volume(const TetMesh& mesh, size_t t) {
-  using geometry::cross, geometry::dot, geometry::sub;
   const auto& v = mesh.tetrahedra[t];
-  const auto& p0 = mesh.points[v[0]];
-  return dot(sub(mesh.points[v[1]], p0),
-             cross(sub(mesh.points[v[2]], p0), sub(mesh.points[v[3]], p0))) /
-         6.0;
+  return quality::tetra_signed_volume(
+      {mesh.points[v[0]], mesh.points[v[1]], mesh.points[v[2]], mesh.points[v[3]]});
 }
 
 const std::array<uint8_t, 3>& outward_face(uint8_t across) {
