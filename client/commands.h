@@ -15,5 +15,13 @@ using CommandRunner = std::function<int()>;
 CommandRunner add_info_command(CLI::App& app);
 CommandRunner add_mesh_command(CLI::App& app);
 CommandRunner add_phantom_command(CLI::App& app);
+// Commands that talk to a labelmeshd server.
+CommandRunner add_submit_command(CLI::App& app);
+CommandRunner add_watch_command(CLI::App& app);
+CommandRunner add_status_command(CLI::App& app);
+CommandRunner add_fetch_command(CLI::App& app);
+CommandRunner add_cancel_command(CLI::App& app);
+CommandRunner add_list_command(CLI::App& app);
+CommandRunner add_health_command(CLI::App& app);
 
 }  // namespace labelmesh::client

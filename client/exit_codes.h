@@ -10,6 +10,7 @@ enum ExitCode : int {
   kExitUsage = 2,     // bad command line
   kExitBadInput = 3,  // the input file or an option about it is wrong
   kExitFailure = 4,   // a pipeline stage failed or was cancelled
+  kExitService = 5,   // the server could not be reached or refused the call
 };
 
 inline int exit_code_for(const absl::Status& status) {
@@ -25,6 +26,7 @@ inline int exit_code_for(const absl::Status& status) {
 }
 
 inline constexpr const char* kExitCodeHelp =
-    "Exit codes: 0 success, 2 bad usage, 3 bad input (file or option), 4 pipeline failure.";
+    "Exit codes: 0 success, 2 bad usage, 3 bad input (file or option), 4 pipeline failure or "
+    "cancelled, 5 server unreachable or call refused.";
 
 }  // namespace labelmesh::client

@@ -15,7 +15,9 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   app.footer(kExitCodeHelp);
   std::map<const CLI::App*, CommandRunner> runners;
-  for (auto add : {add_info_command, add_mesh_command, add_phantom_command}) {
+  for (auto add : {add_info_command, add_mesh_command, add_phantom_command, add_submit_command,
+                   add_watch_command, add_status_command, add_fetch_command, add_cancel_command,
+                   add_list_command, add_health_command}) {
     const size_t before = app.get_subcommands({}).size();
     CommandRunner runner = add(app);
     runners[app.get_subcommands({}).at(before)] = std::move(runner);

@@ -1,0 +1,204 @@
+// Commands about jobs on a labelmeshd server: watch, status, fetch, cancel,
+// list, health. Each takes --json and the connection flags.
+#include <CLI/CLI.hpp>
+
+#include <ctime>
+
+#include "client/commands.h"
+#include "client/exit_codes.h"
+#include "client/job_follow.h"
+#include "client/server_connection.h"
+#include "core/report.h"
+#include "grpc/health/v1/health.grpc.pb.h"
+#include "labelmesh/v1/service.grpc.pb.h"
+
+namespace labelmesh::client {
+namespace {
+
+constexpr std::chrono::seconds kCallTimeout{30};
+
+struct JobFlags {
+  std::string job_id;
+  std::string out_dir;
+  std::string artifact;
+  ConnectionFlags connection;
+  bool json = false;
+};
+
+CLI::App* add_job_command(CLI::App& app, const std::string& name, const std::string& help,
+                          JobFlags& flags, bool takes_job) {
+  CLI::App* command = app.add_subcommand(name, help);
+  if (takes_job) command->add_option("job", flags.job_id, "Job id")->required();
+  add_connection_flags(*command, flags.connection);
+  command->add_flag("--json", flags.json, "Print JSON on stdout");
+  command->footer(kExitCodeHelp);
+  return command;
+}
+
+int fail(const char* command, const absl::Status& status) {
+  std::fprintf(stderr, "labelmesh %s: %s\n", command, std::string(status.message()).c_str());
+  return exit_code_for_call(status);
+}
+
+std::string state_name(v1::JobState state) {
+  std::string name = v1::JobState_Name(state);
+  name = name.substr(std::string("JOB_STATE_").size());
+  for (char& c : name) c = static_cast<char>(std::tolower(c));
+  return name;
+}
+
+void print_job_line(const v1::Job& job) {
+  char created[32] = "";
+  const std::time_t when = static_cast<std::time_t>(job.created_at());
+  std::strftime(created, sizeof created, "%Y-%m-%d %H:%M:%S", std::localtime(&when));
+  std::printf("%s  %-9s  %s", job.job_id().c_str(), state_name(job.state()).c_str(), created);
+  if (job.state() == v1::JOB_STATE_QUEUED) std::printf("  position %u", job.queue_position());
+  if (job.state() == v1::JOB_STATE_RUNNING) {
+    std::printf("  %s %.0f %%", job.stage().c_str(), 100 * job.progress());
+  }
+  if (job.state() == v1::JOB_STATE_FAILED) std::printf("  %s", job.error().message().c_str());
+  std::printf("\n");
+}
+
+int run_watch(const JobFlags& flags) {
+  auto connection = ServerConnection::open(flags.connection);
+  if (!connection.ok()) return fail("watch", connection.status());
+  auto job = follow_job(*connection, flags.job_id, FollowOptions{.json = flags.json});
+  if (!job.ok()) return fail("watch", job.status());
+  if (!flags.json) print_job_line(*job);
+  return exit_code_for_job(*job);
+}
+
+int run_status(const JobFlags& flags) {
+  auto connection = ServerConnection::open(flags.connection);
+  if (!connection.ok()) return fail("status", connection.status());
+  auto stub = v1::MeshingService::NewStub(connection->channel());
+  auto context = connection->context(kCallTimeout);
+  v1::GetJobRequest request;
+  request.set_job_id(flags.job_id);
+  v1::Job job;
+  if (auto status = stub->GetJob(context.get(), request, &job); !status.ok()) {
+    return fail("status", from_grpc(status));
+  }
+  if (flags.json) {
+    std::printf("%s\n", to_json(job).c_str());
+  } else {
+    print_job_line(job);
+  }
+  return kExitSuccess;
+}
+
+int run_fetch(const JobFlags& flags) {
+  auto connection = ServerConnection::open(flags.connection);
+  if (!connection.ok()) return fail("fetch", connection.status());
+  std::optional<std::string> only;
+  if (!flags.artifact.empty()) only = flags.artifact;
+  auto written = fetch_artifacts(*connection, flags.job_id, flags.out_dir, only);
+  if (!written.ok()) return fail("fetch", written.status());
+  if (flags.json) {
+    std::printf("{\"job_id\": \"%s\", \"files\": %d}\n", flags.job_id.c_str(), *written);
+  } else {
+    std::printf("%d files written to %s\n", *written, flags.out_dir.c_str());
+  }
+  return kExitSuccess;
+}
+
+int run_cancel(const JobFlags& flags) {
+  auto connection = ServerConnection::open(flags.connection);
+  if (!connection.ok()) return fail("cancel", connection.status());
+  auto stub = v1::MeshingService::NewStub(connection->channel());
+  auto context = connection->context(kCallTimeout);
+  v1::CancelRequest request;
+  request.set_job_id(flags.job_id);
+  v1::Job job;
+  if (auto status = stub->Cancel(context.get(), request, &job); !status.ok()) {
+    return fail("cancel", from_grpc(status));
+  }
+  if (flags.json) {
+    std::printf("%s\n", to_json(job).c_str());
+  } else {
+    std::printf("%s: %s\n", job.job_id().c_str(),
+                job.state() == v1::JOB_STATE_CANCELLED ? "cancelled" : "cancelling");
+  }
+  return kExitSuccess;
+}
+
+int run_list(const JobFlags& flags) {
+  auto connection = ServerConnection::open(flags.connection);
+  if (!connection.ok()) return fail("list", connection.status());
+  auto stub = v1::MeshingService::NewStub(connection->channel());
+  auto context = connection->context(kCallTimeout);
+  v1::ListJobsReply reply;
+  if (auto status = stub->ListJobs(context.get(), v1::ListJobsRequest(), &reply); !status.ok()) {
+    return fail("list", from_grpc(status));
+  }
+  if (flags.json) {
+    std::printf("%s\n", to_json(reply).c_str());
+  } else {
+    for (const auto& job : reply.jobs()) print_job_line(job);
+  }
+  return kExitSuccess;
+}
+
+int run_health(const JobFlags& flags) {
+  auto connection = ServerConnection::open(flags.connection);
+  if (!connection.ok()) return fail("health", connection.status());
+  auto stub = grpc::health::v1::Health::NewStub(connection->channel());
+  auto context = connection->context(std::chrono::seconds(5));
+  grpc::health::v1::HealthCheckResponse reply;
+  if (auto status = stub->Check(context.get(), grpc::health::v1::HealthCheckRequest(), &reply);
+      !status.ok()) {
+    return fail("health", from_grpc(status));
+  }
+  const bool serving = reply.status() == grpc::health::v1::HealthCheckResponse::SERVING;
+  if (flags.json) {
+    std::printf("{\"status\": \"%s\"}\n",
+                grpc::health::v1::HealthCheckResponse::ServingStatus_Name(reply.status()).c_str());
+  } else {
+    std::printf("%s: %s\n", flags.connection.server.c_str(), serving ? "serving" : "not serving");
+  }
+  return serving ? kExitSuccess : kExitService;
+}
+
+}  // namespace
+
+CommandRunner add_watch_command(CLI::App& app) {
+  auto flags = std::make_shared<JobFlags>();
+  add_job_command(app, "watch", "Follow a job to its end (exit 0 only if it finished)", *flags,
+                  true);
+  return [flags] { return run_watch(*flags); };
+}
+
+CommandRunner add_status_command(CLI::App& app) {
+  auto flags = std::make_shared<JobFlags>();
+  add_job_command(app, "status", "Show a job's state", *flags, true);
+  return [flags] { return run_status(*flags); };
+}
+
+CommandRunner add_fetch_command(CLI::App& app) {
+  auto flags = std::make_shared<JobFlags>();
+  CLI::App* fetch = add_job_command(app, "fetch", "Fetch a finished job's files", *flags, true);
+  fetch->add_option("--out", flags->out_dir, "Directory to write into")->required();
+  fetch->add_option("--artifact", flags->artifact, "Only this file (default: every one)");
+  return [flags] { return run_fetch(*flags); };
+}
+
+CommandRunner add_cancel_command(CLI::App& app) {
+  auto flags = std::make_shared<JobFlags>();
+  add_job_command(app, "cancel", "Cancel a queued or running job", *flags, true);
+  return [flags] { return run_cancel(*flags); };
+}
+
+CommandRunner add_list_command(CLI::App& app) {
+  auto flags = std::make_shared<JobFlags>();
+  add_job_command(app, "list", "List the server's jobs, newest first", *flags, false);
+  return [flags] { return run_list(*flags); };
+}
+
+CommandRunner add_health_command(CLI::App& app) {
+  auto flags = std::make_shared<JobFlags>();
+  add_job_command(app, "health", "Ask the server whether it is serving", *flags, false);
+  return [flags] { return run_health(*flags); };
+}
+
+}  // namespace labelmesh::client

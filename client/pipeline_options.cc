@@ -1,0 +1,125 @@
+#include "client/pipeline_options.h"
+
+#include <CLI/CLI.hpp>
+
+namespace labelmesh::client {
+
+void add_pipeline_flags(CLI::App& command, PipelineFlags& flags) {
+  command
+      .add_option("--labels", flags.labels,
+                  "Labels to mesh, e.g. 1,3 (default: every non-zero label)")
+      ->delimiter(',');
+  command
+      .add_option("--surface", flags.surface,
+                  "Surface method: mc (Marching Cubes), repaired (MC repaired with CGAL), "
+                  "poisson (repaired MC, then CGAL Poisson reconstruction)")
+      ->check(CLI::IsMember({"mc", "repaired", "poisson"}))
+      ->capture_default_str();
+  auto& poisson = flags.poisson;
+  command
+      .add_option("--min-angle", poisson.min_angle_deg,
+                  "Poisson: smallest triangle angle, degrees, at most 30")
+      ->capture_default_str();
+  command
+      .add_option("--max-edge", poisson.max_edge_voxels, "Poisson: longest triangle edge, voxels")
+      ->capture_default_str();
+  command
+      .add_option("--max-distance", poisson.max_distance_voxels,
+                  "Poisson: surface mesher distance bound, voxels")
+      ->capture_default_str();
+  command
+      .add_option("--min-component-voxels", poisson.min_component_voxels,
+                  "Drop connected components of a label with fewer voxels (repaired, poisson)")
+      ->capture_default_str();
+  command.add_flag("--keep-strands", flags.keep_strands,
+                   "Keep strands one voxel thick (repaired, poisson); by default they are pruned");
+  command
+      .add_option("--smoothing-iterations", poisson.smoothing.iterations,
+                  "Poisson: windowed-sinc smoothing of the repaired surface before "
+                  "reconstruction, filter iterations (0: off)")
+      ->capture_default_str();
+  command
+      .add_option("--smoothing-pass-band", poisson.smoothing.pass_band,
+                  "Poisson: smoothing pass band in (0, 2); lower smooths more")
+      ->capture_default_str();
+  command
+      .add_option("--normals", flags.normals,
+                  "Poisson: vertex normals from incident triangles, uniform or area weighted")
+      ->check(CLI::IsMember({"uniform", "area"}))
+      ->capture_default_str();
+  command
+      .add_option("--point-reduction", flags.point_reduction,
+                  "Poisson: thin the oriented points with grid, hierarchy or none")
+      ->check(CLI::IsMember({"grid", "hierarchy", "none"}))
+      ->capture_default_str();
+  command
+      .add_option("--point-cell", poisson.point_cell_voxels,
+                  "Poisson: grid cell of the point reduction, voxels")
+      ->capture_default_str();
+  command
+      .add_option("--volume", flags.volume,
+                  "Volume mesh: none, or tet (TetGen on each label's output surface)")
+      ->check(CLI::IsMember({"none", "tet"}))
+      ->capture_default_str();
+  auto& tetgen = flags.tetgen;
+  command
+      .add_option("--tet-radius-edge", tetgen.radius_edge_ratio,
+                  "Tet: largest circumradius / shortest edge (TetGen -q), at least 1")
+      ->capture_default_str();
+  command
+      .add_option("--tet-min-dihedral", tetgen.min_dihedral_deg,
+                  "Tet: smallest dihedral angle TetGen refines for, degrees (at most 30)")
+      ->capture_default_str();
+  command
+      .add_option("--tet-max-volume", tetgen.max_volume_mm3,
+                  "Tet: largest tetrahedron volume, mm^3 (TetGen -a); 0 for no bound")
+      ->capture_default_str();
+  command.add_flag("--tet-split-boundary", flags.tet_split_boundary,
+                   "Tet: let TetGen add points on the surface (by default it keeps the surface "
+                   "triangles, -Y)");
+  command
+      .add_option("--formats", flags.formats,
+                  "Files to write: surfaces per label (stl, ply, obj, off, vtp) and, with "
+                  "--volume, one volume mesh (vtu, msh, mesh, inp, node); default stl,vtp; "
+                  "with --volume and no volume format listed, vtu")
+      ->delimiter(',')
+      ->check(
+          CLI::IsMember({"stl", "ply", "obj", "off", "vtp", "vtu", "msh", "mesh", "inp", "node"}));
+  command.add_option("--max-voxels", flags.max_voxels, "Refuse volumes with more voxels than this")
+      ->capture_default_str();
+}
+
+v1::MeshOptions to_mesh_options(const PipelineFlags& flags) {
+  v1::MeshOptions proto;
+  for (int32_t label : flags.labels) proto.add_labels(label);
+  proto.set_surface(flags.surface == "mc"         ? v1::SURFACE_METHOD_MARCHING_CUBES
+                    : flags.surface == "repaired" ? v1::SURFACE_METHOD_REPAIRED
+                                                  : v1::SURFACE_METHOD_POISSON);
+  const auto& poisson = flags.poisson;
+  proto.set_min_angle_deg(poisson.min_angle_deg);
+  proto.set_max_edge_voxels(poisson.max_edge_voxels);
+  proto.set_max_distance_voxels(poisson.max_distance_voxels);
+  proto.set_min_component_voxels(poisson.min_component_voxels);
+  proto.set_point_cell_voxels(poisson.point_cell_voxels);
+  proto.set_prune_strands(!flags.keep_strands);
+  proto.set_smoothing_iterations(poisson.smoothing.iterations);
+  proto.set_smoothing_pass_band(poisson.smoothing.pass_band);
+
+  proto.set_normals(flags.normals == "area" ? v1::NORMAL_WEIGHTING_AREA
+                                            : v1::NORMAL_WEIGHTING_UNIFORM);
+  proto.set_point_reduction(flags.point_reduction == "hierarchy" ? v1::POINT_REDUCTION_HIERARCHY
+                            : flags.point_reduction == "none"    ? v1::POINT_REDUCTION_NONE
+                                                                 : v1::POINT_REDUCTION_GRID);
+  if (flags.volume == "tet") {
+    proto.set_volume(v1::VOLUME_METHOD_TETGEN);
+    proto.set_tet_radius_edge(flags.tetgen.radius_edge_ratio);
+    proto.set_tet_min_dihedral_deg(flags.tetgen.min_dihedral_deg);
+    proto.set_tet_max_volume_mm3(flags.tetgen.max_volume_mm3);
+    proto.set_tet_keep_boundary(!flags.tet_split_boundary);
+  }
+  for (const auto& format : flags.formats) proto.add_formats(format);
+  proto.set_max_voxels(flags.max_voxels);
+  return proto;
+}
+
+}  // namespace labelmesh::client

@@ -1,0 +1,35 @@
+// The pipeline options of `labelmesh mesh` and `labelmesh submit`: one set of
+// flags, turned into the one job-options message both paths run with.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "core/mesh_params.h"
+#include "labelmesh/v1/options.pb.h"
+
+namespace CLI {
+class App;
+}
+
+namespace labelmesh::client {
+
+struct PipelineFlags {
+  std::vector<int32_t> labels;
+  std::string surface = "poisson";
+  PoissonOptions poisson;
+  std::string normals = "uniform";
+  std::string point_reduction = "grid";
+  bool keep_strands = false;
+  std::string volume = "none";
+  volume_mesh::TetgenParams tetgen;
+  bool tet_split_boundary = false;
+  std::vector<std::string> formats{"stl", "vtp"};
+  uint64_t max_voxels = volume::ReadLimits{}.max_voxels;
+};
+
+void add_pipeline_flags(CLI::App& command, PipelineFlags& flags);
+
+v1::MeshOptions to_mesh_options(const PipelineFlags& flags);
+
+}  // namespace labelmesh::client

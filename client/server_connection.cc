@@ -1,0 +1,103 @@
+#include "client/server_connection.h"
+
+#include <CLI/CLI.hpp>
+
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+
+#include "absl/strings/str_cat.h"
+#include "absl/strings/strip.h"
+
+namespace labelmesh::client {
+namespace {
+
+absl::StatusOr<std::string> read_file(const std::string& path, const std::string& flag) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return absl::InvalidArgumentError(absl::StrCat("--", flag, ": cannot read ", path));
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+}  // namespace
+
+void add_connection_flags(CLI::App& command, ConnectionFlags& flags) {
+  command.add_option("--server", flags.server, "labelmeshd address")
+      ->envname("LABELMESH_SERVER")
+      ->capture_default_str();
+  command.add_option("--token-file", flags.token_file,
+                     "File holding the bearer token (or set LABELMESH_TOKEN to the token)");
+  command.add_flag("--tls", flags.tls, "Use TLS, trusting the system's CAs");
+  command.add_option("--tls-ca", flags.tls_ca, "PEM CA that signed the server's certificate");
+  command.add_option("--tls-cert", flags.tls_cert, "PEM client certificate (mutual TLS)");
+  command.add_option("--tls-key", flags.tls_key, "PEM private key of --tls-cert");
+}
+
+absl::StatusOr<ServerConnection> ServerConnection::open(const ConnectionFlags& flags) {
+  ServerConnection connection;
+  if (!flags.token_file.empty()) {
+    auto token = read_file(flags.token_file, "token-file");
+    if (!token.ok()) return token.status();
+    connection.token_ = std::string(absl::StripAsciiWhitespace(*token));
+  } else if (const char* token = std::getenv("LABELMESH_TOKEN")) {
+    connection.token_ = std::string(absl::StripAsciiWhitespace(token));
+  }
+  std::shared_ptr<grpc::ChannelCredentials> credentials;
+  if (flags.tls || !flags.tls_ca.empty() || !flags.tls_cert.empty()) {
+    grpc::SslCredentialsOptions options;
+    if (!flags.tls_ca.empty()) {
+      auto ca = read_file(flags.tls_ca, "tls-ca");
+      if (!ca.ok()) return ca.status();
+      options.pem_root_certs = *ca;
+    }
+    if (!flags.tls_cert.empty()) {
+      auto cert = read_file(flags.tls_cert, "tls-cert");
+      if (!cert.ok()) return cert.status();
+      auto key = read_file(flags.tls_key, "tls-key");
+      if (!key.ok()) return key.status();
+      options.pem_cert_chain = *cert;
+      options.pem_private_key = *key;
+    }
+    credentials = grpc::SslCredentials(options);
+  } else {
+    credentials = grpc::InsecureChannelCredentials();
+  }
+  grpc::ChannelArguments arguments;
+  // Reports of large multi-label runs exceed gRPC's 4 MiB default.
+  arguments.SetMaxReceiveMessageSize(64 << 20);
+  connection.channel_ = grpc::CreateCustomChannel(flags.server, credentials, arguments);
+  return connection;
+}
+
+std::unique_ptr<grpc::ClientContext> ServerConnection::context(std::chrono::seconds timeout) const {
+  auto context = std::make_unique<grpc::ClientContext>();
+  if (!token_.empty()) context->AddMetadata("authorization", "Bearer " + token_);
+  if (timeout.count() > 0) context->set_deadline(std::chrono::system_clock::now() + timeout);
+  return context;
+}
+
+std::string describe(const grpc::Status& status) {
+  static const char* const kNames[] = {"OK",
+                                       "CANCELLED",
+                                       "UNKNOWN",
+                                       "INVALID_ARGUMENT",
+                                       "DEADLINE_EXCEEDED",
+                                       "NOT_FOUND",
+                                       "ALREADY_EXISTS",
+                                       "PERMISSION_DENIED",
+                                       "RESOURCE_EXHAUSTED",
+                                       "FAILED_PRECONDITION",
+                                       "ABORTED",
+                                       "OUT_OF_RANGE",
+                                       "UNIMPLEMENTED",
+                                       "INTERNAL",
+                                       "UNAVAILABLE",
+                                       "DATA_LOSS",
+                                       "UNAUTHENTICATED"};
+  const int code = static_cast<int>(status.error_code());
+  const char* name = code >= 0 && code <= 16 ? kNames[code] : "?";
+  return absl::StrCat(name, ": ", status.error_message());
+}
+
+}  // namespace labelmesh::client

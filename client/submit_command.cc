@@ -1,0 +1,157 @@
+// `labelmesh submit FILE --out DIR`: upload a volume to labelmeshd, follow the
+// job, fetch its results. The same pipeline flags as `labelmesh mesh`.
+#include <unistd.h>
+#include <CLI/CLI.hpp>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+
+#include "absl/strings/str_cat.h"
+#include "client/commands.h"
+#include "client/exit_codes.h"
+#include "client/job_follow.h"
+#include "client/pipeline_options.h"
+#include "client/server_connection.h"
+#include "core/report.h"
+#include "labelmesh/v1/service.grpc.pb.h"
+#include "server/sha256.h"
+
+namespace labelmesh::client {
+namespace {
+
+constexpr size_t kChunkBytes = 1 << 20;
+
+struct SubmitFlags {
+  std::string path;
+  std::string out_dir;
+  PipelineFlags pipeline;
+  ConnectionFlags connection;
+  bool detach = false;
+  bool json = false;
+};
+
+// The upload's percentage and rate on a terminal.
+void print_upload_progress(uint64_t sent, uint64_t total, double seconds) {
+  if (isatty(STDERR_FILENO) != 1) return;
+  std::fprintf(stderr, "\r  %-20s %3d %%  %7.1f MB/s", "upload",
+               total ? static_cast<int>(100 * sent / total) : 100,
+               seconds > 0 ? sent / seconds / 1e6 : 0.0);
+  if (sent == total) std::fprintf(stderr, "\n");
+  std::fflush(stderr);
+}
+
+absl::StatusOr<v1::SubmitReply> upload(const ServerConnection& connection,
+                                       const SubmitFlags& flags) {
+  auto digest = digest::sha256_file(flags.path);
+  if (!digest.ok()) return digest.status();
+  std::error_code error;
+  const uint64_t size = std::filesystem::file_size(flags.path, error);
+  if (error) return absl::NotFoundError(absl::StrCat(flags.path, ": ", error.message()));
+
+  auto stub = v1::MeshingService::NewStub(connection.channel());
+  auto context = connection.context();
+  v1::SubmitReply reply;
+  auto writer = stub->Submit(context.get(), &reply);
+  v1::SubmitRequest request;
+  v1::JobSpec& spec = *request.mutable_spec();
+  *spec.mutable_options() = to_mesh_options(flags.pipeline);
+  spec.set_file_name(std::filesystem::path(flags.path).filename().string());
+  spec.set_size_bytes(size);
+  spec.set_sha256(*digest);
+  const auto start = std::chrono::steady_clock::now();
+  bool open = writer->Write(request);
+  std::ifstream in(flags.path, std::ios::binary);
+  std::string buffer(kChunkBytes, '\0');
+  uint64_t sent = 0;
+  while (open && in) {
+    in.read(buffer.data(), static_cast<std::streamsize>(buffer.size()));
+    const auto count = static_cast<size_t>(in.gcount());
+    if (count == 0) break;
+    request.set_chunk(buffer.data(), count);
+    open = writer->Write(request);
+    sent += count;
+    print_upload_progress(
+        sent, size,
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+  }
+  writer->WritesDone();
+  if (auto status = writer->Finish(); !status.ok()) return from_grpc(status);
+  return reply;
+}
+
+int run_submit(const SubmitFlags& flags) {
+  auto params = params_from_options(to_mesh_options(flags.pipeline));
+  if (!params.ok()) {
+    std::fprintf(stderr, "labelmesh submit: %s\n", std::string(params.status().message()).c_str());
+    return kExitUsage;
+  }
+  auto connection = ServerConnection::open(flags.connection);
+  if (!connection.ok()) {
+    std::fprintf(stderr, "labelmesh submit: %s\n",
+                 std::string(connection.status().message()).c_str());
+    return kExitUsage;
+  }
+  auto reply = upload(*connection, flags);
+  if (!reply.ok()) {
+    std::fprintf(stderr, "labelmesh submit: %s\n", std::string(reply.status().message()).c_str());
+    return reply.status().code() == absl::StatusCode::kNotFound
+               ? kExitBadInput
+               : exit_code_for_call(reply.status());
+  }
+  if (flags.detach) {
+    if (flags.json) {
+      std::printf("{\"job_id\": \"%s\", \"queue_position\": %u}\n", reply->job_id().c_str(),
+                  reply->queue_position());
+    } else {
+      std::printf("%s\n", reply->job_id().c_str());
+    }
+    return kExitSuccess;
+  }
+  if (!flags.json) std::fprintf(stderr, "job %s\n", reply->job_id().c_str());
+  auto job = follow_job(*connection, reply->job_id(), FollowOptions{.json = false});
+  if (!job.ok()) {
+    std::fprintf(stderr, "labelmesh submit: %s\n", std::string(job.status().message()).c_str());
+    return exit_code_for_call(job.status());
+  }
+  if (job->state() != v1::JOB_STATE_SUCCEEDED) return exit_code_for_job(*job);
+  auto written = fetch_artifacts(*connection, reply->job_id(), flags.out_dir);
+  if (!written.ok()) {
+    std::fprintf(stderr, "labelmesh submit: %s\n", std::string(written.status().message()).c_str());
+    return exit_code_for_call(written.status());
+  }
+  if (flags.json) {
+    std::printf("%s\n", to_json(job->report()).c_str());
+  } else {
+    std::printf("job %s finished: %d files written to %s\n", reply->job_id().c_str(), *written,
+                flags.out_dir.c_str());
+  }
+  return kExitSuccess;
+}
+
+}  // namespace
+
+CommandRunner add_submit_command(CLI::App& app) {
+  auto flags = std::make_shared<SubmitFlags>();
+  CLI::App* submit = app.add_subcommand("submit", "Mesh a label volume on a labelmeshd server");
+  submit
+      ->add_option("file", flags->path,
+                   "Label volume held in one file (.nii .nii.gz .mha .nrrd .inr .inr.gz .vti)")
+      ->required();
+  submit->add_option("--out", flags->out_dir, "Where the results are fetched to");
+  add_pipeline_flags(*submit, flags->pipeline);
+  add_connection_flags(*submit, flags->connection);
+  submit->add_flag("--detach", flags->detach, "Print the job id once accepted and return");
+  submit->add_flag("--json", flags->json,
+                   "Print the report (or, with --detach, the job id) as JSON on stdout");
+  submit->footer(kExitCodeHelp);
+  return [flags] {
+    if (!flags->detach && flags->out_dir.empty()) {
+      std::fprintf(stderr, "labelmesh submit: --out is required unless --detach\n");
+      return int{kExitUsage};
+    }
+    return run_submit(*flags);
+  };
+}
+
+}  // namespace labelmesh::client

@@ -1,0 +1,384 @@
+#include "server/job_table.h"
+
+#include <algorithm>
+#include <chrono>
+
+#include "absl/strings/str_cat.h"
+#include "spdlog/spdlog.h"
+
+namespace labelmesh::server {
+namespace {
+
+// Watchers of a long job see every stage event; progress events past this
+// many are applied to the job but not kept.
+constexpr size_t kMaxStoredEvents = 4096;
+
+bool has_ended(v1::JobState state) {
+  return state == v1::JOB_STATE_SUCCEEDED || state == v1::JOB_STATE_FAILED ||
+         state == v1::JOB_STATE_CANCELLED;
+}
+
+// The event that tells a watcher where a job stands, for jobs loaded from the
+// spool (their history was not kept).
+v1::JobEvent state_event(const v1::Job& job, uint32_t position) {
+  v1::JobEvent event;
+  switch (job.state()) {
+    case v1::JOB_STATE_SUCCEEDED:
+      *event.mutable_finished()->mutable_report() = job.report();
+      break;
+    case v1::JOB_STATE_FAILED:
+      *event.mutable_failed() = job.error();
+      break;
+    case v1::JOB_STATE_CANCELLED:
+      event.mutable_cancelled();
+      break;
+    default:
+      event.mutable_queued()->set_position(position);
+  }
+  return event;
+}
+
+}  // namespace
+
+double unix_now() {
+  return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+}
+
+JobTable::JobTable(const Spool& spool, int queue_capacity, Metrics& metrics)
+    : spool_(spool),
+      queue_capacity_(static_cast<size_t>(queue_capacity)),
+      metrics_(metrics),
+      // Microseconds since 1970: sequences keep growing across restarts, so a
+      // watcher that reconnects can tell new events from replayed ones.
+      next_sequence_(static_cast<uint64_t>(unix_now() * 1e6)) {}
+
+JobTable::Entry* JobTable::find(const std::string& job_id) {
+  auto it = jobs_.find(job_id);
+  return it == jobs_.end() ? nullptr : &it->second;
+}
+
+const JobTable::Entry* JobTable::find(const std::string& job_id) const {
+  auto it = jobs_.find(job_id);
+  return it == jobs_.end() ? nullptr : &it->second;
+}
+
+void JobTable::persist(const Entry& entry) {
+  if (auto status = spool_.save(entry.record); !status.ok()) {
+    spdlog::error("job {} record not saved: {}", entry.record.job().job_id(),
+                  std::string(status.message()));
+  }
+}
+
+void JobTable::update_gauges() {
+  metrics_.set_queue_depth(queue_.size());
+  metrics_.set_running(running_);
+}
+
+uint32_t JobTable::position_of(const std::string& job_id) const {
+  auto it = std::find(queue_.begin(), queue_.end(), job_id);
+  return static_cast<uint32_t>(it - queue_.begin());
+}
+
+void JobTable::add_event(Entry& entry, v1::JobEvent event) {
+  event.set_job_id(entry.record.job().job_id());
+  event.set_sequence(next_sequence_++);
+  event.set_time(unix_now());
+  if (event.has_progress() && entry.events.size() >= kMaxStoredEvents) return;
+  entry.events.push_back(std::move(event));
+  events_added_.notify_all();
+}
+
+void JobTable::recover(absl::Duration result_ttl) {
+  std::vector<v1::JobRecord> records = spool_.load_all();
+  std::sort(records.begin(), records.end(), [](const auto& a, const auto& b) {
+    return a.job().created_at() < b.job().created_at();
+  });
+  const double now = unix_now();
+  std::lock_guard lock(mutex_);
+  int requeued = 0, kept = 0, expired = 0;
+  for (auto& record : records) {
+    v1::Job& job = *record.mutable_job();
+    const std::string id = job.job_id();
+    if (has_ended(job.state())) {
+      if (job.finished_at() + absl::ToDoubleSeconds(result_ttl) < now) {
+        spool_.remove_job(id);
+        ++expired;
+        continue;
+      }
+      ++kept;
+    } else {
+      // Queued, or running when the server stopped: runs again from the start.
+      job.set_state(v1::JOB_STATE_QUEUED);
+      job.clear_stage();
+      job.set_progress(0);
+      queue_.push_back(id);
+      ++requeued;
+    }
+    Entry& entry = jobs_[id];
+    entry.record = std::move(record);
+    if (!has_ended(entry.record.job().state())) persist(entry);
+    add_event(entry, state_event(entry.record.job(), position_of(id)));
+  }
+  update_gauges();
+  spdlog::info("spool: {} jobs queued again, {} ended jobs kept, {} expired jobs deleted", requeued,
+               kept, expired);
+  queue_changed_.notify_all();
+}
+
+bool JobTable::queue_full() const {
+  std::lock_guard lock(mutex_);
+  return queue_.size() >= queue_capacity_;
+}
+
+absl::StatusOr<uint32_t> JobTable::accept(v1::JobRecord record, const std::string& upload_path) {
+  std::lock_guard lock(mutex_);
+  if (closed_) return absl::UnavailableError("the server is shutting down");
+  if (queue_.size() >= queue_capacity_) {
+    return absl::ResourceExhaustedError(
+        absl::StrCat("the job queue is full (", queue_capacity_, " jobs); try again later"));
+  }
+  const std::string id = record.job().job_id();
+  record.mutable_job()->set_state(v1::JOB_STATE_QUEUED);
+  if (auto status = spool_.create_job(record, upload_path); !status.ok()) return status;
+  Entry& entry = jobs_[id];
+  entry.record = std::move(record);
+  queue_.push_back(id);
+  const uint32_t position = position_of(id);
+  v1::JobEvent event;
+  event.mutable_queued()->set_position(position);
+  add_event(entry, std::move(event));
+  update_gauges();
+  spdlog::info("job {} queued at position {}", id, position);
+  queue_changed_.notify_one();
+  return position;
+}
+
+std::optional<v1::JobRecord> JobTable::take_next() {
+  std::unique_lock lock(mutex_);
+  queue_changed_.wait(lock, [this] { return closed_ || (dispatching_ && !queue_.empty()); });
+  if (closed_) return std::nullopt;
+  const std::string id = queue_.front();
+  queue_.pop_front();
+  Entry& entry = *find(id);
+  v1::Job& job = *entry.record.mutable_job();
+  const double now = unix_now();
+  if (job.attempts() == 0) metrics_.queue_wait(now - job.created_at());
+  job.set_state(v1::JOB_STATE_RUNNING);
+  job.set_attempts(job.attempts() + 1);
+  job.set_started_at(now);
+  persist(entry);
+  ++running_;
+  v1::JobEvent event;
+  event.mutable_started()->set_attempt(job.attempts());
+  add_event(entry, std::move(event));
+  update_gauges();
+  spdlog::info("job {} started (attempt {})", id, job.attempts());
+  return entry.record;
+}
+
+void JobTable::publish(const std::string& job_id, v1::JobEvent event) {
+  std::lock_guard lock(mutex_);
+  Entry* entry = find(job_id);
+  if (entry == nullptr || entry->record.job().state() != v1::JOB_STATE_RUNNING) return;
+  v1::Job& job = *entry->record.mutable_job();
+  if (event.has_stage_started()) {
+    job.set_stage(event.stage_started().stage());
+    job.set_progress(0);
+  } else if (event.has_progress()) {
+    job.set_stage(event.progress().stage());
+    job.set_progress(event.progress().fraction());
+  } else if (event.has_stage_finished()) {
+    const auto& finished = event.stage_finished();
+    metrics_.stage_finished(finished.stage(), finished.seconds());
+    spdlog::info("job {} stage {} finished in {:.3f} s", job_id, finished.stage(),
+                 finished.seconds());
+  } else {
+    return;  // Ends go through succeed, fail and mark_cancelled.
+  }
+  add_event(*entry, std::move(event));
+}
+
+void JobTable::end_job(Entry& entry, v1::JobState state, v1::JobEvent event) {
+  v1::Job& job = *entry.record.mutable_job();
+  const bool was_running = job.state() == v1::JOB_STATE_RUNNING;
+  job.set_state(state);
+  job.set_finished_at(unix_now());
+  job.clear_stage();
+  persist(entry);
+  if (was_running && running_ > 0) --running_;
+  add_event(entry, std::move(event));
+  update_gauges();
+  static const char* const kOutcome[] = {"", "", "", "succeeded", "failed", "cancelled"};
+  metrics_.job_ended(kOutcome[state]);
+}
+
+void JobTable::succeed(const std::string& job_id, const v1::Report& report,
+                       std::vector<v1::Artifact> artifacts) {
+  std::lock_guard lock(mutex_);
+  Entry* entry = find(job_id);
+  if (entry == nullptr) return;
+  *entry->record.mutable_job()->mutable_report() = report;
+  entry->record.mutable_job()->set_progress(1);
+  entry->record.clear_artifacts();
+  for (auto& artifact : artifacts) *entry->record.add_artifacts() = std::move(artifact);
+  v1::JobEvent event;
+  *event.mutable_finished()->mutable_report() = report;
+  end_job(*entry, v1::JOB_STATE_SUCCEEDED, std::move(event));
+  spdlog::info("job {} succeeded in {:.3f} s", job_id,
+               entry->record.job().finished_at() - entry->record.job().started_at());
+}
+
+void JobTable::fail(const std::string& job_id, int code, const std::string& message) {
+  std::lock_guard lock(mutex_);
+  Entry* entry = find(job_id);
+  if (entry == nullptr) return;
+  v1::JobError& error = *entry->record.mutable_job()->mutable_error();
+  error.set_code(code);
+  error.set_message(message);
+  v1::JobEvent event;
+  *event.mutable_failed() = error;
+  end_job(*entry, v1::JOB_STATE_FAILED, std::move(event));
+  // The message may quote the volume's fields; the log keeps the code only.
+  spdlog::warn("job {} failed with status code {}", job_id, code);
+}
+
+void JobTable::mark_cancelled(const std::string& job_id) {
+  std::lock_guard lock(mutex_);
+  Entry* entry = find(job_id);
+  if (entry == nullptr || has_ended(entry->record.job().state())) return;
+  v1::JobError& error = *entry->record.mutable_job()->mutable_error();
+  error.set_code(static_cast<int>(absl::StatusCode::kCancelled));
+  error.set_message("cancelled by a client");
+  v1::JobEvent event;
+  event.mutable_cancelled();
+  end_job(*entry, v1::JOB_STATE_CANCELLED, std::move(event));
+  spdlog::info("job {} cancelled", job_id);
+}
+
+void JobTable::requeue_interrupted(const std::string& job_id) {
+  std::lock_guard lock(mutex_);
+  Entry* entry = find(job_id);
+  if (entry == nullptr || entry->record.job().state() != v1::JOB_STATE_RUNNING) return;
+  entry->record.mutable_job()->set_state(v1::JOB_STATE_QUEUED);
+  persist(*entry);
+  if (running_ > 0) --running_;
+  update_gauges();
+  spdlog::info("job {} interrupted by shutdown; it runs again at the next start", job_id);
+}
+
+absl::StatusOr<v1::Job> JobTable::get(const std::string& job_id) const {
+  std::lock_guard lock(mutex_);
+  const Entry* entry = find(job_id);
+  if (entry == nullptr) return absl::NotFoundError(absl::StrCat("no job ", job_id));
+  v1::Job job = entry->record.job();
+  if (job.state() == v1::JOB_STATE_QUEUED) job.set_queue_position(position_of(job_id));
+  return job;
+}
+
+std::vector<v1::Job> JobTable::list() const {
+  std::lock_guard lock(mutex_);
+  std::vector<v1::Job> jobs;
+  for (const auto& [id, entry] : jobs_) {
+    v1::Job job = entry.record.job();
+    job.clear_report();
+    if (job.state() == v1::JOB_STATE_QUEUED) job.set_queue_position(position_of(id));
+    jobs.push_back(std::move(job));
+  }
+  std::sort(jobs.begin(), jobs.end(),
+            [](const auto& a, const auto& b) { return a.created_at() > b.created_at(); });
+  return jobs;
+}
+
+absl::StatusOr<v1::Job> JobTable::cancel(const std::string& job_id) {
+  {
+    std::lock_guard lock(mutex_);
+    Entry* entry = find(job_id);
+    if (entry == nullptr) return absl::NotFoundError(absl::StrCat("no job ", job_id));
+    const v1::JobState state = entry->record.job().state();
+    if (has_ended(state)) {
+      return absl::FailedPreconditionError(
+          absl::StrCat("job ", job_id, " already ended (", v1::JobState_Name(state), ")"));
+    }
+    if (state == v1::JOB_STATE_RUNNING) {
+      entry->cancel_requested = true;
+      return entry->record.job();
+    }
+    queue_.erase(std::find(queue_.begin(), queue_.end(), job_id));
+  }
+  mark_cancelled(job_id);
+  return get(job_id);
+}
+
+bool JobTable::cancel_requested(const std::string& job_id) const {
+  std::lock_guard lock(mutex_);
+  const Entry* entry = find(job_id);
+  return entry != nullptr && entry->cancel_requested;
+}
+
+absl::StatusOr<std::vector<v1::Artifact>> JobTable::artifacts(const std::string& job_id) const {
+  std::lock_guard lock(mutex_);
+  const Entry* entry = find(job_id);
+  if (entry == nullptr) return absl::NotFoundError(absl::StrCat("no job ", job_id));
+  if (entry->record.job().state() != v1::JOB_STATE_SUCCEEDED) {
+    return absl::FailedPreconditionError(absl::StrCat(
+        "job ", job_id, " has no results: it is ", v1::JobState_Name(entry->record.job().state())));
+  }
+  return std::vector<v1::Artifact>(entry->record.artifacts().begin(),
+                                   entry->record.artifacts().end());
+}
+
+absl::StatusOr<JobTable::EventBatch> JobTable::events_since(const std::string& job_id,
+                                                            uint64_t from,
+                                                            absl::Duration wait) const {
+  std::unique_lock lock(mutex_);
+  auto has_news = [&] {
+    const Entry* entry = find(job_id);
+    return closed_ || entry == nullptr ||
+           (!entry->events.empty() && entry->events.back().sequence() >= from);
+  };
+  events_added_.wait_for(lock, absl::ToChronoMilliseconds(wait), has_news);
+  const Entry* entry = find(job_id);
+  if (entry == nullptr) return absl::NotFoundError(absl::StrCat("no job ", job_id));
+  EventBatch batch;
+  for (const auto& event : entry->events) {
+    if (event.sequence() >= from) batch.events.push_back(event);
+  }
+  batch.ended = has_ended(entry->record.job().state());
+  if (closed_ && !batch.ended && batch.events.empty()) {
+    return absl::UnavailableError("the server is shutting down");
+  }
+  return batch;
+}
+
+int JobTable::expire(absl::Duration result_ttl) {
+  std::lock_guard lock(mutex_);
+  const double cutoff = unix_now() - absl::ToDoubleSeconds(result_ttl);
+  int removed = 0;
+  for (auto it = jobs_.begin(); it != jobs_.end();) {
+    const v1::Job& job = it->second.record.job();
+    if (has_ended(job.state()) && job.finished_at() < cutoff) {
+      spool_.remove_job(it->first);
+      spdlog::info("job {} results expired and deleted", it->first);
+      it = jobs_.erase(it);
+      ++removed;
+    } else {
+      ++it;
+    }
+  }
+  if (removed > 0) events_added_.notify_all();
+  return removed;
+}
+
+void JobTable::close() {
+  std::lock_guard lock(mutex_);
+  closed_ = true;
+  queue_changed_.notify_all();
+  events_added_.notify_all();
+}
+
+void JobTable::stop_dispatch() {
+  std::lock_guard lock(mutex_);
+  dispatching_ = false;
+}
+
+}  // namespace labelmesh::server

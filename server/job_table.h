@@ -1,0 +1,109 @@
+// Every job the server knows: the queue, each job's state and event history,
+// and the waits of workers and watchers. Each state change is written to the
+// spool before it is visible to anyone.
+#pragma once
+
+#include <condition_variable>
+#include <cstdint>
+#include <deque>
+#include <map>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "absl/time/time.h"
+#include "labelmesh/v1/service.pb.h"
+#include "server/metrics.h"
+#include "server/spool.h"
+
+namespace labelmesh::server {
+
+class JobTable {
+ public:
+  JobTable(const Spool& spool, int queue_capacity, Metrics& metrics);
+
+  // Loads the spool: queued and interrupted jobs are queued again in their
+  // order of arrival; ended jobs stay fetchable until `result_ttl` after they
+  // ended, older ones are deleted.
+  void recover(absl::Duration result_ttl);
+
+  bool queue_full() const;
+  // Moves the upload into a new job and queues it; returns the queue position.
+  // RESOURCE_EXHAUSTED when the queue is full, UNAVAILABLE after close().
+  absl::StatusOr<uint32_t> accept(v1::JobRecord record, const std::string& upload_path);
+
+  // Blocks for the next queued job and marks it running; nullopt after close().
+  std::optional<v1::JobRecord> take_next();
+  // A running job's stage and progress events, as its worker sends them.
+  void publish(const std::string& job_id, v1::JobEvent event);
+  void succeed(const std::string& job_id, const v1::Report& report,
+               std::vector<v1::Artifact> artifacts);
+  void fail(const std::string& job_id, int code, const std::string& message);
+  void mark_cancelled(const std::string& job_id);
+  // A running job stopped by shutdown: queued again on disk for the next start.
+  void requeue_interrupted(const std::string& job_id);
+
+  // NOT_FOUND for an unknown id.
+  absl::StatusOr<v1::Job> get(const std::string& job_id) const;
+  // Newest first, without reports.
+  std::vector<v1::Job> list() const;
+  // A queued job is cancelled at once; a running one is flagged for its
+  // worker to stop. FAILED_PRECONDITION for a job that ended.
+  absl::StatusOr<v1::Job> cancel(const std::string& job_id);
+  bool cancel_requested(const std::string& job_id) const;
+  // FAILED_PRECONDITION unless the job succeeded.
+  absl::StatusOr<std::vector<v1::Artifact>> artifacts(const std::string& job_id) const;
+
+  struct EventBatch {
+    std::vector<v1::JobEvent> events;
+    // The job ended and `events` holds everything up to its end.
+    bool ended = false;
+  };
+  // Events with sequence >= `from`, waiting up to `wait` for one to come.
+  // UNAVAILABLE after close().
+  absl::StatusOr<EventBatch> events_since(const std::string& job_id, uint64_t from,
+                                          absl::Duration wait) const;
+
+  // Deletes jobs that ended more than `result_ttl` ago; returns how many.
+  int expire(absl::Duration result_ttl);
+  // Wakes every waiter; take_next() returns nullopt from now on.
+  void close();
+  // Stops handing out jobs but still accepts them (drain before shutdown).
+  void stop_dispatch();
+
+ private:
+  struct Entry {
+    v1::JobRecord record;
+    std::vector<v1::JobEvent> events;
+    bool cancel_requested = false;
+  };
+
+  Entry* find(const std::string& job_id);
+  const Entry* find(const std::string& job_id) const;
+  // Appends an event (sequence and time set here) and wakes watchers.
+  void add_event(Entry& entry, v1::JobEvent event);
+  void persist(const Entry& entry);
+  void end_job(Entry& entry, v1::JobState state, v1::JobEvent event);
+  uint32_t position_of(const std::string& job_id) const;
+  void update_gauges();
+
+  const Spool& spool_;
+  const size_t queue_capacity_;
+  Metrics& metrics_;
+
+  mutable std::mutex mutex_;
+  std::condition_variable queue_changed_;
+  mutable std::condition_variable events_added_;
+  std::map<std::string, Entry> jobs_;
+  std::deque<std::string> queue_;
+  size_t running_ = 0;
+  uint64_t next_sequence_ = 1;
+  bool closed_ = false;
+  bool dispatching_ = true;
+};
+
+double unix_now();
+
+}  // namespace labelmesh::server

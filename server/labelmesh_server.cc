@@ -1,0 +1,132 @@
+#include "server/labelmesh_server.h"
+
+#include <grpcpp/ext/proto_server_reflection_plugin.h>
+#include <grpcpp/grpcpp.h>
+#include <grpcpp/health_check_service_interface.h>
+
+#include <fstream>
+#include <sstream>
+
+#include "absl/strings/str_cat.h"
+#include "absl/strings/strip.h"
+#include "server/job_table.h"
+#include "server/meshing_service.h"
+#include "server/metrics.h"
+#include "server/spool.h"
+#include "server/worker_pool.h"
+#include "spdlog/spdlog.h"
+
+namespace labelmesh::server {
+namespace {
+
+absl::StatusOr<std::string> read_text_file(const std::string& path, const std::string& flag) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return absl::InvalidArgumentError(absl::StrCat("--", flag, ": cannot read ", path));
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+absl::StatusOr<std::shared_ptr<grpc::ServerCredentials>> credentials(const ServerConfig& config) {
+  if (!config.tls()) return grpc::InsecureServerCredentials();
+  auto cert = read_text_file(config.tls_cert, "tls-cert");
+  if (!cert.ok()) return cert.status();
+  auto key = read_text_file(config.tls_key, "tls-key");
+  if (!key.ok()) return key.status();
+  grpc::SslServerCredentialsOptions options;
+  options.pem_key_cert_pairs.push_back({*key, *cert});
+  if (!config.client_ca.empty()) {
+    auto ca = read_text_file(config.client_ca, "client-ca");
+    if (!ca.ok()) return ca.status();
+    options.pem_root_certs = *ca;
+    options.client_certificate_request = GRPC_SSL_REQUEST_AND_REQUIRE_CLIENT_CERTIFICATE_AND_VERIFY;
+  }
+  return grpc::SslServerCredentials(options);
+}
+
+}  // namespace
+
+absl::StatusOr<std::unique_ptr<LabelmeshServer>> LabelmeshServer::start(ServerConfig config) {
+  if (auto status = validate_config(config); !status.ok()) return status;
+  std::unique_ptr<LabelmeshServer> server(new LabelmeshServer());
+  server->config_ = std::move(config);
+  const ServerConfig& c = server->config_;
+
+  std::string token;
+  if (!c.auth_token_file.empty()) {
+    auto text = read_text_file(c.auth_token_file, "auth-token-file");
+    if (!text.ok()) return text.status();
+    token = std::string(absl::StripAsciiWhitespace(*text));
+    if (token.size() < 16) {
+      return absl::InvalidArgumentError(
+          "--auth-token-file: the token must be 16 characters or more");
+    }
+  }
+  auto creds = credentials(c);
+  if (!creds.ok()) return creds.status();
+
+  server->metrics_ = std::make_unique<Metrics>(c.queue_capacity);
+  if (!c.metrics_listen.empty()) {
+    if (auto status = server->metrics_->expose(c.metrics_listen); !status.ok()) return status;
+  }
+  auto spool = Spool::open(c.spool_dir);
+  if (!spool.ok()) return spool.status();
+  server->spool_ = std::make_unique<Spool>(std::move(*spool));
+  server->table_ = std::make_unique<JobTable>(*server->spool_, c.queue_capacity, *server->metrics_);
+  server->table_->recover(c.result_ttl);
+  server->service_ = std::make_unique<MeshingService>(*server->table_, *server->spool_, c,
+                                                      *server->metrics_, std::move(token));
+
+  grpc::EnableDefaultHealthCheckService(true);
+  grpc::reflection::InitProtoReflectionServerBuilderPlugin();
+  grpc::ServerBuilder builder;
+  builder.AddListeningPort(c.listen, *creds, &server->port_);
+  builder.RegisterService(server->service_.get());
+  builder.SetMaxReceiveMessageSize(c.max_message_bytes);
+  builder.SetMaxSendMessageSize(c.max_message_bytes);
+  server->server_ = builder.BuildAndStart();
+  if (!server->server_ || server->port_ == 0) {
+    return absl::UnavailableError(absl::StrCat("--listen: cannot serve on ", c.listen));
+  }
+  server->pool_ = std::make_unique<WorkerPool>(*server->table_, *server->spool_, c);
+  server->pool_->start();
+  server->expirer_ = std::thread([s = server.get()] { s->expire_loop(); });
+  spdlog::info(
+      "labelmeshd listening on {} (port {}), {} workers, queue capacity {}, TLS {}, auth {}",
+      c.listen, server->port_, c.workers, c.queue_capacity, c.tls() ? "on" : "off",
+      c.auth_token_file.empty() ? "off" : "on");
+  return server;
+}
+
+void LabelmeshServer::expire_loop() {
+  const auto period =
+      std::min(absl::ToChronoMilliseconds(config_.result_ttl), std::chrono::milliseconds(60'000));
+  std::unique_lock lock(mutex_);
+  while (!stopping_.wait_for(lock, period, [this] { return stopped_; })) {
+    table_->expire(config_.result_ttl);
+  }
+}
+
+void LabelmeshServer::shutdown() {
+  {
+    std::lock_guard lock(mutex_);
+    if (stopped_) return;
+    stopped_ = true;
+  }
+  stopping_.notify_all();
+  spdlog::info("shutting down: no new uploads or jobs; running jobs have {} s to finish",
+               absl::ToDoubleSeconds(config_.shutdown_grace));
+  if (!server_ || !pool_) return;  // start() failed half way: nothing runs yet.
+  service_->stop_accepting();
+  table_->stop_dispatch();
+  pool_->drain(config_.shutdown_grace);
+  table_->close();
+  server_->Shutdown(std::chrono::system_clock::now() + std::chrono::seconds(2));
+  pool_->join();
+  if (expirer_.joinable()) expirer_.join();
+  spdlog::info("labelmeshd stopped");
+}
+
+LabelmeshServer::~LabelmeshServer() { shutdown(); }
+
+}  // namespace labelmesh::server

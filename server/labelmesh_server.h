@@ -1,0 +1,58 @@
+// labelmeshd assembled: spool, job table, worker pool, gRPC services
+// (meshing, health, reflection), metrics and the expiry of old results.
+#pragma once
+
+#include <condition_variable>
+#include <memory>
+#include <mutex>
+#include <thread>
+
+#include "absl/status/statusor.h"
+#include "server/server_config.h"
+
+namespace grpc {
+class Server;
+}
+
+namespace labelmesh::server {
+
+class JobTable;
+class MeshingService;
+class Metrics;
+class Spool;
+class WorkerPool;
+
+class LabelmeshServer {
+ public:
+  // Validates the config, recovers the spool and starts serving.
+  static absl::StatusOr<std::unique_ptr<LabelmeshServer>> start(ServerConfig config);
+  ~LabelmeshServer();
+
+  // The port bound (useful with a listen address ending in ":0").
+  int port() const { return port_; }
+  Metrics& metrics() { return *metrics_; }
+
+  // Stops accepting uploads and starting jobs, lets running jobs finish for
+  // the grace period (the rest stay queued on disk), then stops serving.
+  void shutdown();
+
+ private:
+  LabelmeshServer() = default;
+  void expire_loop();
+
+  ServerConfig config_;
+  std::unique_ptr<Metrics> metrics_;
+  std::unique_ptr<Spool> spool_;
+  std::unique_ptr<JobTable> table_;
+  std::unique_ptr<WorkerPool> pool_;
+  std::unique_ptr<MeshingService> service_;
+  std::unique_ptr<grpc::Server> server_;
+  int port_ = 0;
+
+  std::thread expirer_;
+  std::mutex mutex_;
+  std::condition_variable stopping_;
+  bool stopped_ = false;
+};
+
+}  // namespace labelmesh::server

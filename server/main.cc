@@ -1,0 +1,127 @@
+// labelmeshd: the meshing service. Jobs run in labelmesh-worker processes.
+#include <signal.h>
+#include <CLI/CLI.hpp>
+
+#include <cstdio>
+#include <thread>
+
+#include "absl/time/time.h"
+#include "server/labelmesh_server.h"
+#include "spdlog/spdlog.h"
+
+namespace {
+
+using labelmesh::server::ServerConfig;
+
+// A CLI11 option holding a duration such as 90s, 30m or 24h.
+CLI::Option* add_duration(CLI::App& app, const std::string& name, absl::Duration& value,
+                          const std::string& help) {
+  auto* option = app.add_option_function<std::string>(
+      name,
+      [&value, name](const std::string& text) {
+        if (!absl::ParseDuration(text, &value)) {
+          throw CLI::ValidationError(name,
+                                     "'" + text + "' is not a duration such as 90s, 30m, 24h");
+        }
+      },
+      help + " (default " + absl::FormatDuration(value) + ")");
+  return option;
+}
+
+void add_server_flags(CLI::App& app, ServerConfig& c) {
+  auto env = [](CLI::Option* option, const char* variable) { option->envname(variable); };
+  env(app.add_option("--listen", c.listen, "gRPC address")->capture_default_str(),
+      "LABELMESHD_LISTEN");
+  env(app.add_option("--metrics-listen", c.metrics_listen,
+                     "Prometheus /metrics address, e.g. 127.0.0.1:9464 (default: none)"),
+      "LABELMESHD_METRICS_LISTEN");
+  env(app.add_option("--spool-dir", c.spool_dir, "Jobs, uploads and results")
+          ->capture_default_str(),
+      "LABELMESHD_SPOOL_DIR");
+  env(app.add_option("--workers", c.workers, "Jobs run at once, each in a worker process")
+          ->capture_default_str(),
+      "LABELMESHD_WORKERS");
+  env(app.add_option("--queue-capacity", c.queue_capacity, "Most jobs waiting to start")
+          ->capture_default_str(),
+      "LABELMESHD_QUEUE_CAPACITY");
+  env(add_duration(app, "--job-timeout", c.job_timeout, "Longest a job may run"),
+      "LABELMESHD_JOB_TIMEOUT");
+  env(add_duration(app, "--result-ttl", c.result_ttl, "How long results stay fetchable"),
+      "LABELMESHD_RESULT_TTL");
+  env(add_duration(app, "--shutdown-grace", c.shutdown_grace,
+                   "On SIGTERM, how long running jobs may finish; the rest run at next start"),
+      "LABELMESHD_SHUTDOWN_GRACE");
+  env(app.add_option("--max-upload-bytes", c.max_upload_bytes, "Largest upload")
+          ->capture_default_str(),
+      "LABELMESHD_MAX_UPLOAD_BYTES");
+  env(app.add_option("--max-voxels", c.max_voxels, "Largest volume, voxels")->capture_default_str(),
+      "LABELMESHD_MAX_VOXELS");
+  env(app.add_option("--max-concurrent-uploads", c.max_concurrent_uploads,
+                     "Uploads received at once")
+          ->capture_default_str(),
+      "LABELMESHD_MAX_CONCURRENT_UPLOADS");
+  env(app.add_option("--max-message-bytes", c.max_message_bytes, "Largest gRPC message")
+          ->capture_default_str(),
+      "LABELMESHD_MAX_MESSAGE_BYTES");
+  env(app.add_option("--worker-memory-bytes", c.worker_memory_bytes,
+                     "Address-space limit of each worker process (0: none)")
+          ->capture_default_str(),
+      "LABELMESHD_WORKER_MEMORY_BYTES");
+  env(app.add_option("--worker-cpu-seconds", c.worker_cpu_seconds,
+                     "CPU-time limit of each worker process (0: twice --job-timeout)")
+          ->capture_default_str(),
+      "LABELMESHD_WORKER_CPU_SECONDS");
+  env(app.add_option("--tls-cert", c.tls_cert, "PEM server certificate (chain)"),
+      "LABELMESHD_TLS_CERT");
+  env(app.add_option("--tls-key", c.tls_key, "PEM private key of --tls-cert"),
+      "LABELMESHD_TLS_KEY");
+  env(app.add_option("--client-ca", c.client_ca,
+                     "PEM CA: require client certificates it signed (mutual TLS)"),
+      "LABELMESHD_CLIENT_CA");
+  env(app.add_option("--auth-token-file", c.auth_token_file,
+                     "File holding the bearer token every call must present"),
+      "LABELMESHD_AUTH_TOKEN_FILE");
+  env(app.add_flag("--insecure", c.insecure,
+                   "Allow a non-loopback --listen without TLS (trusted networks only)"),
+      "LABELMESHD_INSECURE");
+}
+
+// SIGTERM and SIGINT are taken by one thread with sigwait, never by a handler.
+int wait_for_stop_signal() {
+  sigset_t signals;
+  sigemptyset(&signals);
+  sigaddset(&signals, SIGTERM);
+  sigaddset(&signals, SIGINT);
+  int number = 0;
+  sigwait(&signals, &number);
+  return number;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  // Blocked before any thread starts, so every thread inherits the mask.
+  sigset_t signals;
+  sigemptyset(&signals);
+  sigaddset(&signals, SIGTERM);
+  sigaddset(&signals, SIGINT);
+  pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+  signal(SIGPIPE, SIG_IGN);
+
+  ServerConfig config;
+  CLI::App app{"labelmeshd " LABELMESH_VERSION
+               ": the labelmesh gRPC meshing service. Every flag can also be set with the "
+               "environment variable named after it. Without TLS it listens on loopback only."};
+  add_server_flags(app, config);
+  CLI11_PARSE(app, argc, argv);
+
+  auto server = labelmesh::server::LabelmeshServer::start(config);
+  if (!server.ok()) {
+    std::fprintf(stderr, "labelmeshd: %s\n", std::string(server.status().message()).c_str());
+    return 2;
+  }
+  const int number = wait_for_stop_signal();
+  spdlog::info("received {}", number == SIGTERM ? "SIGTERM" : "SIGINT");
+  (*server)->shutdown();
+  return 0;
+}

@@ -1,0 +1,276 @@
+#include "server/meshing_service.h"
+
+#include <filesystem>
+#include <fstream>
+
+#include "absl/strings/match.h"
+#include "absl/strings/str_cat.h"
+#include "core/report.h"
+#include "server/sha256.h"
+#include "server/upload_checks.h"
+#include "spdlog/spdlog.h"
+
+namespace labelmesh::server {
+namespace {
+
+constexpr size_t kChunkBytes = 1 << 20;
+
+grpc::Status to_grpc(const absl::Status& status) {
+  return grpc::Status(static_cast<grpc::StatusCode>(status.code()), std::string(status.message()));
+}
+
+grpc::Status invalid(const std::string& message) {
+  return grpc::Status(grpc::StatusCode::INVALID_ARGUMENT, message);
+}
+
+// An unknown or malformed id is NOT_FOUND; only well-formed ids reach paths.
+grpc::Status check_job_id(const std::string& job_id) {
+  if (is_job_id(job_id)) return grpc::Status::OK;
+  return grpc::Status(grpc::StatusCode::NOT_FOUND, "no such job (ids are 32 hex digits)");
+}
+
+// Counts an upload in flight for as long as it lives.
+class UploadSlot {
+ public:
+  UploadSlot(std::atomic<int>& count, int limit) : count_(count) {
+    acquired_ = count_.fetch_add(1) < limit;
+  }
+  ~UploadSlot() { count_.fetch_sub(1); }
+  bool acquired() const { return acquired_; }
+
+ private:
+  std::atomic<int>& count_;
+  bool acquired_;
+};
+
+// Deletes the upload file unless it was handed to a job.
+class UploadFile {
+ public:
+  explicit UploadFile(std::string path) : path_(std::move(path)) {}
+  ~UploadFile() {
+    std::error_code ignored;
+    if (!kept_) std::filesystem::remove(path_, ignored);
+  }
+  const std::string& path() const { return path_; }
+  void keep() { kept_ = true; }
+
+ private:
+  std::string path_;
+  bool kept_ = false;
+};
+
+}  // namespace
+
+MeshingService::MeshingService(JobTable& table, const Spool& spool, const ServerConfig& config,
+                               Metrics& metrics, std::string token)
+    : table_(table), spool_(spool), config_(config), metrics_(metrics), token_(std::move(token)) {}
+
+grpc::Status MeshingService::authenticate(const grpc::ServerContext& context) {
+  if (token_.empty()) return grpc::Status::OK;
+  const auto& metadata = context.client_metadata();
+  auto it = metadata.find("authorization");
+  std::string presented;
+  if (it != metadata.end()) presented.assign(it->second.data(), it->second.size());
+  const std::string scheme = "Bearer ";
+  const bool ok =
+      presented.compare(0, scheme.size(), scheme) == 0 &&
+      digest::constant_time_equal(std::string_view(presented).substr(scheme.size()), token_);
+  if (ok) return grpc::Status::OK;
+  metrics_.rejected("unauthenticated");
+  return grpc::Status(grpc::StatusCode::UNAUTHENTICATED,
+                      "missing or wrong bearer token (metadata 'authorization: Bearer <token>')");
+}
+
+grpc::Status MeshingService::receive_upload(grpc::ServerReader<v1::SubmitRequest>& reader,
+                                            const v1::JobSpec& spec, const std::string& path) {
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  if (!out) return grpc::Status(grpc::StatusCode::INTERNAL, "spool: cannot store the upload");
+  digest::Sha256 hash;
+  uint64_t received = 0;
+  v1::SubmitRequest message;
+  while (reader.Read(&message)) {
+    if (!message.has_chunk()) return invalid("after the spec, every message must be a chunk");
+    const std::string& chunk = message.chunk();
+    if (chunk.size() > kChunkBytes) return invalid("chunk: over 1 MiB");
+    if (received + chunk.size() > spec.size_bytes()) {
+      return invalid(
+          absl::StrCat("upload: more bytes than spec.size_bytes (", spec.size_bytes(), ")"));
+    }
+    out.write(chunk.data(), static_cast<std::streamsize>(chunk.size()));
+    hash.update(chunk);
+    received += chunk.size();
+  }
+  out.flush();
+  if (!out) return grpc::Status(grpc::StatusCode::INTERNAL, "spool: cannot write the upload");
+  if (received < spec.size_bytes()) {
+    return invalid(absl::StrCat("upload: truncated, ", received, " of ", spec.size_bytes(),
+                                " bytes received"));
+  }
+  if (hash.hex_digest() != spec.sha256()) {
+    metrics_.rejected("bad_digest");
+    return invalid("upload: SHA-256 of the bytes received does not match spec.sha256");
+  }
+  metrics_.upload_bytes(received);
+  return grpc::Status::OK;
+}
+
+grpc::Status MeshingService::Submit(grpc::ServerContext* context,
+                                    grpc::ServerReader<v1::SubmitRequest>* reader,
+                                    v1::SubmitReply* reply) {
+  if (auto status = authenticate(*context); !status.ok()) return status;
+  if (!accepting_)
+    return grpc::Status(grpc::StatusCode::UNAVAILABLE, "the server is shutting down");
+  UploadSlot slot(uploads_, config_.max_concurrent_uploads);
+  if (!slot.acquired()) {
+    metrics_.rejected("too_many_uploads");
+    return grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED,
+                        absl::StrCat("too many uploads at once (limit ",
+                                     config_.max_concurrent_uploads, "); try again later"));
+  }
+  v1::SubmitRequest first;
+  if (!reader->Read(&first) || !first.has_spec()) {
+    metrics_.rejected("bad_request");
+    return invalid("the first message must hold the job spec");
+  }
+  v1::JobSpec spec = first.spec();
+  if (auto status = check_spec(spec, config_); !status.ok()) {
+    metrics_.rejected(absl::StartsWith(status.message(), "spec.size_bytes") ? "too_large"
+                                                                            : "bad_request");
+    return to_grpc(status);
+  }
+  if (table_.queue_full()) {
+    metrics_.rejected("queue_full");
+    return grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED,
+                        "the job queue is full; try again later");
+  }
+  // The job's voxel limit is the smaller of the client's and the server's.
+  auto& options = *spec.mutable_options();
+  const uint64_t voxel_limit = options.max_voxels() == 0
+                                   ? config_.max_voxels
+                                   : std::min<uint64_t>(options.max_voxels(), config_.max_voxels);
+  options.set_max_voxels(voxel_limit);
+
+  const std::string job_id = new_job_id();
+  const std::string extension = *upload_extension(spec.file_name());
+  UploadFile upload(spool_.upload_path(job_id, extension));
+  if (auto status = receive_upload(*reader, spec, upload.path()); !status.ok()) {
+    if (status.error_code() == grpc::StatusCode::INVALID_ARGUMENT &&
+        !absl::StrContains(status.error_message(), "SHA-256")) {
+      metrics_.rejected("bad_request");
+    }
+    return status;
+  }
+  if (auto status = check_uploaded_volume(upload.path(), voxel_limit); !status.ok()) {
+    metrics_.rejected("bad_volume");
+    return to_grpc(status);
+  }
+
+  v1::JobRecord record;
+  v1::Job& job = *record.mutable_job();
+  job.set_job_id(job_id);
+  job.set_created_at(unix_now());
+  *job.mutable_options() = spec.options();
+  // Only the extension of the client's file name is kept: names can hold
+  // patient identifiers.
+  spec.set_file_name(absl::StrCat("upload", extension));
+  *record.mutable_spec() = spec;
+  record.set_input_extension(extension);
+  auto position = table_.accept(std::move(record), upload.path());
+  if (!position.ok()) {
+    if (position.status().code() == absl::StatusCode::kResourceExhausted) {
+      metrics_.rejected("queue_full");
+    }
+    return to_grpc(position.status());
+  }
+  upload.keep();
+  reply->set_job_id(job_id);
+  reply->set_queue_position(*position);
+  return grpc::Status::OK;
+}
+
+grpc::Status MeshingService::Watch(grpc::ServerContext* context, const v1::WatchRequest* request,
+                                   grpc::ServerWriter<v1::JobEvent>* writer) {
+  if (auto status = authenticate(*context); !status.ok()) return status;
+  if (auto status = check_job_id(request->job_id()); !status.ok()) return status;
+  uint64_t next = 0;
+  for (;;) {
+    auto batch = table_.events_since(request->job_id(), next, absl::Milliseconds(500));
+    if (!batch.ok()) return to_grpc(batch.status());
+    for (const auto& event : batch->events) {
+      if (!writer->Write(event)) return grpc::Status(grpc::StatusCode::CANCELLED, "watcher left");
+      next = event.sequence() + 1;
+    }
+    if (batch->ended) return grpc::Status::OK;
+    if (context->IsCancelled()) return grpc::Status(grpc::StatusCode::CANCELLED, "watcher left");
+  }
+}
+
+grpc::Status MeshingService::GetJob(grpc::ServerContext* context, const v1::GetJobRequest* request,
+                                    v1::Job* reply) {
+  if (auto status = authenticate(*context); !status.ok()) return status;
+  if (auto status = check_job_id(request->job_id()); !status.ok()) return status;
+  auto job = table_.get(request->job_id());
+  if (!job.ok()) return to_grpc(job.status());
+  *reply = std::move(*job);
+  return grpc::Status::OK;
+}
+
+grpc::Status MeshingService::ListJobs(grpc::ServerContext* context, const v1::ListJobsRequest*,
+                                      v1::ListJobsReply* reply) {
+  if (auto status = authenticate(*context); !status.ok()) return status;
+  for (auto& job : table_.list()) *reply->add_jobs() = std::move(job);
+  return grpc::Status::OK;
+}
+
+grpc::Status MeshingService::Cancel(grpc::ServerContext* context, const v1::CancelRequest* request,
+                                    v1::Job* reply) {
+  if (auto status = authenticate(*context); !status.ok()) return status;
+  if (auto status = check_job_id(request->job_id()); !status.ok()) return status;
+  auto job = table_.cancel(request->job_id());
+  if (!job.ok()) return to_grpc(job.status());
+  *reply = std::move(*job);
+  return grpc::Status::OK;
+}
+
+grpc::Status MeshingService::ListArtifacts(grpc::ServerContext* context,
+                                           const v1::ListArtifactsRequest* request,
+                                           v1::ListArtifactsReply* reply) {
+  if (auto status = authenticate(*context); !status.ok()) return status;
+  if (auto status = check_job_id(request->job_id()); !status.ok()) return status;
+  auto artifacts = table_.artifacts(request->job_id());
+  if (!artifacts.ok()) return to_grpc(artifacts.status());
+  for (auto& artifact : *artifacts) *reply->add_artifacts() = std::move(artifact);
+  return grpc::Status::OK;
+}
+
+grpc::Status MeshingService::Fetch(grpc::ServerContext* context, const v1::FetchRequest* request,
+                                   grpc::ServerWriter<v1::FetchChunk>* writer) {
+  if (auto status = authenticate(*context); !status.ok()) return status;
+  if (auto status = check_job_id(request->job_id()); !status.ok()) return status;
+  auto artifacts = table_.artifacts(request->job_id());
+  if (!artifacts.ok()) return to_grpc(artifacts.status());
+  // Only names the job recorded are served: nothing else in the spool is reachable.
+  const v1::Artifact* artifact = nullptr;
+  for (const auto& candidate : *artifacts) {
+    if (candidate.name() == request->artifact()) artifact = &candidate;
+  }
+  if (artifact == nullptr) {
+    return grpc::Status(grpc::StatusCode::NOT_FOUND,
+                        absl::StrCat("job has no artifact '", request->artifact(), "'"));
+  }
+  std::ifstream in(absl::StrCat(spool_.output_dir(request->job_id()), "/", artifact->name()),
+                   std::ios::binary);
+  if (!in) return grpc::Status(grpc::StatusCode::NOT_FOUND, "the artifact expired or was removed");
+  v1::FetchChunk chunk;
+  *chunk.mutable_artifact() = *artifact;
+  std::string buffer(kChunkBytes, '\0');
+  do {
+    in.read(buffer.data(), static_cast<std::streamsize>(buffer.size()));
+    chunk.set_data(buffer.data(), static_cast<size_t>(in.gcount()));
+    if (!writer->Write(chunk)) return grpc::Status(grpc::StatusCode::CANCELLED, "reader left");
+    chunk.clear_artifact();
+  } while (in);
+  return grpc::Status::OK;
+}
+
+}  // namespace labelmesh::server

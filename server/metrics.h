@@ -1,0 +1,44 @@
+// The server's Prometheus metrics, all named labelmesh_*, in base units.
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include "absl/status/statusor.h"
+
+namespace prometheus {
+class Registry;
+class Exposer;
+}  // namespace prometheus
+
+namespace labelmesh::server {
+
+class Metrics {
+ public:
+  explicit Metrics(int queue_capacity);
+  ~Metrics();
+
+  // Serves /metrics on `address`. Errors: INVALID_ARGUMENT when it cannot bind.
+  absl::Status expose(const std::string& address);
+  // The text exposition format of every metric (what /metrics returns).
+  std::string text() const;
+
+  void set_queue_depth(size_t depth);
+  void set_running(size_t running);
+  // outcome: succeeded, failed, cancelled.
+  void job_ended(const std::string& outcome);
+  void queue_wait(double seconds);
+  void stage_finished(const std::string& stage, double seconds);
+  // reason: queue_full, too_many_uploads, too_large, bad_request, bad_digest,
+  // bad_volume, unauthenticated.
+  void rejected(const std::string& reason);
+  void upload_bytes(uint64_t bytes);
+
+ private:
+  struct Families;
+  std::shared_ptr<prometheus::Registry> registry_;
+  std::unique_ptr<Families> families_;
+  std::unique_ptr<prometheus::Exposer> exposer_;
+};
+
+}  // namespace labelmesh::server

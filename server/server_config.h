@@ -1,0 +1,62 @@
+// Everything labelmeshd can be told, with its defaults. Flags and LABELMESHD_*
+// environment variables fill it (server_flags.cc); tests build it directly.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <thread>
+
+#include "absl/status/status.h"
+#include "absl/time/time.h"
+
+namespace labelmesh::server {
+
+struct ServerConfig {
+  std::string listen = "127.0.0.1:50051";
+  // Prometheus metrics endpoint; empty for none.
+  std::string metrics_listen;
+  std::string spool_dir = "labelmeshd-spool";
+  // 0 accepts and queues jobs without running them (a drained node).
+  int workers = static_cast<int>(std::thread::hardware_concurrency());
+  int queue_capacity = 64;
+  absl::Duration job_timeout = absl::Minutes(30);
+  absl::Duration result_ttl = absl::Hours(24);
+  // On SIGTERM: how long running jobs may take to finish before they are
+  // stopped and left queued for the next start.
+  absl::Duration shutdown_grace = absl::Seconds(30);
+
+  uint64_t max_upload_bytes = uint64_t{2} << 30;
+  uint64_t max_voxels = uint64_t{1} << 31;
+  int max_concurrent_uploads = 8;
+  // Largest gRPC message either way; upload and fetch chunks are 1 MiB.
+  int max_message_bytes = 4 << 20;
+
+  // Limits of each worker process: address space (0: none) and CPU seconds
+  // (0: twice the job timeout).
+  uint64_t worker_memory_bytes = uint64_t{8} << 30;
+  uint64_t worker_cpu_seconds = 0;
+
+  std::string tls_cert;
+  std::string tls_key;
+  // Requires clients to present a certificate signed by this CA (mutual TLS).
+  std::string client_ca;
+  // One line holding the bearer token every call must carry.
+  std::string auth_token_file;
+  // Allow a non-loopback listen address without TLS.
+  bool insecure = false;
+
+  // The worker started as `<it> JOB_DIR`; empty for labelmesh-worker beside
+  // this process's own executable.
+  std::string worker_executable;
+
+  bool tls() const { return !tls_cert.empty(); }
+};
+
+// INVALID_ARGUMENT naming the flag at fault: ranges, TLS files in pairs, and a
+// non-loopback address without TLS or --insecure.
+absl::Status validate_config(const ServerConfig& config);
+
+// True for 127.0.0.0/8, ::1, localhost and unix: addresses.
+bool is_loopback_address(const std::string& address);
+
+}  // namespace labelmesh::server

@@ -1,0 +1,53 @@
+// The spool directory: every accepted job and its files, on disk before the
+// client hears "accepted", so that a crash or restart loses nothing.
+//
+//   <root>/uploads/<id><ext>      an upload being received (wiped at start)
+//   <root>/jobs/<id>/job.pb       the JobRecord, replaced atomically
+//   <root>/jobs/<id>/input<ext>   the uploaded volume
+//   <root>/jobs/<id>/out/         meshes and report.json of the last attempt
+//   <root>/jobs/<id>/worker.log   the worker's stderr
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "labelmesh/v1/service.pb.h"
+
+namespace labelmesh::server {
+
+class Spool {
+ public:
+  // Creates the directories and wipes unfinished uploads.
+  static absl::StatusOr<Spool> open(const std::string& root);
+
+  const std::string& root() const { return root_; }
+  std::string upload_path(const std::string& job_id, const std::string& extension) const;
+  std::string job_dir(const std::string& job_id) const;
+  std::string input_path(const v1::JobRecord& record) const;
+  std::string output_dir(const std::string& job_id) const;
+  std::string worker_log(const std::string& job_id) const;
+
+  // Makes the job directory, moves the upload in and writes the record.
+  absl::Status create_job(const v1::JobRecord& record, const std::string& upload_path) const;
+  // Replaces job.pb atomically (temporary file, fsync, rename, fsync).
+  absl::Status save(const v1::JobRecord& record) const;
+  // Every job directory with a readable record; others are removed.
+  std::vector<v1::JobRecord> load_all() const;
+  void remove_job(const std::string& job_id) const;
+  // Empties out/ before an attempt.
+  absl::Status reset_output(const std::string& job_id) const;
+  // Every regular file under out/, with size and SHA-256, sorted by name.
+  absl::StatusOr<std::vector<v1::Artifact>> collect_artifacts(const std::string& job_id) const;
+
+ private:
+  explicit Spool(std::string root) : root_(std::move(root)) {}
+  std::string root_;
+};
+
+// A fresh job id: 32 random lowercase hex digits.
+std::string new_job_id();
+// True for what new_job_id() makes; anything else never reaches a path.
+bool is_job_id(std::string_view text);
+
+}  // namespace labelmesh::server

@@ -1,0 +1,58 @@
+#include "server/upload_checks.h"
+
+#include "absl/strings/match.h"
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_replace.h"
+#include "core/report.h"
+#include "core/volume/volume_header.h"
+#include "server/sha256.h"
+
+namespace labelmesh::server {
+
+absl::StatusOr<std::string> upload_extension(const std::string& file_name) {
+  // Longest first: ".nii.gz" before ".nii" could never match it anyway, but
+  // ".gz" alone must not pass.
+  for (const char* extension : {".nii.gz", ".inr.gz", ".nii", ".mha", ".nrrd", ".inr", ".vti"}) {
+    if (absl::EndsWithIgnoreCase(file_name, extension)) return std::string(extension);
+  }
+  return absl::InvalidArgumentError(
+      "spec.file_name: unknown or unsupported extension; uploads are single files: .nii, "
+      ".nii.gz, .mha, .nrrd, .inr, .inr.gz or .vti");
+}
+
+absl::Status check_spec(const v1::JobSpec& spec, const ServerConfig& config) {
+  if (auto extension = upload_extension(spec.file_name()); !extension.ok()) {
+    return extension.status();
+  }
+  if (spec.size_bytes() == 0)
+    return absl::InvalidArgumentError("spec.size_bytes: must be positive");
+  if (spec.size_bytes() > config.max_upload_bytes) {
+    return absl::InvalidArgumentError(absl::StrCat("spec.size_bytes: ", spec.size_bytes(),
+                                                   " is over the server's upload limit of ",
+                                                   config.max_upload_bytes, " bytes"));
+  }
+  if (!digest::is_sha256_hex(spec.sha256())) {
+    return absl::InvalidArgumentError("spec.sha256: must be 64 lowercase hex digits");
+  }
+  if (auto params = params_from_options(spec.options()); !params.ok()) {
+    return absl::InvalidArgumentError(absl::StrCat("spec.options: ", params.status().message()));
+  }
+  return absl::OkStatus();
+}
+
+absl::Status check_uploaded_volume(const std::string& path, uint64_t max_voxels) {
+  volume::ReadLimits limits;
+  limits.max_voxels = max_voxels;
+  auto header = volume::check_volume_header(path, limits);
+  absl::Status status = header.status();
+  if (status.ok() && header->data_path != path) {
+    status = absl::InvalidArgumentError(
+        absl::StrCat(path,
+                     ": the header names a separate data file; upload a format that holds "
+                     "its voxels (.nii, .mha, .nrrd with attached data)"));
+  }
+  if (status.ok()) return status;
+  return absl::Status(status.code(), absl::StrReplaceAll(status.message(), {{path, "upload"}}));
+}
+
+}  // namespace labelmesh::server

@@ -1,0 +1,120 @@
+// labelmesh-worker JOB_DIR: one job, run with the core library, its events
+// sent to labelmeshd over file descriptor 3. The server kills it to stop it.
+#include <chrono>
+#include <cstdio>
+#include <fstream>
+#include <new>
+
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_replace.h"
+#include "core/pipeline.h"
+#include "core/report.h"
+#include "server/event_pipe.h"
+#include "server/worker_process.h"
+
+namespace labelmesh::server {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// Turns the pipeline's progress callbacks into stage and progress events.
+class StageEvents {
+ public:
+  explicit StageEvents(int fd) : fd_(fd) {}
+
+  void update(std::string_view stage, double fraction) {
+    if (stage != stage_) {
+      finish_stage();
+      stage_ = std::string(stage);
+      stage_start_ = Clock::now();
+      percent_ = -1;
+      v1::JobEvent event;
+      event.mutable_stage_started()->set_stage(stage_);
+      write_event(fd_, event);
+    }
+    const int percent = static_cast<int>(fraction * 100);
+    if (percent == percent_) return;
+    percent_ = percent;
+    v1::JobEvent event;
+    event.mutable_progress()->set_stage(stage_);
+    event.mutable_progress()->set_fraction(fraction);
+    write_event(fd_, event);
+  }
+
+  void finish_stage() {
+    if (stage_.empty()) return;
+    v1::JobEvent event;
+    event.mutable_stage_finished()->set_stage(stage_);
+    event.mutable_stage_finished()->set_seconds(
+        std::chrono::duration<double>(Clock::now() - stage_start_).count());
+    write_event(fd_, event);
+    stage_.clear();
+  }
+
+ private:
+  int fd_;
+  std::string stage_;
+  int percent_ = -1;
+  Clock::time_point stage_start_;
+};
+
+void send_failure(int fd, const absl::Status& status, const std::string& job_dir) {
+  v1::JobEvent event;
+  event.mutable_failed()->set_code(static_cast<int>(status.code()));
+  // Paths inside the spool mean nothing to the client: name the input plainly.
+  event.mutable_failed()->set_message(
+      absl::StrReplaceAll(status.message(), {{absl::StrCat(job_dir, "/"), ""}}));
+  write_event(fd, event);
+}
+
+absl::Status run_job(const std::string& job_dir, int fd) {
+  v1::JobRecord record;
+  {
+    std::ifstream in(absl::StrCat(job_dir, "/job.pb"), std::ios::binary);
+    if (!in || !record.ParseFromIstream(&in)) {
+      return absl::InternalError("the worker cannot read its job record");
+    }
+  }
+  auto params = params_from_options(record.spec().options());
+  if (!params.ok()) return params.status();
+  StageEvents events(fd);
+  RunContext context;
+  context.progress = [&events](std::string_view stage, double fraction) {
+    events.update(stage, fraction);
+  };
+  auto result =
+      run_pipeline(absl::StrCat(job_dir, "/input", record.input_extension()), *params, context);
+  if (!result.ok()) return result.status();
+  const std::string out_dir = absl::StrCat(job_dir, "/out");
+  if (auto status = write_results(*result, *params, out_dir, context); !status.ok()) return status;
+  events.finish_stage();
+  v1::JobEvent finished;
+  *finished.mutable_finished()->mutable_report() = make_report(*result, *params);
+  if (!write_event(fd, finished)) return absl::InternalError("the server stopped listening");
+  return absl::OkStatus();
+}
+
+}  // namespace
+
+int worker_main(const std::string& job_dir, int event_fd) {
+  absl::Status status;
+  try {
+    status = run_job(job_dir, event_fd);
+  } catch (const std::bad_alloc&) {
+    status = absl::ResourceExhaustedError("the job ran out of memory in the worker");
+  } catch (const std::exception& e) {
+    status = absl::InternalError(absl::StrCat("the worker failed: ", e.what()));
+  }
+  if (!status.ok()) send_failure(event_fd, status, job_dir);
+  return status.ok() ? 0 : 1;
+}
+
+}  // namespace labelmesh::server
+
+int main(int argc, char** argv) {
+  if (argc != 2) {
+    std::fprintf(stderr, "usage: labelmesh-worker JOB_DIR (started by labelmeshd)\n");
+    return 2;
+  }
+  return labelmesh::server::worker_main(argv[1], 3);
+}

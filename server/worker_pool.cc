@@ -1,0 +1,103 @@
+#include "server/worker_pool.h"
+
+#include <unistd.h>
+
+#include <filesystem>
+
+#include "absl/strings/str_cat.h"
+#include "server/worker_process.h"
+#include "spdlog/spdlog.h"
+
+namespace labelmesh::server {
+
+WorkerPool::WorkerPool(JobTable& table, const Spool& spool, const ServerConfig& config)
+    : table_(table), spool_(spool), config_(config) {
+  executable_ =
+      config.worker_executable.empty()
+          ? (std::filesystem::read_symlink("/proc/self/exe").parent_path() / "labelmesh-worker")
+                .string()
+          : config.worker_executable;
+}
+
+WorkerPool::~WorkerPool() { join(); }
+
+void WorkerPool::start() {
+  for (int i = 0; i < config_.workers; ++i) threads_.emplace_back([this] { run_thread(); });
+}
+
+void WorkerPool::run_thread() {
+  while (auto record = table_.take_next()) {
+    {
+      std::lock_guard lock(mutex_);
+      ++busy_;
+    }
+    run_job(*record);
+    std::lock_guard lock(mutex_);
+    --busy_;
+    idle_.notify_all();
+  }
+}
+
+void WorkerPool::run_job(const v1::JobRecord& record) {
+  const std::string id = record.job().job_id();
+  if (auto status = spool_.reset_output(id); !status.ok()) {
+    table_.fail(id, static_cast<int>(status.code()), std::string(status.message()));
+    return;
+  }
+  WorkerRun run;
+  run.executable = executable_;
+  run.job_dir = spool_.job_dir(id);
+  run.log_path = spool_.worker_log(id);
+  run.limits.memory_bytes = config_.worker_memory_bytes;
+  run.limits.cpu_seconds =
+      config_.worker_cpu_seconds > 0
+          ? config_.worker_cpu_seconds
+          : static_cast<uint64_t>(2 * absl::ToDoubleSeconds(config_.job_timeout)) + 1;
+  run.deadline = absl::Now() + config_.job_timeout;
+  run.on_event = [this, &id](v1::JobEvent event) { table_.publish(id, std::move(event)); };
+  run.stop_request = [this, &id] {
+    if (table_.cancel_requested(id)) return StopRequest::kCancel;
+    if (interrupt_.load()) return StopRequest::kShutdown;
+    return StopRequest::kNone;
+  };
+  WorkerOutcome outcome = run_worker_process(run);
+  switch (outcome.kind) {
+    case WorkerOutcome::Kind::kSucceeded: {
+      auto artifacts = spool_.collect_artifacts(id);
+      if (!artifacts.ok()) {
+        table_.fail(id, static_cast<int>(artifacts.status().code()),
+                    std::string(artifacts.status().message()));
+      } else {
+        table_.succeed(id, outcome.report, std::move(*artifacts));
+      }
+      break;
+    }
+    case WorkerOutcome::Kind::kFailed:
+      table_.fail(id, outcome.code, outcome.message);
+      break;
+    case WorkerOutcome::Kind::kCancelled:
+      table_.mark_cancelled(id);
+      break;
+    case WorkerOutcome::Kind::kInterrupted:
+      table_.requeue_interrupted(id);
+      break;
+  }
+}
+
+void WorkerPool::drain(absl::Duration grace) {
+  std::unique_lock lock(mutex_);
+  if (!idle_.wait_for(lock, absl::ToChronoMilliseconds(grace), [this] { return busy_ == 0; })) {
+    spdlog::warn("shutdown: {} jobs still running after the grace period; stopping them", busy_);
+    interrupt_ = true;
+    idle_.wait(lock, [this] { return busy_ == 0; });
+  }
+}
+
+void WorkerPool::join() {
+  for (auto& thread : threads_) {
+    if (thread.joinable()) thread.join();
+  }
+  threads_.clear();
+}
+
+}  // namespace labelmesh::server

@@ -1,0 +1,45 @@
+// Threads that take queued jobs and run each in a worker process.
+#pragma once
+
+#include <atomic>
+#include <condition_variable>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+#include "absl/time/time.h"
+#include "server/job_table.h"
+#include "server/server_config.h"
+#include "server/spool.h"
+
+namespace labelmesh::server {
+
+class WorkerPool {
+ public:
+  WorkerPool(JobTable& table, const Spool& spool, const ServerConfig& config);
+  ~WorkerPool();
+
+  void start();
+  // Lets running jobs finish for up to `grace`, then stops the rest, which
+  // stay queued on disk. The table must no longer dispatch.
+  void drain(absl::Duration grace);
+  // After the table is closed.
+  void join();
+
+ private:
+  void run_thread();
+  void run_job(const v1::JobRecord& record);
+
+  JobTable& table_;
+  const Spool& spool_;
+  const ServerConfig& config_;
+  std::string executable_;
+  std::vector<std::thread> threads_;
+
+  std::mutex mutex_;
+  std::condition_variable idle_;
+  int busy_ = 0;
+  std::atomic<bool> interrupt_{false};
+};
+
+}  // namespace labelmesh::server

@@ -1,0 +1,166 @@
+#include "server/worker_process.h"
+
+#include <fcntl.h>
+#include <poll.h>
+#include <signal.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+#include <optional>
+#include <vector>
+
+#include "absl/status/status.h"
+#include "absl/strings/str_cat.h"
+#include "server/event_pipe.h"
+
+namespace labelmesh::server {
+namespace {
+
+constexpr int kChildEventFd = 3;
+
+struct ChildSetup {
+  int event_write_fd;
+  int log_fd;
+  int null_fd;
+  WorkerLimits limits;
+};
+
+// Between fork and exec only async-signal-safe calls are allowed.
+[[noreturn]] void exec_child(const ChildSetup& setup, char* const argv[]) {
+  setpgid(0, 0);  // Terminal signals go to the server, which decides.
+  rlimit no_core{0, 0};
+  setrlimit(RLIMIT_CORE, &no_core);
+#if !defined(__SANITIZE_ADDRESS__)
+  // AddressSanitizer reserves terabytes of shadow address space.
+  if (setup.limits.memory_bytes > 0) {
+    rlimit memory{setup.limits.memory_bytes, setup.limits.memory_bytes};
+    setrlimit(RLIMIT_AS, &memory);
+  }
+#endif
+  if (setup.limits.cpu_seconds > 0) {
+    // SIGXCPU at the soft limit, SIGKILL five seconds later.
+    rlimit cpu{setup.limits.cpu_seconds, setup.limits.cpu_seconds + 5};
+    setrlimit(RLIMIT_CPU, &cpu);
+  }
+  dup2(setup.null_fd, STDIN_FILENO);
+  dup2(setup.log_fd, STDOUT_FILENO);
+  dup2(setup.log_fd, STDERR_FILENO);
+  dup2(setup.event_write_fd, kChildEventFd);
+  // Nothing of the server's (sockets, other jobs' pipes) reaches the child.
+  close_range(kChildEventFd + 1, ~0U, 0);
+  execv(argv[0], argv);
+  _exit(127);
+}
+
+std::string signal_description(int signal_number) {
+  const char* name = sigabbrev_np(signal_number);
+  return absl::StrCat("signal ", signal_number, " (SIG", name ? name : "?", ")");
+}
+
+WorkerOutcome failed(absl::StatusCode code, std::string message) {
+  WorkerOutcome outcome;
+  outcome.kind = WorkerOutcome::Kind::kFailed;
+  outcome.code = static_cast<int>(code);
+  outcome.message = std::move(message);
+  return outcome;
+}
+
+// What a child that ended without a result died of.
+WorkerOutcome outcome_of_exit(int wait_status) {
+  if (WIFSIGNALED(wait_status)) {
+    const int number = WTERMSIG(wait_status);
+    if (number == SIGXCPU || number == SIGKILL) {
+      return failed(absl::StatusCode::kResourceExhausted,
+                    absl::StrCat("the worker went over its CPU time or memory limit and was "
+                                 "killed (",
+                                 signal_description(number), ")"));
+    }
+    return failed(absl::StatusCode::kInternal,
+                  absl::StrCat("the worker crashed with ", signal_description(number)));
+  }
+  const int code = WIFEXITED(wait_status) ? WEXITSTATUS(wait_status) : -1;
+  return failed(absl::StatusCode::kInternal,
+                absl::StrCat("the worker exited with status ", code, " without a result"));
+}
+
+}  // namespace
+
+WorkerOutcome run_worker_process(const WorkerRun& run) {
+  int pipe_fds[2];
+  if (pipe2(pipe_fds, O_CLOEXEC) != 0) {
+    return failed(absl::StatusCode::kInternal, "cannot create the worker's event pipe");
+  }
+  const int log_fd = ::open(run.log_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0640);
+  const int null_fd = ::open("/dev/null", O_RDONLY | O_CLOEXEC);
+  std::string executable = run.executable, job_dir = run.job_dir;
+  std::vector<char*> argv{executable.data(), job_dir.data(), nullptr};
+  const ChildSetup setup{pipe_fds[1], log_fd >= 0 ? log_fd : null_fd, null_fd, run.limits};
+
+  const pid_t pid = fork();
+  if (pid == 0) exec_child(setup, argv.data());
+  ::close(pipe_fds[1]);
+  if (log_fd >= 0) ::close(log_fd);
+  if (null_fd >= 0) ::close(null_fd);
+  if (pid < 0) {
+    ::close(pipe_fds[0]);
+    return failed(absl::StatusCode::kInternal,
+                  absl::StrCat("cannot start a worker: ", std::strerror(errno)));
+  }
+
+  EventPipeReader reader;
+  std::optional<WorkerOutcome> result;
+  std::optional<WorkerOutcome> stopped;
+  char buffer[1 << 16];
+  bool open = true;
+  while (open && !stopped) {
+    pollfd watch{pipe_fds[0], POLLIN, 0};
+    const int ready = poll(&watch, 1, 100);
+    if (ready > 0) {
+      const ssize_t n = ::read(pipe_fds[0], buffer, sizeof buffer);
+      if (n > 0) {
+        reader.append(buffer, static_cast<size_t>(n));
+      } else if (n == 0 || errno != EINTR) {
+        open = false;
+      }
+      for (;;) {
+        auto event = reader.next();
+        if (!event.ok()) {
+          stopped = failed(absl::StatusCode::kInternal, std::string(event.status().message()));
+          break;
+        }
+        if (!event->has_value()) break;
+        v1::JobEvent& e = **event;
+        if (e.has_finished()) {
+          result = WorkerOutcome{WorkerOutcome::Kind::kSucceeded, 0, "", e.finished().report()};
+        } else if (e.has_failed()) {
+          result = failed(static_cast<absl::StatusCode>(e.failed().code()), e.failed().message());
+        } else if (run.on_event) {
+          run.on_event(std::move(e));
+        }
+      }
+    }
+    if (stopped) break;
+    const StopRequest request = run.stop_request ? run.stop_request() : StopRequest::kNone;
+    if (request == StopRequest::kCancel) {
+      stopped = WorkerOutcome{WorkerOutcome::Kind::kCancelled, 0, "", {}};
+    } else if (request == StopRequest::kShutdown) {
+      stopped = WorkerOutcome{WorkerOutcome::Kind::kInterrupted, 0, "", {}};
+    } else if (absl::Now() >= run.deadline) {
+      stopped = failed(absl::StatusCode::kDeadlineExceeded,
+                       "the job ran over the server's job time limit and was stopped");
+    }
+  }
+  if (stopped) ::kill(pid, SIGKILL);
+  ::close(pipe_fds[0]);
+  int wait_status = 0;
+  while (waitpid(pid, &wait_status, 0) < 0 && errno == EINTR) {
+  }
+  if (stopped) return *stopped;
+  if (result) return *result;
+  return outcome_of_exit(wait_status);
+}
+
+}  // namespace labelmesh::server
