@@ -5,3 +5,4 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/build.sh dev
 build/dev/tests/labelmesh_bench "$@"
+bash scripts/bench-service.sh

@@ -10,11 +10,13 @@ packages=(
   libvtk9-dev libcgal-dev libeigen3-dev libtbb-dev libtet1.5-dev zlib1g-dev
   # service: schema, RPC, logging, metrics
   libgrpc++-dev libgrpc-dev protobuf-compiler protobuf-compiler-grpc libprotobuf-dev
-  libspdlog-dev libfmt-dev prometheus-cpp-dev
+  libspdlog-dev libfmt-dev prometheus-cpp-dev libssl-dev
   # command line and tests
   libcli11-dev libgtest-dev libgmock-dev
   # tests that prove our files with tools we did not write
-  python3 python3-numpy python3-nibabel python3-meshio python3-grpcio
+  python3 python3-numpy python3-nibabel python3-meshio python3-grpcio python3-protobuf
+  # service tests: TLS certificates
+  openssl
 )
 
 if [ "$(id -u)" -eq 0 ]; then sudo=(); else sudo=(sudo); fi

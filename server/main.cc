@@ -7,6 +7,7 @@
 
 #include "absl/time/time.h"
 #include "server/labelmesh_server.h"
+#include "spdlog/sinks/stdout_color_sinks.h"
 #include "spdlog/spdlog.h"
 
 namespace {
@@ -108,6 +109,8 @@ int main(int argc, char** argv) {
   pthread_sigmask(SIG_BLOCK, &signals, nullptr);
   signal(SIGPIPE, SIG_IGN);
 
+  // Logs go to stderr, as a service manager or container runtime expects.
+  spdlog::set_default_logger(spdlog::stderr_color_mt("labelmeshd"));
   ServerConfig config;
   CLI::App app{"labelmeshd " LABELMESH_VERSION
                ": the labelmesh gRPC meshing service. Every flag can also be set with the "

@@ -1,0 +1,125 @@
+#!/usr/bin/env bash
+# End to end through the real executables: labelmeshd on a free loopback port,
+# `labelmesh submit` of the liver compared with `labelmesh mesh` of the same
+# file and options, the job commands and their exit codes, TLS with a token,
+# and SIGTERM shutdown.
+# Usage: client_end_to_end_test.sh LABELMESHD LABELMESH SHARED_DATA
+set -euo pipefail
+labelmeshd=$1 labelmesh=$2 data=$3
+work=$(mktemp -d)
+server_pid=
+stop_server() {
+  if [ -n "$server_pid" ] && kill -0 "$server_pid" 2>/dev/null; then
+    kill -TERM "$server_pid"
+    wait "$server_pid" || { echo "FAIL: labelmeshd exited non-zero on SIGTERM"; exit 1; }
+  fi
+  server_pid=
+}
+trap 'stop_server; rm -rf "$work"' EXIT
+fail() { echo "FAIL: $*"; tail -20 "$work/server.log" 2>/dev/null; exit 1; }
+free_port() { /usr/bin/python3 -c 'import socket; s=socket.socket(); s.bind(("127.0.0.1",0)); print(s.getsockname()[1])'; }
+# Environment variables of the server and client are part of what is tested.
+unset LABELMESH_SERVER LABELMESH_TOKEN
+for v in $(env | grep -o '^LABELMESHD_[A-Z_]*' || true); do unset "$v"; done
+
+start_server() {  # extra flags...
+  "$labelmeshd" --spool-dir "$work/spool" --workers 2 "$@" 2>>"$work/server.log" &
+  server_pid=$!
+  for _ in $(seq 100); do
+    "$labelmesh" health "${client_flags[@]}" >/dev/null 2>&1 && return 0
+    kill -0 "$server_pid" 2>/dev/null || fail "labelmeshd exited at start"
+    sleep 0.1
+  done
+  fail "labelmeshd not serving after 10 s"
+}
+
+port=$(free_port)
+export LABELMESH_SERVER=127.0.0.1:$port
+client_flags=()
+start_server --listen "127.0.0.1:$port"
+
+# The liver through the server and in-process: the same report figures.
+"$labelmesh" submit "$data/liver.inr.gz" --labels 255 --out "$work/remote" --json \
+  >"$work/remote.json" || fail "submit of the liver exited $?"
+"$labelmesh" mesh "$data/liver.inr.gz" --labels 255 --out "$work/local" --json \
+  >"$work/local.json" || fail "local mesh of the liver exited $?"
+/usr/bin/python3 - "$work" <<'PY' || fail "remote and local reports differ"
+import json, os, sys
+work = sys.argv[1]
+def figures(path):
+    report = json.load(open(path))
+    return [(s["label"], s["stage"], s["nodes"], s["triangles"], round(s["volume_mm3"], 3))
+            for s in report["surfaces"]]
+remote, local = figures(f"{work}/remote.json"), figures(f"{work}/local.json")
+print("remote", remote)
+print("local ", local)
+# Marching Cubes and repair are exact. CGAL's Poisson on the liver gives one
+# of two surfaces (15,798 or 15,890 nodes) from one process to the next, in
+# and out of the server alike (an open issue-3 finding), so its figures are
+# compared within 1 %.
+assert remote[:2] == local[:2], "Marching Cubes or repaired surfaces differ"
+(r_label, r_stage, r_nodes, r_tris, r_vol), (l_label, l_stage, l_nodes, l_tris, l_vol) = remote[2], local[2]
+assert (r_label, r_stage) == (l_label, l_stage) == (255, "poisson")
+assert abs(r_nodes - l_nodes) <= 0.01 * l_nodes, "Poisson node counts differ by over 1 %"
+assert abs(r_vol - l_vol) <= 1e-3 * l_vol, "Poisson volumes differ by over 0.1 %"
+assert r_nodes > 5000, "too few output nodes"
+fetched = sorted(os.listdir(f"{work}/remote"))
+written = sorted(os.listdir(f"{work}/local"))
+assert fetched == written, (fetched, written)
+fetched_report = json.load(open(f"{work}/remote/report.json"))
+assert [s["nodes"] for s in fetched_report["surfaces"]] == [f[2] for f in remote]
+PY
+
+# --detach --json, status, watch, fetch, list.
+"$labelmesh" phantom torus --out "$work/torus.nii.gz" >/dev/null
+job=$("$labelmesh" submit "$work/torus.nii.gz" --surface repaired --detach --json |
+  /usr/bin/python3 -c 'import json,sys; print(json.load(sys.stdin)["job_id"])')
+[ ${#job} -eq 32 ] || fail "submit --detach --json gave no job id"
+"$labelmesh" watch "$job" >/dev/null 2>&1 || fail "watch of a good job exited $?"
+"$labelmesh" status "$job" --json | grep -q '"state": "JOB_STATE_SUCCEEDED"' || fail "status"
+"$labelmesh" fetch "$job" --out "$work/fetched" >/dev/null || fail "fetch exited $?"
+[ -s "$work/fetched/surface-label1.stl" ] || fail "fetch wrote no surface"
+"$labelmesh" list | grep -q "$job" || fail "list does not show the job"
+
+# Exit codes: unknown job 3, cancel of an ended job 4, a volume that fails 3.
+set +e
+"$labelmesh" status 00000000000000000000000000000000 >/dev/null 2>&1
+[ $? -eq 3 ] || fail "status of an unknown job should exit 3"
+"$labelmesh" cancel "$job" >/dev/null 2>&1
+[ $? -eq 4 ] || fail "cancel of an ended job should exit 4"
+head -c 5000 /dev/urandom >"$work/noise.nii"
+"$labelmesh" submit "$work/noise.nii" --out "$work/noise" >/dev/null 2>&1
+[ $? -eq 3 ] || fail "submit of a bad volume should exit 3"
+set -e
+grep -q "noise" "$work/server.log" && fail "the server log names an uploaded file"
+stop_server
+
+# TLS and a bearer token: refused without the token, served with it.
+openssl req -x509 -newkey rsa:2048 -nodes -days 1 -subj /CN=localhost \
+  -addext subjectAltName=DNS:localhost,IP:127.0.0.1 \
+  -keyout "$work/key.pem" -out "$work/cert.pem" 2>/dev/null
+echo "token-for-the-end-to-end-test" >"$work/token"
+port=$(free_port)
+export LABELMESH_SERVER=localhost:$port
+client_flags=(--tls-ca "$work/cert.pem" --token-file "$work/token")
+start_server --listen "127.0.0.1:$port" --tls-cert "$work/cert.pem" --tls-key "$work/key.pem" \
+  --auth-token-file "$work/token"
+set +e
+"$labelmesh" list --tls-ca "$work/cert.pem" >/dev/null 2>&1
+[ $? -eq 5 ] || fail "a call without the token should exit 5"
+"$labelmesh" list >/dev/null 2>&1
+[ $? -eq 5 ] || fail "a plaintext call to a TLS server should exit 5"
+set -e
+LABELMESH_TOKEN=token-for-the-end-to-end-test "$labelmesh" submit "$work/torus.nii.gz" \
+  --surface repaired --tls-ca "$work/cert.pem" --out "$work/tls" >/dev/null 2>&1 ||
+  fail "submit over TLS with the token exited $?"
+[ -s "$work/tls/report.json" ] || fail "no report over TLS"
+stop_server
+
+# Without TLS the server refuses a non-loopback address unless --insecure.
+set +e
+"$labelmeshd" --listen 0.0.0.0:$port --spool-dir "$work/spool2" 2>"$work/refusal.txt"
+code=$?
+set -e
+[ $code -eq 2 ] && grep -q "needs TLS" "$work/refusal.txt" || fail "plaintext 0.0.0.0 was not refused"
+echo PASSED

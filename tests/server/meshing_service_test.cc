@@ -1,0 +1,415 @@
+// The service's contract, in-process: every RPC, its status codes, and what
+// the spool holds afterwards. Jobs run in real labelmesh-worker processes.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <thread>
+
+#include "absl/strings/match.h"
+#include "core/volume/phantom.h"
+#include "core/volume/write_label_volume.h"
+#include "server/metrics.h"
+#include "support/service_harness.h"
+
+namespace labelmesh::testing {
+namespace {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+fs::path write_phantom(const fs::path& dir, volume::PhantomShape shape, double scale = 1.0) {
+  const fs::path path = dir / "phantom.nii.gz";
+  auto status =
+      volume::write_label_volume(volume::make_phantom(shape, scale).volume, path.string());
+  EXPECT_TRUE(status.ok()) << status;
+  return path;
+}
+
+// The liver's organ label (it also holds a few stray voxels of label 84).
+v1::MeshOptions liver_options() {
+  v1::MeshOptions options;
+  options.add_labels(255);
+  return options;
+}
+
+v1::MeshOptions repaired_options() {
+  v1::MeshOptions options;
+  options.set_surface(v1::SURFACE_METHOD_REPAIRED);
+  return options;
+}
+
+bool ended(const v1::JobEvent& event) {
+  return event.has_finished() || event.has_failed() || event.has_cancelled();
+}
+
+class MeshingServiceTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = scratch_dir(::testing::UnitTest::GetInstance()->current_test_info()->name());
+    spool_ = dir_ / "spool";
+    config_ = ServiceHarness::config_for(spool_);
+  }
+
+  size_t uploads_left() const { return count_files(spool_ / "uploads"); }
+  size_t job_dirs() const {
+    size_t count = 0;
+    for ([[maybe_unused]] const auto& entry : fs::directory_iterator(spool_ / "jobs")) ++count;
+    return count;
+  }
+
+  fs::path dir_, spool_;
+  server::ServerConfig config_;
+};
+
+TEST_F(MeshingServiceTest, WholeJobFromUploadToFetchedArtifacts) {
+  ServiceHarness service(config_);
+  v1::SubmitReply reply;
+  const fs::path input = write_phantom(dir_, volume::PhantomShape::kSphere);
+  ASSERT_TRUE(service.submit(input, v1::MeshOptions(), &reply).ok());
+  EXPECT_EQ(reply.job_id().size(), 32u);
+  EXPECT_EQ(reply.queue_position(), 0u);
+
+  const auto events = service.watch(reply.job_id());
+  ASSERT_FALSE(events.empty());
+  EXPECT_TRUE(events.front().has_queued());
+  ASSERT_TRUE(events.back().has_finished()) << events.back().DebugString();
+  int stages_finished = 0;
+  for (size_t i = 1; i < events.size(); ++i) {
+    EXPECT_GT(events[i].sequence(), events[i - 1].sequence());
+    if (events[i].has_stage_finished()) ++stages_finished;
+  }
+  EXPECT_GE(stages_finished, 5);  // read, marching cubes, components, repair, poisson, ...
+  const v1::Report& report = events.back().finished().report();
+  ASSERT_EQ(report.input().labels_size(), 1);
+  bool found_output = false;
+  for (const auto& surface : report.surfaces()) {
+    if (!surface.output()) continue;
+    found_output = true;
+    EXPECT_EQ(surface.stage(), "poisson");
+    EXPECT_TRUE(surface.closed());
+    EXPECT_GE(surface.min_angle_deg(), 29.9);
+  }
+  EXPECT_TRUE(found_output);
+
+  const v1::Job job = service.get(reply.job_id());
+  EXPECT_EQ(job.state(), v1::JOB_STATE_SUCCEEDED);
+  EXPECT_EQ(job.attempts(), 1u);
+  EXPECT_DOUBLE_EQ(job.progress(), 1.0);
+
+  auto ctx = service.context();
+  v1::ListArtifactsRequest list_request;
+  list_request.set_job_id(reply.job_id());
+  v1::ListArtifactsReply artifacts;
+  ASSERT_TRUE(service.stub().ListArtifacts(ctx.get(), list_request, &artifacts).ok());
+  std::vector<std::string> names;
+  for (const auto& artifact : artifacts.artifacts()) names.push_back(artifact.name());
+  EXPECT_EQ(names,
+            (std::vector<std::string>{"report.json", "surface-label1.stl", "surface-label1.vtp"}));
+  for (const auto& artifact : artifacts.artifacts()) {
+    auto fetch_ctx = service.context();
+    v1::FetchRequest request;
+    request.set_job_id(reply.job_id());
+    request.set_artifact(artifact.name());
+    auto reader = service.stub().Fetch(fetch_ctx.get(), request);
+    v1::FetchChunk chunk;
+    std::string bytes;
+    int chunks = 0;
+    while (reader->Read(&chunk)) {
+      if (chunks++ == 0) EXPECT_EQ(chunk.artifact().sha256(), artifact.sha256());
+      EXPECT_LE(chunk.data().size(), 1u << 20);
+      bytes += chunk.data();
+    }
+    ASSERT_TRUE(reader->Finish().ok());
+    EXPECT_EQ(bytes.size(), artifact.size_bytes());
+    EXPECT_EQ(digest::sha256_hex(bytes), artifact.sha256()) << artifact.name();
+  }
+  EXPECT_NE(service.server().metrics().text().find("labelmesh_jobs_total{outcome=\"succeeded\"} 1"),
+            std::string::npos);
+}
+
+TEST_F(MeshingServiceTest, FullQueueRefusesWithResourceExhausted) {
+  config_.workers = 0;  // Nothing starts: the queue only fills.
+  config_.queue_capacity = 2;
+  ServiceHarness service(config_);
+  const fs::path input = write_phantom(dir_, volume::PhantomShape::kSphere);
+  v1::SubmitReply reply;
+  ASSERT_TRUE(service.submit(input, repaired_options(), &reply).ok());
+  EXPECT_EQ(reply.queue_position(), 0u);
+  ASSERT_TRUE(service.submit(input, repaired_options(), &reply).ok());
+  EXPECT_EQ(reply.queue_position(), 1u);
+  const grpc::Status full = service.submit(input, repaired_options(), &reply);
+  EXPECT_EQ(full.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED) << full.error_message();
+  EXPECT_EQ(job_dirs(), 2u);
+  EXPECT_EQ(uploads_left(), 0u);
+  EXPECT_NE(
+      service.server().metrics().text().find("labelmesh_rejections_total{reason=\"queue_full\"} 1"),
+      std::string::npos);
+}
+
+TEST_F(MeshingServiceTest, BrokenUploadsAreRefusedAndLeaveNothing) {
+  config_.max_upload_bytes = 1 << 20;
+  ServiceHarness service(config_);
+  const std::string bytes = read_bytes(write_phantom(dir_, volume::PhantomShape::kSphere));
+  v1::JobSpec good;
+  good.set_file_name("scan.nii.gz");
+  good.set_size_bytes(bytes.size());
+  good.set_sha256(digest::sha256_hex(bytes));
+  v1::SubmitReply reply;
+  auto expect_invalid = [&](const v1::JobSpec& spec, const std::string& sent,
+                            const std::string& fragment) {
+    const grpc::Status status = service.submit_raw(spec, sent, &reply);
+    EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT) << fragment;
+    EXPECT_TRUE(absl::StrContains(status.error_message(), fragment)) << status.error_message();
+  };
+
+  v1::JobSpec wrong_digest = good;
+  wrong_digest.set_sha256(digest::sha256_hex("something else"));
+  expect_invalid(wrong_digest, bytes, "SHA-256");
+  expect_invalid(good, bytes.substr(0, bytes.size() / 2), "truncated");
+  v1::JobSpec too_small = good;
+  too_small.set_size_bytes(bytes.size() - 1);
+  expect_invalid(too_small, bytes, "more bytes than spec.size_bytes");
+  v1::JobSpec oversize = good;
+  oversize.set_size_bytes(2 << 20);
+  expect_invalid(oversize, bytes, "upload limit");
+  v1::JobSpec detached = good;
+  detached.set_file_name("scan.mhd");
+  expect_invalid(detached, bytes, "spec.file_name");
+  v1::JobSpec bad_option = good;
+  bad_option.mutable_options()->set_min_angle_deg(45);
+  expect_invalid(bad_option, bytes, "spec.options");
+  // Bytes that are not a NIfTI file: our header check names the file "upload".
+  const std::string garbage(4096, 'x');
+  v1::JobSpec not_nifti = good;
+  not_nifti.set_file_name("scan.nii");
+  not_nifti.set_size_bytes(garbage.size());
+  not_nifti.set_sha256(digest::sha256_hex(garbage));
+  expect_invalid(not_nifti, garbage, "upload");
+  // A chunk over 1 MiB.
+  const std::string big(1536 << 10, '\0');
+  v1::JobSpec big_spec = good;
+  big_spec.set_size_bytes(big.size());
+  big_spec.set_sha256(digest::sha256_hex(big));
+  config_.max_upload_bytes = 4 << 20;
+  EXPECT_EQ(service.submit_raw(big_spec, big, &reply, big.size()).error_code(),
+            grpc::StatusCode::INVALID_ARGUMENT);
+
+  EXPECT_EQ(uploads_left(), 0u);
+  EXPECT_EQ(job_dirs(), 0u);
+  // The refusals cost the server nothing: a good upload still goes through.
+  EXPECT_TRUE(service.submit_raw(good, bytes, &reply).ok());
+}
+
+TEST_F(MeshingServiceTest, CancelStopsARunningJobWithinASecond) {
+  ServiceHarness service(config_);
+  v1::SubmitReply reply;
+  ASSERT_TRUE(service.submit(shared_data("liver.inr.gz"), liver_options(), &reply).ok());
+  // Follow the job until a stage after reading starts, then cancel.
+  auto ctx = service.context();
+  v1::WatchRequest watch;
+  watch.set_job_id(reply.job_id());
+  auto reader = service.stub().Watch(ctx.get(), watch);
+  v1::JobEvent event;
+  Clock::time_point cancelled_at{};
+  std::vector<v1::JobEvent> events;
+  while (reader->Read(&event)) {
+    events.push_back(event);
+    if (event.has_stage_started() && event.stage_started().stage() == "repair" &&
+        cancelled_at == Clock::time_point{}) {
+      auto cancel_ctx = service.context();
+      v1::CancelRequest cancel;
+      cancel.set_job_id(reply.job_id());
+      v1::Job job;
+      ASSERT_TRUE(service.stub().Cancel(cancel_ctx.get(), cancel, &job).ok());
+      cancelled_at = Clock::now();
+    }
+  }
+  ASSERT_TRUE(reader->Finish().ok());
+  ASSERT_NE(cancelled_at, Clock::time_point{}) << "no repair stage seen";
+  EXPECT_TRUE(events.back().has_cancelled()) << events.back().DebugString();
+  EXPECT_LT(std::chrono::duration<double>(Clock::now() - cancelled_at).count(), 1.0);
+  const v1::Job job = service.get(reply.job_id());
+  EXPECT_EQ(job.state(), v1::JOB_STATE_CANCELLED);
+
+  auto again_ctx = service.context();
+  v1::CancelRequest cancel;
+  cancel.set_job_id(reply.job_id());
+  v1::Job ignored;
+  EXPECT_EQ(service.stub().Cancel(again_ctx.get(), cancel, &ignored).error_code(),
+            grpc::StatusCode::FAILED_PRECONDITION);
+  auto fetch_ctx = service.context();
+  v1::ListArtifactsRequest list;
+  list.set_job_id(reply.job_id());
+  v1::ListArtifactsReply artifacts;
+  EXPECT_EQ(service.stub().ListArtifacts(fetch_ctx.get(), list, &artifacts).error_code(),
+            grpc::StatusCode::FAILED_PRECONDITION);
+}
+
+TEST_F(MeshingServiceTest, JobOverTheDeadlineFailsWithDeadlineExceeded) {
+  config_.job_timeout = absl::Seconds(1);
+  ServiceHarness service(config_);
+  v1::SubmitReply reply;
+  ASSERT_TRUE(service.submit(shared_data("liver.inr.gz"), liver_options(), &reply).ok());
+  const auto events = service.watch(reply.job_id());
+  ASSERT_TRUE(events.back().has_failed()) << events.back().DebugString();
+  EXPECT_EQ(events.back().failed().code(), int(grpc::StatusCode::DEADLINE_EXCEEDED))
+      << events.back().failed().message();
+  const v1::Job job = service.get(reply.job_id());
+  EXPECT_EQ(job.state(), v1::JOB_STATE_FAILED);
+  EXPECT_LT(job.finished_at() - job.started_at(), 2.5);
+}
+
+TEST_F(MeshingServiceTest, TwoWatchersSeeTheSameEvents) {
+  config_.workers = 0;
+  ServiceHarness service(config_);
+  v1::SubmitReply reply;
+  ASSERT_TRUE(
+      service.submit(write_phantom(dir_, volume::PhantomShape::kTorus), repaired_options(), &reply)
+          .ok());
+  std::vector<v1::JobEvent> first, second;
+  std::thread a([&] { first = service.watch(reply.job_id()); });
+  std::thread b([&] { second = service.watch(reply.job_id()); });
+  // Both watchers are attached to a queued job; cancelling ends both streams.
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  auto ctx = service.context();
+  v1::CancelRequest cancel;
+  cancel.set_job_id(reply.job_id());
+  v1::Job job;
+  ASSERT_TRUE(service.stub().Cancel(ctx.get(), cancel, &job).ok());
+  EXPECT_EQ(job.state(), v1::JOB_STATE_CANCELLED);
+  a.join();
+  b.join();
+  ASSERT_EQ(first.size(), 2u);
+  ASSERT_EQ(second.size(), 2u);
+  for (size_t i = 0; i < first.size(); ++i) {
+    EXPECT_EQ(first[i].SerializeAsString(), second[i].SerializeAsString());
+  }
+  EXPECT_TRUE(first.back().has_cancelled());
+  // A late watcher replays the same history.
+  EXPECT_EQ(service.watch(reply.job_id()).size(), 2u);
+}
+
+TEST_F(MeshingServiceTest, QueuedJobRunsAfterARestart) {
+  std::string job_id;
+  {
+    config_.workers = 0;
+    ServiceHarness service(config_);
+    v1::SubmitReply reply;
+    ASSERT_TRUE(
+        service
+            .submit(write_phantom(dir_, volume::PhantomShape::kSphere), repaired_options(), &reply)
+            .ok());
+    job_id = reply.job_id();
+    service.shutdown();
+  }
+  config_.workers = 1;
+  ServiceHarness restarted(config_);
+  const auto events = restarted.watch(job_id);
+  ASSERT_FALSE(events.empty());
+  EXPECT_TRUE(events.back().has_finished()) << events.back().DebugString();
+  const v1::Job job = restarted.get(job_id);
+  EXPECT_EQ(job.state(), v1::JOB_STATE_SUCCEEDED);
+  EXPECT_EQ(job.attempts(), 1u);
+  // Its results outlive another restart, and the replay is the final state.
+  restarted.shutdown();
+  ServiceHarness again(config_);
+  const auto replay = again.watch(job_id);
+  ASSERT_EQ(replay.size(), 1u);
+  EXPECT_TRUE(replay.front().has_finished());
+}
+
+TEST_F(MeshingServiceTest, ExpiredResultsAreDeletedAtStart) {
+  std::string job_id;
+  config_.result_ttl = absl::Seconds(1);
+  {
+    ServiceHarness service(config_);
+    v1::SubmitReply reply;
+    ASSERT_TRUE(
+        service
+            .submit(write_phantom(dir_, volume::PhantomShape::kSphere), repaired_options(), &reply)
+            .ok());
+    job_id = reply.job_id();
+    EXPECT_TRUE(service.watch(job_id).back().has_finished());
+    service.shutdown();
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(1200));
+  ServiceHarness restarted(config_);
+  grpc::Status status;
+  restarted.get(job_id, &status);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::NOT_FOUND);
+  EXPECT_EQ(job_dirs(), 0u);
+}
+
+TEST_F(MeshingServiceTest, CallsWithoutTheTokenAreUnauthenticated) {
+  const fs::path token_file = dir_ / "token";
+  write_file(token_file, "s3cret-token-0123456789\n");
+  config_.auth_token_file = token_file.string();
+  ServiceHarness service(config_);
+  v1::ListJobsReply jobs;
+  {
+    auto ctx = service.context();
+    EXPECT_EQ(service.stub().ListJobs(ctx.get(), {}, &jobs).error_code(),
+              grpc::StatusCode::UNAUTHENTICATED);
+  }
+  service.token = "s3cret-token-0123456788";
+  {
+    auto ctx = service.context();
+    EXPECT_EQ(service.stub().ListJobs(ctx.get(), {}, &jobs).error_code(),
+              grpc::StatusCode::UNAUTHENTICATED);
+  }
+  v1::SubmitReply reply;
+  EXPECT_EQ(
+      service.submit(write_phantom(dir_, volume::PhantomShape::kSphere), repaired_options(), &reply)
+          .error_code(),
+      grpc::StatusCode::UNAUTHENTICATED);
+  EXPECT_EQ(job_dirs(), 0u);
+  service.token = "s3cret-token-0123456789";
+  auto ctx = service.context();
+  EXPECT_TRUE(service.stub().ListJobs(ctx.get(), {}, &jobs).ok());
+}
+
+TEST_F(MeshingServiceTest, UnknownJobsAndArtifactsAreNotFound) {
+  ServiceHarness service(config_);
+  grpc::Status status;
+  service.get(std::string(32, '0'), &status);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::NOT_FOUND);
+  service.get("../../etc", &status);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::NOT_FOUND);
+  v1::SubmitReply reply;
+  ASSERT_TRUE(
+      service.submit(write_phantom(dir_, volume::PhantomShape::kSphere), repaired_options(), &reply)
+          .ok());
+  ASSERT_TRUE(service.watch(reply.job_id()).back().has_finished());
+  for (const std::string name : {"../job.pb", "job.pb", "/etc/passwd", "missing.stl"}) {
+    auto ctx = service.context();
+    v1::FetchRequest request;
+    request.set_job_id(reply.job_id());
+    request.set_artifact(name);
+    auto reader = service.stub().Fetch(ctx.get(), request);
+    v1::FetchChunk chunk;
+    EXPECT_FALSE(reader->Read(&chunk)) << name;
+    EXPECT_EQ(reader->Finish().error_code(), grpc::StatusCode::NOT_FOUND) << name;
+  }
+}
+
+TEST_F(MeshingServiceTest, CrashedWorkerFailsOnlyItsJob) {
+  const fs::path crashing = dir_ / "crashing-worker.sh";
+  write_file(crashing, "#!/bin/sh\nkill -SEGV $$\n");
+  fs::permissions(crashing, fs::perms::owner_all);
+  config_.worker_executable = crashing.string();
+  ServiceHarness service(config_);
+  v1::SubmitReply reply;
+  const fs::path input = write_phantom(dir_, volume::PhantomShape::kSphere);
+  ASSERT_TRUE(service.submit(input, repaired_options(), &reply).ok());
+  const auto events = service.watch(reply.job_id());
+  ASSERT_TRUE(events.back().has_failed());
+  EXPECT_EQ(events.back().failed().code(), int(grpc::StatusCode::INTERNAL));
+  EXPECT_TRUE(absl::StrContains(events.back().failed().message(), "SIGSEGV"))
+      << events.back().failed().message();
+  // The server is still there and takes the next job.
+  ASSERT_TRUE(service.submit(input, repaired_options(), &reply).ok());
+  EXPECT_TRUE(service.watch(reply.job_id()).back().has_failed());
+}
+
+}  // namespace
+}  // namespace labelmesh::testing
