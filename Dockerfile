@@ -1,5 +1,6 @@
 # labelmesh in a container: Debian 12 with the packages from the same
-# scripts/install-deps.sh that README.md and CI use.
+# scripts/install-deps.sh that README.md and CI use. The image holds the
+# labelmesh client and the labelmeshd service (with its labelmesh-worker).
 FROM debian:12
 
 WORKDIR /opt/labelmesh
@@ -8,11 +9,14 @@ RUN bash scripts/install-deps.sh && rm -rf /var/lib/apt/lists/*
 
 COPY . .
 RUN bash scripts/build.sh release \
- && install -m 0755 build/release/client/labelmesh /usr/local/bin/labelmesh
+ && install -m 0755 build/release/client/labelmesh build/release/server/labelmeshd \
+      build/release/server/labelmesh-worker /usr/local/bin/
 
-# Run as an unprivileged user; mount volumes under /data.
-RUN useradd --system --create-home labelmesh && mkdir -p /data && chown labelmesh /data
+# Run as an unprivileged user; volumes and the spool live under /data.
+RUN useradd --system --create-home labelmesh && mkdir -p /data/spool && chown -R labelmesh /data
 USER labelmesh
 WORKDIR /data
-ENTRYPOINT ["labelmesh"]
-CMD ["--help"]
+ENV LABELMESHD_SPOOL_DIR=/data/spool
+EXPOSE 50051 9464
+# The service by default; `docker run IMAGE labelmesh mesh ...` runs the CLI.
+CMD ["labelmeshd"]

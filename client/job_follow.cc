@@ -8,6 +8,7 @@
 #include "client/exit_codes.h"
 #include "client/terminal_progress.h"
 #include "core/report.h"
+#include "google/protobuf/util/json_util.h"
 #include "labelmesh/v1/service.grpc.pb.h"
 #include "server/sha256.h"
 
@@ -27,7 +28,12 @@ class EventPrinter {
 
   void print(const v1::JobEvent& event) {
     if (json_) {
-      std::printf("%s\n", to_json(event).c_str());
+      // One object per line (JSON Lines), so a pipe can read events as they come.
+      std::string line;
+      google::protobuf::util::JsonPrintOptions options;
+      options.preserve_proto_field_names = true;
+      (void)google::protobuf::util::MessageToJsonString(event, &line, options);
+      std::printf("%s\n", line.c_str());
       std::fflush(stdout);
       return;
     }

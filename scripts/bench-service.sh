@@ -52,8 +52,8 @@ best_us() {
 }
 
 # watch_times JOB: "queued started end" in unix seconds, from the job's events.
-# watch --json prints pretty-printed objects back to back, so decode them in
-# turn; a job that did not finish, or events out of order, fail the run.
+# watch --json prints one object per line (decoded in turn either way); a job
+# that did not finish, or events out of order, fail the run.
 watch_times() {
   "$CLI" watch "$1" --server "$ADDR" --json | $PY -c '
 import json, sys

@@ -18,20 +18,25 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 // Turns the pipeline's progress callbacks into stage and progress events.
+// Some stages report only when they are done (fraction 1), so a stage is
+// taken to start when the one before it last reported, not at its own first
+// report.
 class StageEvents {
  public:
-  explicit StageEvents(int fd) : fd_(fd) {}
+  explicit StageEvents(int fd) : fd_(fd), last_report_(Clock::now()) {}
 
   void update(std::string_view stage, double fraction) {
+    const Clock::time_point now = Clock::now();
     if (stage != stage_) {
       finish_stage();
       stage_ = std::string(stage);
-      stage_start_ = Clock::now();
+      stage_start_ = last_report_;
       percent_ = -1;
       v1::JobEvent event;
       event.mutable_stage_started()->set_stage(stage_);
       write_event(fd_, event);
     }
+    last_report_ = now;
     const int percent = static_cast<int>(fraction * 100);
     if (percent == percent_) return;
     percent_ = percent;
@@ -46,7 +51,7 @@ class StageEvents {
     v1::JobEvent event;
     event.mutable_stage_finished()->set_stage(stage_);
     event.mutable_stage_finished()->set_seconds(
-        std::chrono::duration<double>(Clock::now() - stage_start_).count());
+        std::chrono::duration<double>(last_report_ - stage_start_).count());
     write_event(fd_, event);
     stage_.clear();
   }
@@ -56,6 +61,7 @@ class StageEvents {
   std::string stage_;
   int percent_ = -1;
   Clock::time_point stage_start_;
+  Clock::time_point last_report_;
 };
 
 void send_failure(int fd, const absl::Status& status, const std::string& job_dir) {
