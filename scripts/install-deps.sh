@@ -10,7 +10,7 @@ packages=(
   libvtk9-dev libcgal-dev libeigen3-dev libtbb-dev libtet1.5-dev zlib1g-dev
   # service: schema, RPC, logging, metrics
   libgrpc++-dev libgrpc-dev protobuf-compiler protobuf-compiler-grpc libprotobuf-dev
-  libspdlog-dev libfmt-dev prometheus-cpp-dev libssl-dev
+  libspdlog-dev libfmt-dev prometheus-cpp-dev libcivetweb-dev libssl-dev
   # command line and tests
   libcli11-dev libgtest-dev libgmock-dev
   # tests that prove our files with tools we did not write
