@@ -116,6 +116,25 @@ LABELMESH_TOKEN=token-for-the-end-to-end-test "$labelmesh" submit "$work/torus.n
 [ -s "$work/tls/report.json" ] || fail "no report over TLS"
 stop_server
 
+# Mutual TLS: a client certificate signed by --client-ca is required.
+openssl req -x509 -newkey rsa:2048 -nodes -days 1 -subj /CN=test-ca \
+  -keyout "$work/ca-key.pem" -out "$work/ca.pem" 2>/dev/null
+openssl req -newkey rsa:2048 -nodes -subj /CN=client -keyout "$work/client-key.pem" \
+  -out "$work/client.csr" 2>/dev/null
+openssl x509 -req -in "$work/client.csr" -CA "$work/ca.pem" -CAkey "$work/ca-key.pem" \
+  -CAcreateserial -days 1 -out "$work/client.pem" 2>/dev/null
+port=$(free_port)
+export LABELMESH_SERVER=localhost:$port
+client_flags=(--tls-ca "$work/cert.pem" --tls-cert "$work/client.pem" --tls-key "$work/client-key.pem")
+start_server --listen "127.0.0.1:$port" --tls-cert "$work/cert.pem" --tls-key "$work/key.pem" \
+  --client-ca "$work/ca.pem"
+set +e
+"$labelmesh" health --tls-ca "$work/cert.pem" >/dev/null 2>&1
+[ $? -eq 5 ] || fail "a client without a certificate should be refused (exit 5)"
+set -e
+"$labelmesh" list "${client_flags[@]}" >/dev/null || fail "a client with its certificate exited $?"
+stop_server
+
 # Without TLS the server refuses a non-loopback address unless --insecure.
 set +e
 "$labelmeshd" --listen 0.0.0.0:$port --spool-dir "$work/spool2" 2>"$work/refusal.txt"
