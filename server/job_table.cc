@@ -242,17 +242,21 @@ void JobTable::fail(const std::string& job_id, int code, const std::string& mess
   spdlog::warn("job {} failed with status code {}", job_id, code);
 }
 
-void JobTable::mark_cancelled(const std::string& job_id) {
-  std::lock_guard lock(mutex_);
-  Entry* entry = find(job_id);
-  if (entry == nullptr || has_ended(entry->record.job().state())) return;
-  v1::JobError& error = *entry->record.mutable_job()->mutable_error();
+void JobTable::end_cancelled(Entry& entry) {
+  v1::JobError& error = *entry.record.mutable_job()->mutable_error();
   error.set_code(static_cast<int>(absl::StatusCode::kCancelled));
   error.set_message("cancelled by a client");
   v1::JobEvent event;
   event.mutable_cancelled();
-  end_job(*entry, v1::JOB_STATE_CANCELLED, std::move(event));
-  spdlog::info("job {} cancelled", job_id);
+  end_job(entry, v1::JOB_STATE_CANCELLED, std::move(event));
+  spdlog::info("job {} cancelled", entry.record.job().job_id());
+}
+
+void JobTable::mark_cancelled(const std::string& job_id) {
+  std::lock_guard lock(mutex_);
+  Entry* entry = find(job_id);
+  if (entry == nullptr || has_ended(entry->record.job().state())) return;
+  end_cancelled(*entry);
 }
 
 void JobTable::requeue_interrupted(const std::string& job_id) {
@@ -290,23 +294,21 @@ std::vector<v1::Job> JobTable::list() const {
 }
 
 absl::StatusOr<v1::Job> JobTable::cancel(const std::string& job_id) {
-  {
-    std::lock_guard lock(mutex_);
-    Entry* entry = find(job_id);
-    if (entry == nullptr) return absl::NotFoundError(absl::StrCat("no job ", job_id));
-    const v1::JobState state = entry->record.job().state();
-    if (has_ended(state)) {
-      return absl::FailedPreconditionError(
-          absl::StrCat("job ", job_id, " already ended (", v1::JobState_Name(state), ")"));
-    }
-    if (state == v1::JOB_STATE_RUNNING) {
-      entry->cancel_requested = true;
-      return entry->record.job();
-    }
-    queue_.erase(std::find(queue_.begin(), queue_.end(), job_id));
+  std::lock_guard lock(mutex_);
+  Entry* entry = find(job_id);
+  if (entry == nullptr) return absl::NotFoundError(absl::StrCat("no job ", job_id));
+  const v1::JobState state = entry->record.job().state();
+  if (has_ended(state)) {
+    return absl::FailedPreconditionError(
+        absl::StrCat("job ", job_id, " already ended (", v1::JobState_Name(state), ")"));
   }
-  mark_cancelled(job_id);
-  return get(job_id);
+  if (state == v1::JOB_STATE_RUNNING) {
+    entry->cancel_requested = true;
+  } else {
+    queue_.erase(std::find(queue_.begin(), queue_.end(), job_id));
+    end_cancelled(*entry);
+  }
+  return entry->record.job();
 }
 
 bool JobTable::cancel_requested(const std::string& job_id) const {

@@ -86,6 +86,7 @@ class JobTable {
   void add_event(Entry& entry, v1::JobEvent event);
   void persist(const Entry& entry);
   void end_job(Entry& entry, v1::JobState state, v1::JobEvent event);
+  void end_cancelled(Entry& entry);
   uint32_t position_of(const std::string& job_id) const;
   void update_gauges();
 

@@ -87,25 +87,21 @@ void add_server_flags(CLI::App& app, ServerConfig& c) {
       "LABELMESHD_INSECURE");
 }
 
-// SIGTERM and SIGINT are taken by one thread with sigwait, never by a handler.
-int wait_for_stop_signal() {
+// SIGTERM and SIGINT: blocked in every thread, then taken with sigwait by the
+// main thread, never by a handler.
+sigset_t stop_signals() {
   sigset_t signals;
   sigemptyset(&signals);
   sigaddset(&signals, SIGTERM);
   sigaddset(&signals, SIGINT);
-  int number = 0;
-  sigwait(&signals, &number);
-  return number;
+  return signals;
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
   // Blocked before any thread starts, so every thread inherits the mask.
-  sigset_t signals;
-  sigemptyset(&signals);
-  sigaddset(&signals, SIGTERM);
-  sigaddset(&signals, SIGINT);
+  const sigset_t signals = stop_signals();
   pthread_sigmask(SIG_BLOCK, &signals, nullptr);
   signal(SIGPIPE, SIG_IGN);
 
@@ -123,7 +119,8 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "labelmeshd: %s\n", std::string(server.status().message()).c_str());
     return 2;
   }
-  const int number = wait_for_stop_signal();
+  int number = 0;
+  sigwait(&signals, &number);
   spdlog::info("received {}", number == SIGTERM ? "SIGTERM" : "SIGINT");
   (*server)->shutdown();
   return 0;

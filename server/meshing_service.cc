@@ -85,16 +85,23 @@ grpc::Status MeshingService::receive_upload(grpc::ServerReader<v1::SubmitRequest
                                             const v1::JobSpec& spec, const std::string& path) {
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
   if (!out) return grpc::Status(grpc::StatusCode::INTERNAL, "spool: cannot store the upload");
+  // Each refusal is counted here, by its reason, and only here.
+  auto refuse = [this](const char* reason, const std::string& message) {
+    metrics_.rejected(reason);
+    return invalid(message);
+  };
   digest::Sha256 hash;
   uint64_t received = 0;
   v1::SubmitRequest message;
   while (reader.Read(&message)) {
-    if (!message.has_chunk()) return invalid("after the spec, every message must be a chunk");
+    if (!message.has_chunk()) {
+      return refuse("bad_request", "after the spec, every message must be a chunk");
+    }
     const std::string& chunk = message.chunk();
-    if (chunk.size() > kChunkBytes) return invalid("chunk: over 1 MiB");
+    if (chunk.size() > kChunkBytes) return refuse("bad_request", "chunk: over 1 MiB");
     if (received + chunk.size() > spec.size_bytes()) {
-      return invalid(
-          absl::StrCat("upload: more bytes than spec.size_bytes (", spec.size_bytes(), ")"));
+      return refuse("bad_request", absl::StrCat("upload: more bytes than spec.size_bytes (",
+                                                spec.size_bytes(), ")"));
     }
     out.write(chunk.data(), static_cast<std::streamsize>(chunk.size()));
     hash.update(chunk);
@@ -103,12 +110,11 @@ grpc::Status MeshingService::receive_upload(grpc::ServerReader<v1::SubmitRequest
   out.flush();
   if (!out) return grpc::Status(grpc::StatusCode::INTERNAL, "spool: cannot write the upload");
   if (received < spec.size_bytes()) {
-    return invalid(absl::StrCat("upload: truncated, ", received, " of ", spec.size_bytes(),
-                                " bytes received"));
+    return refuse("bad_request", absl::StrCat("upload: truncated, ", received, " of ",
+                                              spec.size_bytes(), " bytes received"));
   }
   if (hash.hex_digest() != spec.sha256()) {
-    metrics_.rejected("bad_digest");
-    return invalid("upload: SHA-256 of the bytes received does not match spec.sha256");
+    return refuse("bad_digest", "upload: SHA-256 of the bytes received does not match spec.sha256");
   }
   metrics_.upload_bytes(received);
   return grpc::Status::OK;
@@ -153,13 +159,7 @@ grpc::Status MeshingService::Submit(grpc::ServerContext* context,
   const std::string job_id = new_job_id();
   const std::string extension = *upload_extension(spec.file_name());
   UploadFile upload(spool_.upload_path(job_id, extension));
-  if (auto status = receive_upload(*reader, spec, upload.path()); !status.ok()) {
-    if (status.error_code() == grpc::StatusCode::INVALID_ARGUMENT &&
-        !absl::StrContains(status.error_message(), "SHA-256")) {
-      metrics_.rejected("bad_request");
-    }
-    return status;
-  }
+  if (auto status = receive_upload(*reader, spec, upload.path()); !status.ok()) return status;
   if (auto status = check_uploaded_volume(upload.path(), voxel_limit); !status.ok()) {
     metrics_.rejected("bad_volume");
     return to_grpc(status);

@@ -60,8 +60,8 @@ absl::StatusOr<std::string> sha256_file(const std::string& path) {
   return hash.hex_digest();
 }
 
-bool is_sha256_hex(std::string_view text) {
-  if (text.size() != 64) return false;
+bool is_lower_hex(std::string_view text, size_t digits) {
+  if (text.size() != digits) return false;
   for (char c : text) {
     if (!((c >= '0' && c <= '9') || (c >= 'a' && c <= 'f'))) return false;
   }

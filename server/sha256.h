@@ -31,8 +31,11 @@ std::string sha256_hex(std::string_view bytes);
 // Errors: NOT_FOUND / INTERNAL naming the file.
 absl::StatusOr<std::string> sha256_file(const std::string& path);
 
+// True for exactly `digits` lowercase hex digits.
+bool is_lower_hex(std::string_view text, size_t digits);
+
 // True for 64 lowercase hex digits.
-bool is_sha256_hex(std::string_view text);
+inline bool is_sha256_hex(std::string_view text) { return is_lower_hex(text, 64); }
 
 // Equal contents, compared in time that does not depend on where they differ
 // or on their lengths (both are hashed first): for secrets such as tokens.

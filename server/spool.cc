@@ -155,10 +155,6 @@ std::string new_job_id() {
   return id;
 }
 
-bool is_job_id(std::string_view text) {
-  return text.size() == 32 && std::all_of(text.begin(), text.end(), [](char c) {
-           return (c >= '0' && c <= '9') || (c >= 'a' && c <= 'f');
-         });
-}
+bool is_job_id(std::string_view text) { return digest::is_lower_hex(text, 32); }
 
 }  // namespace labelmesh::server

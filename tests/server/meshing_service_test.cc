@@ -50,6 +50,12 @@ class MeshingServiceTest : public ::testing::Test {
     config_ = ServiceHarness::config_for(spool_);
   }
 
+  // The quick job most tests need: the sphere phantom, repaired surface.
+  grpc::Status submit_sphere(ServiceHarness& service, v1::SubmitReply* reply) {
+    return service.submit(write_phantom(dir_, volume::PhantomShape::kSphere), repaired_options(),
+                          reply);
+  }
+
   size_t uploads_left() const { return count_files(spool_ / "uploads"); }
   size_t job_dirs() const {
     size_t count = 0;
@@ -295,10 +301,7 @@ TEST_F(MeshingServiceTest, QueuedJobRunsAfterARestart) {
     config_.workers = 0;
     ServiceHarness service(config_);
     v1::SubmitReply reply;
-    ASSERT_TRUE(
-        service
-            .submit(write_phantom(dir_, volume::PhantomShape::kSphere), repaired_options(), &reply)
-            .ok());
+    ASSERT_TRUE(submit_sphere(service, &reply).ok());
     job_id = reply.job_id();
     service.shutdown();
   }
@@ -324,10 +327,7 @@ TEST_F(MeshingServiceTest, ExpiredResultsAreDeletedAtStart) {
   {
     ServiceHarness service(config_);
     v1::SubmitReply reply;
-    ASSERT_TRUE(
-        service
-            .submit(write_phantom(dir_, volume::PhantomShape::kSphere), repaired_options(), &reply)
-            .ok());
+    ASSERT_TRUE(submit_sphere(service, &reply).ok());
     job_id = reply.job_id();
     EXPECT_TRUE(service.watch(job_id).back().has_finished());
     service.shutdown();
@@ -358,10 +358,7 @@ TEST_F(MeshingServiceTest, CallsWithoutTheTokenAreUnauthenticated) {
               grpc::StatusCode::UNAUTHENTICATED);
   }
   v1::SubmitReply reply;
-  EXPECT_EQ(
-      service.submit(write_phantom(dir_, volume::PhantomShape::kSphere), repaired_options(), &reply)
-          .error_code(),
-      grpc::StatusCode::UNAUTHENTICATED);
+  EXPECT_EQ(submit_sphere(service, &reply).error_code(), grpc::StatusCode::UNAUTHENTICATED);
   EXPECT_EQ(job_dirs(), 0u);
   service.token = "s3cret-token-0123456789";
   auto ctx = service.context();
@@ -376,9 +373,7 @@ TEST_F(MeshingServiceTest, UnknownJobsAndArtifactsAreNotFound) {
   service.get("../../etc", &status);
   EXPECT_EQ(status.error_code(), grpc::StatusCode::NOT_FOUND);
   v1::SubmitReply reply;
-  ASSERT_TRUE(
-      service.submit(write_phantom(dir_, volume::PhantomShape::kSphere), repaired_options(), &reply)
-          .ok());
+  ASSERT_TRUE(submit_sphere(service, &reply).ok());
   ASSERT_TRUE(service.watch(reply.job_id()).back().has_finished());
   for (const std::string name : {"../job.pb", "job.pb", "/etc/passwd", "missing.stl"}) {
     auto ctx = service.context();
