@@ -74,6 +74,16 @@ void add_pipeline_flags(CLI::App& command, PipelineFlags& flags) {
       .add_option("--tet-max-volume", tetgen.max_volume_mm3,
                   "Tet: largest tetrahedron volume, mm^3 (TetGen -a); 0 for no bound")
       ->capture_default_str();
+  command
+      .add_option("--tet-max-dihedral", tetgen.max_dihedral_deg,
+                  "Tet: TetGen's own optimisation (-o/) works on tetrahedra with a dihedral angle "
+                  "above this, degrees in [90, 179]")
+      ->capture_default_str();
+  command
+      .add_option("--tet-improve-quality", flags.improve.target_quality,
+                  "Tet: the improvement pass after TetGen (flips, smoothing of interior points) "
+                  "works on tetrahedra with quality Q below this; 0 turns it off")
+      ->capture_default_str();
   command.add_flag("--tet-split-boundary", flags.tet_split_boundary,
                    "Tet: let TetGen add points on the surface (by default it keeps the surface "
                    "triangles, -Y)");
@@ -116,6 +126,8 @@ v1::MeshOptions to_mesh_options(const PipelineFlags& flags) {
     proto.set_tet_min_dihedral_deg(flags.tetgen.min_dihedral_deg);
     proto.set_tet_max_volume_mm3(flags.tetgen.max_volume_mm3);
     proto.set_tet_keep_boundary(!flags.tet_split_boundary);
+    proto.set_tet_max_dihedral_deg(flags.tetgen.max_dihedral_deg);
+    proto.set_tet_improve_quality(flags.improve.target_quality);
   }
   for (const auto& format : flags.formats) proto.add_formats(format);
   proto.set_max_voxels(flags.max_voxels);

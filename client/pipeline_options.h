@@ -23,6 +23,7 @@ struct PipelineFlags {
   bool keep_strands = false;
   std::string volume = "none";
   volume_mesh::TetgenParams tetgen;
+  volume_mesh::ImproveParams improve;
   bool tet_split_boundary = false;
   std::vector<std::string> formats{"stl", "vtp"};
   uint64_t max_voxels = volume::ReadLimits{}.max_voxels;

@@ -10,6 +10,7 @@
 #include "core/surface/vertex_normals.h"
 #include "core/surface/write_surface.h"
 #include "core/volume/volume_header.h"
+#include "core/volume_mesh/improve_tet_mesh.h"
 #include "core/volume_mesh/tetrahedralize.h"
 #include "core/volume_mesh/write_volume_mesh.h"
 
@@ -64,6 +65,7 @@ struct MeshParams {
                                               surface::SurfaceFormat::kVtp};
   VolumeMethod volume = VolumeMethod::kNone;
   volume_mesh::TetgenParams tetgen;
+  volume_mesh::ImproveParams improve;
   // Volume mesh files (when `volume` is not kNone).
   std::vector<volume_mesh::VolumeFormat> volume_formats{volume_mesh::VolumeFormat::kVtu};
   // Size limits applied to the input before anything is allocated.

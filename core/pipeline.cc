@@ -112,6 +112,13 @@ absl::StatusOr<MeshResult> run_pipeline(const std::string& path, const MeshParam
       tets = tetrahedralize_labels(boundaries, params.tetgen, context);
     }
     if (!tets.ok()) return tets.status();
+    {
+      StageTimer timer(result.stages, "tet_improve");
+      context.report("tet_improve", 0);
+      volume_mesh::ImproveParams improve = params.improve;
+      improve.max_volume_mm3 = params.tetgen.max_volume_mm3;
+      if (auto s = improve_volume(*tets, improve, context); !s.ok()) return s;
+    }
     result.volume = std::move(*tets);
   }
   return result;

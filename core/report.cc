@@ -124,6 +124,9 @@ absl::Status read_volume_options(const v1::MeshOptions& options, MeshParams& par
   if (options.has_tet_min_dihedral_deg()) tetgen.min_dihedral_deg = options.tet_min_dihedral_deg();
   if (options.has_tet_max_volume_mm3()) tetgen.max_volume_mm3 = options.tet_max_volume_mm3();
   if (options.has_tet_keep_boundary()) tetgen.keep_boundary = options.tet_keep_boundary();
+  if (options.has_tet_max_dihedral_deg()) tetgen.max_dihedral_deg = options.tet_max_dihedral_deg();
+  if (options.has_tet_improve_quality())
+    params.improve.target_quality = options.tet_improve_quality();
   if (params.volume == VolumeMethod::kNone) return absl::OkStatus();
   // The ranges are TetGen's, as tetrahedralize() checks them; a job should be
   // refused here, before any surface work is done.
@@ -133,6 +136,12 @@ absl::Status read_volume_options(const v1::MeshOptions& options, MeshParams& par
   if (!(tetgen.min_dihedral_deg >= 0 && tetgen.min_dihedral_deg <= 30))
     return absl::InvalidArgumentError(
         cat("tet_min_dihedral_deg: ", tetgen.min_dihedral_deg, " is outside [0, 30]"));
+  if (!(tetgen.max_dihedral_deg >= 90 && tetgen.max_dihedral_deg <= 179))
+    return absl::InvalidArgumentError(
+        cat("tet_max_dihedral_deg: ", tetgen.max_dihedral_deg, " is outside [90, 179]"));
+  if (!(params.improve.target_quality >= 0 && params.improve.target_quality < 1))
+    return absl::InvalidArgumentError(
+        cat("tet_improve_quality: ", params.improve.target_quality, " is outside [0, 1)"));
   if (!(tetgen.max_volume_mm3 == 0 ||
         (tetgen.max_volume_mm3 >= 1e-6 && tetgen.max_volume_mm3 <= 1e12)))
     return absl::InvalidArgumentError(
@@ -160,6 +169,18 @@ v1::VolumeMeshSummary make_volume_summary(const VolumeResult& volume) {
   categories->set_good(q.good);
   entry.set_conforming(false);
   entry.set_seconds(volume.seconds);
+  if (volume.improvement) {
+    const auto& before = volume.improvement->tetgen_summary;
+    const auto& figures = volume.improvement->figures;
+    auto* improvement = entry.mutable_improvement();
+    improvement->set_tetgen_quality_min(before.count > 0 ? before.min : 0);
+    improvement->set_tetgen_questionable(before.invalid + before.very_bad + before.questionable);
+    improvement->set_flips_2_3(figures.flips_2_3);
+    improvement->set_flips_3_2(figures.flips_3_2);
+    improvement->set_vertices_moved(figures.vertices_moved);
+    improvement->set_vertices_inserted(figures.vertices_inserted);
+    improvement->set_seconds(figures.seconds);
+  }
   for (const auto& file : volume.files) entry.add_files(file);
   return entry;
 }
@@ -255,6 +276,8 @@ v1::MeshOptions make_options(const MeshParams& params) {
   options.set_tet_min_dihedral_deg(params.tetgen.min_dihedral_deg);
   options.set_tet_max_volume_mm3(params.tetgen.max_volume_mm3);
   options.set_tet_keep_boundary(params.tetgen.keep_boundary);
+  options.set_tet_max_dihedral_deg(params.tetgen.max_dihedral_deg);
+  options.set_tet_improve_quality(params.improve.target_quality);
   options.set_max_voxels(params.limits.max_voxels);
   return options;
 }

@@ -13,6 +13,19 @@ quality::Tet corners(const volume_mesh::TetMesh& mesh, size_t t) {
   return {mesh.points[tet[0]], mesh.points[tet[1]], mesh.points[tet[2]], mesh.points[tet[3]]};
 }
 
+void measure(VolumeResult& result) {
+  result.quality.clear();
+  result.summary = {};
+  result.quality.reserve(result.mesh.tetrahedra.size());
+  for (size_t t = 0; t < result.mesh.tetrahedra.size(); ++t) {
+    const quality::Tet tet = corners(result.mesh, t);
+    const double q = quality::tetra_quality(tet);
+    result.quality.push_back(q);
+    result.summary.add(q);
+    result.summary.add_dihedral_range(quality::tetra_dihedral_range_deg(tet));
+  }
+}
+
 absl::StatusOr<VolumeResult> measure_and_join(const std::vector<LabelBoundary>& boundaries,
                                               const volume_mesh::TetgenParams& params,
                                               const RunContext& context) {
@@ -36,14 +49,7 @@ absl::StatusOr<VolumeResult> measure_and_join(const std::vector<LabelBoundary>& 
     result.steiner_points += figures.steiner_points;
     result.mesh.append(*tets);
   }
-  result.quality.reserve(result.mesh.tetrahedra.size());
-  for (size_t t = 0; t < result.mesh.tetrahedra.size(); ++t) {
-    const quality::Tet tet = corners(result.mesh, t);
-    const double q = quality::tetra_quality(tet);
-    result.quality.push_back(q);
-    result.summary.add(q);
-    result.summary.add_dihedral_range(quality::tetra_dihedral_range_deg(tet));
-  }
+  measure(result);
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;
 }
@@ -59,6 +65,24 @@ absl::StatusOr<VolumeResult> tetrahedralize_labels(const std::vector<LabelBounda
   } catch (const std::bad_alloc&) {
     return absl::ResourceExhaustedError("tetgen: out of memory joining the volume meshes");
   }
+}
+
+absl::Status improve_volume(VolumeResult& volume, const volume_mesh::ImproveParams& params,
+                            const RunContext& context) {
+  if (params.target_quality <= 0) return absl::OkStatus();
+  VolumeImprovement improvement;
+  improvement.tetgen_summary = volume.summary;
+  try {
+    if (auto s = volume_mesh::improve_tet_mesh(volume.mesh, params, context, improvement.figures);
+        !s.ok()) {
+      return s;
+    }
+    measure(volume);
+  } catch (const std::bad_alloc&) {
+    return absl::ResourceExhaustedError("tet improvement: out of memory");
+  }
+  volume.improvement = improvement;
+  return absl::OkStatus();
 }
 
 }  // namespace labelmesh

@@ -10,10 +10,17 @@
 #include "core/quality/element_quality.h"
 #include "core/run_context.h"
 #include "core/surface/triangle_mesh.h"
+#include "core/volume_mesh/improve_tet_mesh.h"
 #include "core/volume_mesh/tet_mesh.h"
 #include "core/volume_mesh/tetrahedralize.h"
 
 namespace labelmesh {
+
+struct VolumeImprovement {
+  // TetGen's mesh, as it was before the pass.
+  quality::QualitySummary tetgen_summary;
+  volume_mesh::ImproveFigures figures;
+};
 
 struct VolumeResult {
   std::string mesher = "tetgen";
@@ -23,6 +30,8 @@ struct VolumeResult {
   quality::QualitySummary summary;
   size_t steiner_points = 0;
   double seconds = 0;
+  // Set when the improvement pass ran.
+  std::optional<VolumeImprovement> improvement;
   // Files written for it, relative to the output directory.
   std::vector<std::string> files;
 };
@@ -42,5 +51,11 @@ struct LabelBoundary {
 absl::StatusOr<VolumeResult> tetrahedralize_labels(const std::vector<LabelBoundary>& boundaries,
                                                    const volume_mesh::TetgenParams& params,
                                                    const RunContext& context);
+
+// The improvement pass (volume_mesh::improve_tet_mesh) on every label's
+// tetrahedra, then the quality figures again. Does nothing when
+// params.target_quality is 0. Errors: CANCELLED, RESOURCE_EXHAUSTED.
+absl::Status improve_volume(VolumeResult& volume, const volume_mesh::ImproveParams& params,
+                            const RunContext& context);
 
 }  // namespace labelmesh

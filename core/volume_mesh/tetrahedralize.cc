@@ -46,6 +46,11 @@ absl::Status check_params(const TetgenParams& params) {
     return absl::InvalidArgumentError(
         cat("tet-min-dihedral: is ", angle, " degrees; it must be in [0, 30] (0: no bound)"));
   }
+  const double max_angle = params.max_dihedral_deg;
+  if (!std::isfinite(max_angle) || max_angle < 90.0 || max_angle > 179.0) {
+    return absl::InvalidArgumentError(
+        cat("tet-max-dihedral: is ", max_angle, " degrees; it must be in [90, 179]"));
+  }
   const double volume = params.max_volume_mm3;
   if (!std::isfinite(volume) || (volume != 0.0 && (volume < 1e-6 || volume > 1e12))) {
     return absl::InvalidArgumentError(
@@ -356,7 +361,7 @@ absl::StatusOr<TetMesh> run(const surface::TriangleMesh& mesh, int32_t label,
                              switch_number(params.min_dihedral_deg));
   if (params.max_volume_mm3 > 0) switches += cat("a", switch_number(params.max_volume_mm3));
   if (params.keep_boundary) switches += "Y";
-  switches += "zQ";
+  switches += cat("o/", switch_number(params.max_dihedral_deg), "zQ");
   tetgenio out;
   if (auto status = run_tetgen(switches, in, out, label); !status.ok()) return status;
   if (auto status = context.check_stop(); !status.ok()) return status;

@@ -1,0 +1,52 @@
+// Mesh improvement after TetGen (issue 4): local operations that raise the
+// worst tetrahedron quality Q without touching the boundary.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+#include "core/run_context.h"
+#include "core/volume_mesh/tet_mesh.h"
+
+namespace labelmesh::volume_mesh {
+
+struct ImproveParams {
+  // Tetrahedra with Q below this are worked on; the rest only take part as
+  // neighbours. Above the Table 1 "questionable" bound of 0.2, so the pass
+  // also lifts elements that are just good enough.
+  double target_quality = 0.3;
+  // Full sweeps over the bad tetrahedra; a sweep that changes nothing ends
+  // the pass early.
+  int max_sweeps = 8;
+  // No operation makes a tetrahedron larger than this (mm³) and larger than
+  // those it replaces; 0 for no bound. The pipeline passes TetGen's -a bound.
+  double max_volume_mm3 = 0;
+};
+
+struct ImproveFigures {
+  double quality_min_before = 0;
+  double quality_min_after = 0;
+  size_t flips_2_3 = 0;          // face shared by two tetrahedra replaced by an edge and three
+  size_t flips_3_2 = 0;          // edge with three tetrahedra around it removed, leaving two
+  size_t vertices_moved = 0;     // accepted smoothing moves of interior vertices
+  size_t vertices_inserted = 0;  // points added inside a bad tetrahedron's neighbourhood
+  int sweeps = 0;
+  double seconds = 0;
+};
+
+// Improves `mesh` in place. Boundary faces (faces only one tetrahedron has)
+// and the points on them never change, and no tetrahedron changes label:
+// flips and insertions only replace tetrahedra of one label inside the region
+// they fill, and smoothing moves only points no boundary face uses. Every operation is kept
+// only if it raises the lowest Q among the tetrahedra it replaces, so the
+// worst element never gets worse, and none becomes inverted.
+//
+// Existing points keep their order (inserted points are appended);
+// tetrahedra are renumbered.
+// Precondition: check_tet_mesh(mesh) is OK and every tetrahedron has positive
+// volume. Errors: CANCELLED when `context` asks to stop (the mesh is then
+// valid, partly improved).
+absl::Status improve_tet_mesh(TetMesh& mesh, const ImproveParams& params, const RunContext& context,
+                              ImproveFigures& figures);
+
+}  // namespace labelmesh::volume_mesh

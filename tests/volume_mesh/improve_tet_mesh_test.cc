@@ -1,0 +1,165 @@
+// The improvement pass on meshes built to need one operation each: a 3-2 flip,
+// a 2-3 flip, smoothing of an interior point, and that the boundary and the
+// region never change.
+#include "core/volume_mesh/improve_tet_mesh.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/quality/element_quality.h"
+
+namespace labelmesh::volume_mesh {
+namespace {
+
+double tet_volume(const TetMesh& m, size_t t) { return signed_volume(m, t); }
+
+double total_volume(const TetMesh& m) {
+  double sum = 0;
+  for (size_t t = 0; t < m.tetrahedra.size(); ++t) sum += tet_volume(m, t);
+  return sum;
+}
+
+double lowest_quality(const TetMesh& m) {
+  double lowest = 1e9;
+  for (const auto& t : m.tetrahedra) {
+    lowest = std::min(lowest, quality::tetra_quality({m.points[t[0]], m.points[t[1]],
+                                                      m.points[t[2]], m.points[t[3]]}));
+  }
+  return lowest;
+}
+
+// Three tetrahedra around the edge a-b of a bipyramid whose two halves
+// (apexes a and b over triangle c,d,e) are regular tetrahedra.
+TetMesh bipyramid_as_three() {
+  const double h = std::sqrt(2.0 / 3.0);
+  const double r = 1 / std::sqrt(3.0);
+  TetMesh m;
+  m.points = {{0, 0, h},
+              {0, 0, -h},
+              {r, 0, 0},
+              {r * std::cos(2.0943951023931953), r * std::sin(2.0943951023931953), 0},
+              {r * std::cos(4.1887902047863905), r * std::sin(4.1887902047863905), 0}};
+  // a=0, b=1, c=2, d=3, e=4; tetrahedra a,b with each edge of c,d,e.
+  for (const auto& [x, y] : {std::pair{2u, 3u}, {3u, 4u}, {4u, 2u}}) {
+    std::array<uint32_t, 4> t = {x, y, 1, 0};
+    if (quality::tetra_signed_volume(
+            {m.points[t[0]], m.points[t[1]], m.points[t[2]], m.points[t[3]]}) < 0)
+      std::swap(t[0], t[1]);
+    m.tetrahedra.push_back(t);
+    m.labels.push_back(4);
+  }
+  return m;
+}
+
+TEST(ImproveTetMesh, ThreeAroundAnEdgeBecomeTwoRegularTetrahedra) {
+  TetMesh m = bipyramid_as_three();
+  const double volume = total_volume(m);
+  const double before = lowest_quality(m);
+  ImproveFigures figures;
+  ASSERT_TRUE(improve_tet_mesh(m, {.target_quality = 0.9}, RunContext{}, figures).ok());
+  EXPECT_EQ(figures.flips_3_2, 1u);
+  ASSERT_EQ(m.tetrahedra.size(), 2u);
+  EXPECT_NEAR(lowest_quality(m), 1.0, 1e-12);
+  EXPECT_LT(before, 0.7);
+  EXPECT_NEAR(figures.quality_min_before, before, 1e-12);
+  EXPECT_NEAR(figures.quality_min_after, 1.0, 1e-12);
+  EXPECT_NEAR(total_volume(m), volume, 1e-12);
+  EXPECT_EQ(m.labels, (std::vector<int32_t>{4, 4}));
+  EXPECT_EQ(m.points.size(), 5u);
+}
+
+TEST(ImproveTetMesh, TwoFlatTetrahedraBecomeThree) {
+  // Triangle c,d,e with apexes just above and below: two flat tetrahedra,
+  // which the three around the new edge a-b beat.
+  TetMesh m = bipyramid_as_three();
+  m.points[0][2] = 0.15;
+  m.points[1][2] = -0.15;
+  m.tetrahedra = {{2, 3, 4, 0}, {3, 2, 4, 1}};
+  m.labels = {1, 1};
+  ASSERT_GT(tet_volume(m, 0), 0);
+  ASSERT_GT(tet_volume(m, 1), 0);
+  const double volume = total_volume(m);
+  const double before = lowest_quality(m);
+  ImproveFigures figures;
+  ASSERT_TRUE(improve_tet_mesh(m, {.target_quality = 0.9}, RunContext{}, figures).ok());
+  EXPECT_EQ(figures.flips_2_3, 1u);
+  EXPECT_EQ(m.tetrahedra.size(), 3u);
+  EXPECT_GT(lowest_quality(m), before + 0.1);
+  EXPECT_NEAR(total_volume(m), volume, 1e-12);
+}
+
+// A cube of 2x2x2 cells, each cut into six tetrahedra around its diagonal,
+// with the one interior point (the centre) pushed near a corner.
+TetMesh cube_with_displaced_centre() {
+  TetMesh m;
+  for (int z = 0; z <= 2; ++z)
+    for (int y = 0; y <= 2; ++y)
+      for (int x = 0; x <= 2; ++x) m.points.push_back({double(x), double(y), double(z)});
+  auto id = [](int x, int y, int z) { return uint32_t(x + 3 * y + 9 * z); };
+  // Freudenthal: the six paths from corner 0 to corner 7 of each cell.
+  const int paths[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
+  for (int z = 0; z < 2; ++z)
+    for (int y = 0; y < 2; ++y)
+      for (int x = 0; x < 2; ++x)
+        for (const auto& path : paths) {
+          int c[3] = {x, y, z};
+          std::array<uint32_t, 4> t;
+          t[0] = id(c[0], c[1], c[2]);
+          for (int s = 0; s < 3; ++s) {
+            ++c[path[s]];
+            t[s + 1] = id(c[0], c[1], c[2]);
+          }
+          if (quality::tetra_signed_volume(
+                  {m.points[t[0]], m.points[t[1]], m.points[t[2]], m.points[t[3]]}) < 0)
+            std::swap(t[0], t[1]);
+          m.tetrahedra.push_back(t);
+          m.labels.push_back(2);
+        }
+  m.points[id(1, 1, 1)] = {0.3, 0.35, 0.4};
+  return m;
+}
+
+TEST(ImproveTetMesh, SmoothingLiftsTheWorstElementAndKeepsTheBoundary) {
+  TetMesh m = cube_with_displaced_centre();
+  const auto boundary_before = m.points;
+  const double before = lowest_quality(m);
+  ASSERT_GT(before, 0);
+  ImproveFigures figures;
+  ASSERT_TRUE(improve_tet_mesh(m, {}, RunContext{}, figures).ok());
+  EXPECT_GT(figures.vertices_moved, 0u);
+  EXPECT_GT(lowest_quality(m), 0.5);
+  EXPECT_GT(lowest_quality(m), before + 0.3);
+  EXPECT_NEAR(total_volume(m), 8.0, 1e-9);
+  for (size_t t = 0; t < m.tetrahedra.size(); ++t) EXPECT_GT(tet_volume(m, t), 0);
+  // Every point but the centre is on the cube's surface and stays put.
+  for (uint32_t v = 0; v < boundary_before.size(); ++v) {
+    if (v != 13u) EXPECT_EQ(m.points[v], boundary_before[v]) << "point " << v;
+  }
+}
+
+TEST(ImproveTetMesh, AGoodMeshIsLeftAlone) {
+  TetMesh m = cube_with_displaced_centre();
+  m.points[13] = {1, 1, 1};
+  const TetMesh before = m;
+  ImproveFigures figures;
+  ASSERT_TRUE(improve_tet_mesh(m, {.target_quality = 0.5}, RunContext{}, figures).ok());
+  EXPECT_EQ(m.tetrahedra, before.tetrahedra);
+  EXPECT_EQ(m.points, before.points);
+  EXPECT_EQ(figures.sweeps, 0);
+}
+
+TEST(ImproveTetMesh, AStopRequestEndsThePassWithAValidMesh) {
+  TetMesh m = cube_with_displaced_centre();
+  std::atomic<bool> stop{true};
+  RunContext context;
+  context.stop = &stop;
+  ImproveFigures figures;
+  EXPECT_EQ(improve_tet_mesh(m, {}, context, figures).code(), absl::StatusCode::kCancelled);
+  EXPECT_NEAR(total_volume(m), 8.0, 1e-9);
+  for (size_t t = 0; t < m.tetrahedra.size(); ++t) EXPECT_GT(tet_volume(m, t), 0);
+}
+
+}  // namespace
+}  // namespace labelmesh::volume_mesh
