@@ -15,6 +15,8 @@ packages=(
   libcli11-dev libgtest-dev libgmock-dev
   # tests that prove our files with tools we did not write
   python3 python3-numpy python3-nibabel python3-meshio python3-grpcio python3-protobuf
+  # finite-element tools that must accept our volume meshes
+  calculix-ccx gmsh
   # service tests: TLS certificates
   openssl
 )

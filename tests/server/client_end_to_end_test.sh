@@ -75,10 +75,14 @@ job=$("$labelmesh" submit "$work/torus.nii.gz" --surface repaired --detach --jso
   /usr/bin/python3 -c 'import json,sys; print(json.load(sys.stdin)["job_id"])')
 [ ${#job} -eq 32 ] || fail "submit --detach --json gave no job id"
 "$labelmesh" watch "$job" >/dev/null 2>&1 || fail "watch of a good job exited $?"
-"$labelmesh" status "$job" --json | grep -q '"state": "JOB_STATE_SUCCEEDED"' || fail "status"
+# Whole outputs are captured before grep: `grep -q` stops reading at its first
+# match, and with pipefail the writer's SIGPIPE would fail the pipeline.
+status_json=$("$labelmesh" status "$job" --json) || fail "status exited $?"
+grep -q '"state": "JOB_STATE_SUCCEEDED"' <<<"$status_json" || fail "status"
 "$labelmesh" fetch "$job" --out "$work/fetched" >/dev/null || fail "fetch exited $?"
 [ -s "$work/fetched/surface-label1.stl" ] || fail "fetch wrote no surface"
-"$labelmesh" list | grep -q "$job" || fail "list does not show the job"
+listed=$("$labelmesh" list) || fail "list exited $?"
+grep -q "$job" <<<"$listed" || fail "list does not show the job"
 
 # Exit codes: unknown job 3, cancel of an ended job 4, a volume that fails 3.
 set +e

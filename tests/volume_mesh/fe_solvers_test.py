@@ -1,0 +1,140 @@
+#!/usr/bin/env python3
+"""The liver's tetrahedral mesh in solvers nobody here wrote (issue 4).
+
+`labelmesh mesh liver.inr.gz --labels 255 --volume tet --formats inp,msh`, then:
+- Gmsh loads volume.msh and its coherence check (duplicate nodes and
+  elements, isolated nodes) finds nothing, with the report's counts;
+- CalculiX solves a linear-elastic load case on volume.inp: the nodes in the
+  lowest 5 % of the z range fixed, gravity along -z, soft-tissue material.
+  It must finish without an error or a Jacobian warning, and the largest
+  displacement must be finite, positive and downward at the far end.
+"""
+import argparse
+import json
+import math
+import pathlib
+import re
+import subprocess
+import sys
+import tempfile
+
+
+def fail(message):
+    print(f"FAIL: {message}", file=sys.stderr)
+    sys.exit(1)
+
+
+def read_nodes(inp):
+    """Node id -> (x, y, z) from the *NODE block of an Abaqus deck."""
+    nodes, in_nodes = {}, False
+    for line in inp.read_text().splitlines():
+        if line.startswith("*"):
+            in_nodes = line.upper().split(",")[0].strip() == "*NODE"
+            continue
+        if in_nodes and line.strip():
+            fields = line.split(",")
+            nodes[int(fields[0])] = tuple(float(v) for v in fields[1:4])
+    return nodes
+
+
+def write_deck(work, nodes, label):
+    zs = [p[2] for p in nodes.values()]
+    z_min, z_max = min(zs), max(zs)
+    fixed = sorted(n for n, p in nodes.items() if p[2] <= z_min + 0.05 * (z_max - z_min))
+    lines = ["*INCLUDE, INPUT=volume.inp", "*NSET, NSET=EVERY, GENERATE", f"1, {max(nodes)}, 1",
+             "*NSET, NSET=FIXED"]
+    lines += [", ".join(str(n) for n in fixed[i:i + 12]) for i in range(0, len(fixed), 12)]
+    lines += [
+        # Units mm, N, tonne, s: E = 1 MPa (rubber-like; liver is softer, but a linear
+        # solve of its sag would be meaningless), nearly incompressible.
+        "*MATERIAL, NAME=TISSUE", "*ELASTIC", "1.0, 0.45",
+        "*DENSITY", "1.06e-9",
+        f"*SOLID SECTION, ELSET=LABEL_{label}, MATERIAL=TISSUE",
+        "*BOUNDARY", "FIXED, 1, 3",
+        "*STEP", "*STATIC",
+        "*DLOAD", f"LABEL_{label}, GRAV, 9810., 0., 0., -1.",
+        "*NODE PRINT, NSET=EVERY", "U",
+        "*END STEP",
+    ]
+    (work / "liver.inp").write_text("\n".join(lines) + "\n")
+    return fixed
+
+
+def check_gmsh(work, report):
+    run = subprocess.run(["gmsh", "-check", str(work / "volume.msh")], capture_output=True,
+                         text=True, timeout=300)
+    text = run.stdout + run.stderr
+    if run.returncode != 0:
+        fail(f"gmsh exited {run.returncode}: {text[-2000:]}")
+    bad = [l for l in text.splitlines() if l.startswith(("Warning", "Error"))]
+    if bad:
+        fail(f"gmsh complained: {bad[:5]}")
+    nodes = re.search(r"Info\s*:\s*(\d+) nodes", text)
+    elements = re.search(r"Info\s*:\s*(\d+) elements", text)
+    volume = report["volume"]
+    if not nodes or int(nodes.group(1)) != int(volume["nodes"]):
+        fail(f"gmsh read {nodes and nodes.group(1)} nodes, the report has {volume['nodes']}")
+    if not elements or int(elements.group(1)) != int(volume["tetrahedra"]):
+        fail(f"gmsh read {elements and elements.group(1)} elements, "
+             f"the report has {volume['tetrahedra']}")
+    print(f"gmsh: {nodes.group(1)} nodes, {elements.group(1)} elements, coherence check clean")
+
+
+def check_calculix(work, nodes, fixed):
+    run = subprocess.run(["ccx", "-i", "liver"], cwd=work, capture_output=True, text=True,
+                         timeout=1200)
+    text = run.stdout + run.stderr
+    (work / "ccx.log").write_text(text)
+    if run.returncode != 0 or "*ERROR" in text or "*WARNING" in text:
+        fail(f"ccx exited {run.returncode}: {text[-2000:]}")
+    if re.search(r"jacobian", text, re.IGNORECASE):
+        fail("ccx warned about a Jacobian: " + text[-2000:])
+    if "Job finished" not in text:
+        fail("ccx did not finish: " + text[-2000:])
+    displacements = {}
+    in_table = False
+    for line in (work / "liver.dat").read_text().splitlines():
+        if "displacements" in line:
+            in_table = True
+            continue
+        fields = line.split()
+        if in_table and len(fields) == 4:
+            displacements[int(fields[0])] = tuple(float(v) for v in fields[1:])
+    if len(displacements) != len(nodes):
+        fail(f"ccx printed {len(displacements)} displacements for {len(nodes)} nodes")
+    if any(not all(math.isfinite(c) for c in u) for u in displacements.values()):
+        fail("a displacement is not finite")
+    if any(any(c != 0 for c in displacements[n]) for n in fixed):
+        fail("a fixed node moved")
+    largest = max(displacements, key=lambda n: math.dist((0, 0, 0), displacements[n]))
+    u = displacements[largest]
+    if not (u[2] < 0 and math.dist((0, 0, 0), u) > 0):
+        fail(f"the largest displacement {u} does not point down")
+    print(f"ccx: {len(fixed)} fixed nodes, largest displacement {math.dist((0, 0, 0), u):.3g} mm "
+          f"at node {largest} (z {nodes[largest][2]:.1f} mm), no error or Jacobian warning")
+
+
+def main():
+    parser = argparse.ArgumentParser()
+    parser.add_argument("--labelmesh", required=True)
+    parser.add_argument("--data", required=True)
+    args = parser.parse_args()
+    with tempfile.TemporaryDirectory(prefix="labelmesh-fe-") as tmp:
+        work = pathlib.Path(tmp)
+        run = subprocess.run([args.labelmesh, "mesh", f"{args.data}/liver.inr.gz", "--labels", "255",
+                              "--volume", "tet", "--formats", "inp,msh", "--out", str(work),
+                              "--json"], capture_output=True, text=True, timeout=600)
+        if run.returncode != 0:
+            fail(f"labelmesh mesh exited {run.returncode}: {run.stderr[-2000:]}")
+        report = json.loads(run.stdout)
+        check_gmsh(work, report)
+        nodes = read_nodes(work / "volume.inp")
+        if len(nodes) != int(report["volume"]["nodes"]):
+            fail(f"volume.inp has {len(nodes)} nodes, the report {report['volume']['nodes']}")
+        fixed = write_deck(work, nodes, 255)
+        check_calculix(work, nodes, fixed)
+    print("PASS")
+
+
+if __name__ == "__main__":
+    main()
