@@ -3,13 +3,17 @@
 // a plain decompress + scan of the voxels, and VTK's discrete flying edges
 // run directly on the whole volume. Then the quality-surface pipeline (MC,
 // repair, smoothing, Poisson solve and meshing, checks) on the liver's label
-// 255 and a 256^3 sphere, stage by stage. Prints figures; never fails on time.
+// 255 and a 256^3 sphere, stage by stage; then TetGen and the improvement pass
+// on the liver with Q histograms before and after. Prints figures; never fails
+// on time.
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <iterator>
 #include <string>
 #include <vector>
 
@@ -17,6 +21,7 @@
 #include <vtkNew.h>
 #include <vtkPolyData.h>
 
+#include "bench/mesh3_baseline.h"
 #include "core/pipeline.h"
 #include "core/surface/extract_surfaces.h"
 #include "core/surface/surface_statistics.h"
@@ -25,6 +30,7 @@
 #include "core/volume/phantom.h"
 #include "core/volume/read_label_volume.h"
 #include "core/volume/write_label_volume.h"
+#include "core/volume_meshes.h"
 
 namespace {
 
@@ -158,6 +164,83 @@ int bench_quality_surface(const std::string& path, const std::vector<int32_t>& l
   return 0;
 }
 
+// Counts of `quality` in the Table 1 bins, with the good ones split further.
+void print_quality_histogram(const char* name, const std::vector<double>& quality) {
+  static constexpr double kUpper[] = {0.001, 1.0 / 30, 0.1, 0.2, 0.3, 0.5, 0.7, 0.9, 1.0 + 1e-12};
+  size_t counts[std::size(kUpper)] = {};
+  for (double q : quality) {
+    size_t bin = 0;
+    while (bin + 1 < std::size(kUpper) && q > kUpper[bin]) ++bin;
+    ++counts[bin];
+  }
+  std::printf("  %-10s Q histogram:", name);
+  double lower = -1;
+  for (size_t bin = 0; bin < std::size(kUpper); ++bin) {
+    std::printf(" (%.3g,%.3g] %zu", lower, std::min(kUpper[bin], 1.0), counts[bin]);
+    lower = kUpper[bin];
+  }
+  std::printf("\n");
+}
+
+// TetGen on the liver's Poisson surface, then the improvement pass: time,
+// peak RSS and the quality histogram before and after.
+int bench_tetrahedra(const std::string& path, const std::vector<int32_t>& labels) {
+  labelmesh::MeshParams params;
+  params.labels = labels;
+  params.volume = labelmesh::VolumeMethod::kTetgen;
+  params.improve.target_quality = 0;  // run below, timed on its own
+  const auto pipeline_start = Clock::now();
+  auto result = labelmesh::run_pipeline(path, params, labelmesh::RunContext{});
+  if (!result.ok() || !result->volume) {
+    std::fprintf(stderr, "%s\n", std::string(result.status().message()).c_str());
+    return 1;
+  }
+  labelmesh::VolumeResult& volume = *result->volume;
+  const std::vector<double> before = volume.quality;
+  const auto tetgen_summary = volume.summary;
+  const auto start = Clock::now();
+  if (!labelmesh::improve_volume(volume, labelmesh::volume_mesh::ImproveParams{},
+                                 labelmesh::RunContext{})
+           .ok())
+    return 1;
+  const double improve_seconds = seconds_since(start);
+  const double ours = seconds_since(pipeline_start);
+  const auto& s = volume.summary;
+  const auto& f = volume.improvement->figures;
+  std::printf("%s: tetrahedra\n", path.c_str());
+  std::printf(
+      "  tetgen                      %8.3f s  %zu tetrahedra, Q min %.3f, dihedral %.1f-%.1f\n",
+      volume.seconds, before.size(), tetgen_summary.min, tetgen_summary.min_dihedral_deg,
+      tetgen_summary.max_dihedral_deg);
+  std::printf(
+      "  improvement pass            %8.3f s  %zu tetrahedra, Q min %.3f, dihedral %.1f-%.1f "
+      "(target Q >= 0.2, dihedral >= 10)\n",
+      improve_seconds, volume.mesh.tetrahedra.size(), s.min, s.min_dihedral_deg,
+      s.max_dihedral_deg);
+  std::printf("  flips 3-2 %zu, 2-3 %zu; points moved %zu, inserted %zu\n", f.flips_3_2,
+              f.flips_2_3, f.vertices_moved, f.vertices_inserted);
+  print_quality_histogram("tetgen", before);
+  print_quality_histogram("improved", volume.quality);
+  std::printf("  file to improved tetrahedra %8.3f s, peak RSS %.1f MiB\n", ours, peak_rss_mib());
+
+  // The baseline: CGAL Mesh_3 on the same label of the same image.
+  auto volume_in = labelmesh::volume::read_label_volume(path, {}, {});
+  if (!volume_in.ok()) return 1;
+  auto mesh3 = labelmesh::bench::mesh_label_with_mesh3(*volume_in, labels.front());
+  if (!mesh3.ok()) {
+    std::fprintf(stderr, "%s\n", std::string(mesh3.status().message()).c_str());
+    return 1;
+  }
+  const auto& m = mesh3->quality;
+  std::printf(
+      "  CGAL Mesh_3 (1 thread)      %8.3f s  %zu tetrahedra, %zu nodes, Q min %.3f mean %.3f, "
+      "dihedral %.1f-%.1f, questionable %lld\n",
+      mesh3->seconds, mesh3->tetrahedra, mesh3->nodes, m.min, m.mean, m.min_dihedral_deg,
+      m.max_dihedral_deg, static_cast<long long>(m.invalid + m.very_bad + m.questionable));
+  std::printf("  ours / Mesh_3 time          %8.2f (target < 1)\n", ours / mesh3->seconds);
+  return 0;
+}
+
 // A sphere phantom filling a 256^3 grid (radius 125 voxels), written to /tmp.
 std::string write_large_sphere() {
   const auto phantom =
@@ -197,6 +280,7 @@ int main(int argc, char** argv) {
   if (argc == 1) {
     const std::string liver = files[0];
     if (!in_child([&] { return bench_quality_surface(liver, {255}); })) ++failures;
+    if (!in_child([&] { return bench_tetrahedra(liver, {255}); })) ++failures;
     const std::string sphere = write_large_sphere();
     if (sphere.empty() || !in_child([&] { return bench_quality_surface(sphere, {1}); })) ++failures;
   }
