@@ -40,14 +40,8 @@ class WorkMesh {
   const std::vector<uint32_t>& star(uint32_t v) const { return star_[v]; }
   Vec3& point(uint32_t v) { return mesh_.points[v]; }
 
-  double quality_of(const Tet& t) const {
-    return quality::tetra_quality(
-        {mesh_.points[t[0]], mesh_.points[t[1]], mesh_.points[t[2]], mesh_.points[t[3]]});
-  }
-  double volume_of(const Tet& t) const {
-    return quality::tetra_signed_volume(
-        {mesh_.points[t[0]], mesh_.points[t[1]], mesh_.points[t[2]], mesh_.points[t[3]]});
-  }
+  double quality_of(const Tet& t) const { return quality::tetra_quality(corners(t)); }
+  double volume_of(const Tet& t) const { return quality::tetra_signed_volume(corners(t)); }
 
   uint32_t add(const Tet& t, int32_t label) {
     const auto id = static_cast<uint32_t>(tets_.size());
@@ -105,36 +99,17 @@ class WorkMesh {
   }
 
  private:
-  // A face that only one tetrahedron has lies on the boundary of its label's
-  // region: its points stay where they are.
+  // The points of every label's boundary faces (its surface and its
+  // interfaces with other labels) stay where they are.
   void mark_boundary_points() {
-    struct Face {
-      std::array<uint32_t, 3> v;
-      bool operator<(const Face& o) const { return v < o.v; }
-      bool operator==(const Face& o) const { return v == o.v; }
-    };
-    std::vector<Face> faces;
-    faces.reserve(4 * tets_.size());
-    for (const Tet& t : tets_) {
-      for (int skip = 0; skip < 4; ++skip) {
-        Face f;
-        for (int i = 0, k = 0; i < 4; ++i) {
-          if (i != skip) f.v[k++] = t[i];
-        }
-        std::sort(f.v.begin(), f.v.end());
-        faces.push_back(f);
-      }
-    }
-    std::sort(faces.begin(), faces.end());
     fixed_.assign(mesh_.points.size(), false);
-    for (size_t i = 0; i < faces.size();) {
-      size_t j = i + 1;
-      while (j < faces.size() && faces[j] == faces[i]) ++j;
-      if (j - i == 1) {
-        for (uint32_t v : faces[i].v) fixed_[v] = true;
-      }
-      i = j;
+    for (const BoundaryFace& face : label_boundary_faces(mesh_)) {
+      for (uint32_t v : face.points) fixed_[v] = true;
     }
+  }
+
+  quality::Tet corners(const Tet& t) const {
+    return {mesh_.points[t[0]], mesh_.points[t[1]], mesh_.points[t[2]], mesh_.points[t[3]]};
   }
 
   TetMesh& mesh_;
@@ -152,39 +127,53 @@ double lowest_quality(const WorkMesh& w, const std::vector<uint32_t>& tets) {
   return lowest;
 }
 
-// Replaces `old_tets` by `new_tets` when the new ones fill the same volume,
-// none is inverted, and their worst quality beats the old worst.
-bool replace_if_better(WorkMesh& w, const std::vector<uint32_t>& old_tets,
-                       const std::vector<Tet>& new_tets) {
-  const double old_lowest = lowest_quality(w, old_tets);
-  double old_volume = 0, new_volume = 0, old_largest = 0;
-  for (uint32_t t : old_tets) {
-    const double v = w.volume_of(w.tet(t));
-    old_volume += v;
-    old_largest = std::max(old_largest, v);
-  }
-  double new_lowest = kNone;
+double total_volume(const WorkMesh& w, const std::vector<uint32_t>& tets) {
+  double sum = 0;
+  for (uint32_t t : tets) sum += w.volume_of(w.tet(t));
+  return sum;
+}
+
+// True when no tetrahedron of `new_tets` is inverted and together they have
+// `old_volume`. The same volume means the same region: a flip whose new edge
+// misses the old shared face, or a point outside its cavity's kernel, would
+// cover more than the old tetrahedra did.
+bool fills_same_region(const WorkMesh& w, const std::vector<Tet>& new_tets, double old_volume) {
+  double new_volume = 0;
   for (const Tet& t : new_tets) {
     const double v = w.volume_of(t);
     if (!(v > 0)) return false;
-    if (w.max_volume > 0 && v > w.max_volume && v > old_largest) return false;
     new_volume += v;
+  }
+  return std::abs(new_volume - old_volume) <= 1e-9 * old_volume;
+}
+
+// Replaces `old_tets` by `new_tets` when the new ones fill the same region,
+// none exceeds the volume bound, and their worst quality beats the old worst.
+bool replace_if_better(WorkMesh& w, const std::vector<uint32_t>& old_tets,
+                       const std::vector<Tet>& new_tets) {
+  if (!fills_same_region(w, new_tets, total_volume(w, old_tets))) return false;
+  double old_largest = 0;
+  for (uint32_t t : old_tets) old_largest = std::max(old_largest, w.volume_of(w.tet(t)));
+  double new_lowest = kNone;
+  for (const Tet& t : new_tets) {
+    const double v = w.volume_of(t);
+    if (w.max_volume > 0 && v > w.max_volume && v > old_largest) return false;
     new_lowest = std::min(new_lowest, w.quality_of(t));
   }
-  // The same volume means the same region: a flip whose new edge misses the
-  // old shared face would cover more than the old tetrahedra did.
-  if (std::abs(new_volume - old_volume) > 1e-9 * old_volume) return false;
-  if (!(new_lowest > old_lowest)) return false;
+  if (!(new_lowest > lowest_quality(w, old_tets))) return false;
   const int32_t label = w.label(old_tets.front());
   for (uint32_t t : old_tets) w.remove(t);
   for (const Tet& t : new_tets) w.add(t, label);
   return true;
 }
 
-// The face opposite each local vertex i, ordered so that it and vertex i make
-// a positive tetrahedron (VTK ordering): its normal points towards i.
-constexpr std::array<std::array<int, 3>, 4> kOppositeFace = {
-    {{1, 3, 2}, {0, 2, 3}, {0, 3, 1}, {0, 1, 2}}};
+// The face of `t` opposite its local vertex `across`, wound so that its
+// right-hand normal points into `t` (towards that vertex): a new point on
+// that side makes a positive tetrahedron with it.
+std::array<uint32_t, 3> inward_face(const Tet& t, uint8_t across) {
+  const auto& f = outward_face(across);
+  return {t[f[0]], t[f[2]], t[f[1]]};
+}
 
 // 2-3 flip: tetrahedra a,b,c,d and its neighbour across a,b,c (apex e) become
 // three around the new edge d-e.
@@ -192,8 +181,7 @@ bool flip_2_3(WorkMesh& w, uint32_t t, int face, ImproveFigures& figures) {
   const Tet& k = w.tet(t);
   // Local vertex `face` is d; a,b,c are the others, ordered so that a,b,c,d
   // is positive (the VTK ordering of the face opposite each vertex).
-  const auto& f = kOppositeFace[face];
-  const uint32_t a = k[f[0]], b = k[f[1]], c = k[f[2]];
+  const auto [a, b, c] = inward_face(k, uint8_t(face));
   const uint32_t d = k[face];
   const auto neighbour = w.across(t, a, b, c);
   if (!neighbour || w.label(*neighbour) != w.label(t)) return false;
@@ -340,8 +328,8 @@ bool insert_in_cavity(WorkMesh& w, uint32_t t, std::vector<uint32_t> cavity,
   Vec3 inward = {0, 0, 0};
   for (uint32_t c : cavity) {
     const Tet& ck = w.tet(c);
-    for (const auto& f : kOppositeFace) {
-      const std::array<uint32_t, 3> face = {ck[f[0]], ck[f[1]], ck[f[2]]};
+    for (uint8_t across = 0; across < 4; ++across) {
+      const auto face = inward_face(ck, across);
       const auto other = w.across(c, face[0], face[1], face[2]);
       if (other && in_cavity(*other)) continue;
       faces.push_back(face);
@@ -362,25 +350,19 @@ bool insert_in_cavity(WorkMesh& w, uint32_t t, std::vector<uint32_t> cavity,
   if (n > 0) inward = geometry::scale(inward, 1 / n);
 
   const double old_lowest = lowest_quality(w, cavity);
-  double old_volume = 0;
-  for (uint32_t c : cavity) old_volume += w.volume_of(w.tet(c));
+  const double old_volume = total_volume(w, cavity);
   std::vector<Tet> old_tets;
   for (uint32_t c : cavity) old_tets.push_back(w.tet(c));
 
   // The first start inside the cavity's kernel (every new tetrahedron
   // positive, the volume unchanged), going deeper below t's surface faces.
   const uint32_t p = w.add_point(centre);
+  std::vector<Tet> joined;
+  for (const auto& f : faces) joined.push_back({f[0], f[1], f[2], p});
   bool started = false;
   for (double depth : {0.0, 0.1, 0.2, 0.35, 0.5, 0.75, 1.0}) {
     w.point(p) = geometry::add(centre, geometry::scale(inward, depth * edge_sum / 4));
-    double new_volume = 0;
-    bool valid = true;
-    for (const auto& f : faces) {
-      const double v = w.volume_of({f[0], f[1], f[2], p});
-      valid &= v > 0;
-      new_volume += v;
-    }
-    if (valid && std::abs(new_volume - old_volume) <= 1e-9 * old_volume) {
+    if (fills_same_region(w, joined, old_volume)) {
       started = true;
       break;
     }
@@ -390,7 +372,7 @@ bool insert_in_cavity(WorkMesh& w, uint32_t t, std::vector<uint32_t> cavity,
     return false;
   }
   for (uint32_t c : cavity) w.remove(c);
-  for (const auto& f : faces) w.add({f[0], f[1], f[2], p}, label);
+  for (const Tet& tet : joined) w.add(tet, label);
   ImproveFigures scratch;
   smooth_vertex(w, p, scratch);
   if (lowest_quality(w, w.star(p)) > old_lowest) {
@@ -410,8 +392,9 @@ bool insert_vertex(WorkMesh& w, uint32_t t, ImproveFigures& figures) {
   const int32_t label = w.label(t);
   const Tet k = w.tet(t);
   std::vector<uint32_t> near = {t};
-  for (const auto& f : kOppositeFace) {
-    const auto neighbour = w.across(t, k[f[0]], k[f[1]], k[f[2]]);
+  for (uint8_t across = 0; across < 4; ++across) {
+    const auto [a, b, c] = inward_face(k, across);
+    const auto neighbour = w.across(t, a, b, c);
     if (neighbour && w.label(*neighbour) == label) near.push_back(*neighbour);
   }
   if (insert_in_cavity(w, t, near, figures)) return true;

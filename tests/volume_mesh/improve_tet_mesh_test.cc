@@ -13,12 +13,20 @@
 namespace labelmesh::volume_mesh {
 namespace {
 
-double tet_volume(const TetMesh& m, size_t t) { return signed_volume(m, t); }
-
 double total_volume(const TetMesh& m) {
   double sum = 0;
-  for (size_t t = 0; t < m.tetrahedra.size(); ++t) sum += tet_volume(m, t);
+  for (size_t t = 0; t < m.tetrahedra.size(); ++t) sum += signed_volume(m, t);
   return sum;
+}
+
+// Appends tetrahedron `t` with `label`, its first two points swapped if
+// needed so that it is positive (VTK ordering).
+void add_positive(TetMesh& m, std::array<uint32_t, 4> t, int32_t label) {
+  if (quality::tetra_signed_volume(
+          {m.points[t[0]], m.points[t[1]], m.points[t[2]], m.points[t[3]]}) < 0)
+    std::swap(t[0], t[1]);
+  m.tetrahedra.push_back(t);
+  m.labels.push_back(label);
 }
 
 double lowest_quality(const TetMesh& m) {
@@ -43,12 +51,7 @@ TetMesh bipyramid_as_three() {
               {r * std::cos(4.1887902047863905), r * std::sin(4.1887902047863905), 0}};
   // a=0, b=1, c=2, d=3, e=4; tetrahedra a,b with each edge of c,d,e.
   for (const auto& [x, y] : {std::pair{2u, 3u}, {3u, 4u}, {4u, 2u}}) {
-    std::array<uint32_t, 4> t = {x, y, 1, 0};
-    if (quality::tetra_signed_volume(
-            {m.points[t[0]], m.points[t[1]], m.points[t[2]], m.points[t[3]]}) < 0)
-      std::swap(t[0], t[1]);
-    m.tetrahedra.push_back(t);
-    m.labels.push_back(4);
+    add_positive(m, {x, y, 1, 0}, 4);
   }
   return m;
 }
@@ -78,8 +81,8 @@ TEST(ImproveTetMesh, TwoFlatTetrahedraBecomeThree) {
   m.points[1][2] = -0.15;
   m.tetrahedra = {{2, 3, 4, 0}, {3, 2, 4, 1}};
   m.labels = {1, 1};
-  ASSERT_GT(tet_volume(m, 0), 0);
-  ASSERT_GT(tet_volume(m, 1), 0);
+  ASSERT_GT(signed_volume(m, 0), 0);
+  ASSERT_GT(signed_volume(m, 1), 0);
   const double volume = total_volume(m);
   const double before = lowest_quality(m);
   ImproveFigures figures;
@@ -111,11 +114,7 @@ TetMesh cube_with_displaced_centre() {
             ++c[path[s]];
             t[s + 1] = id(c[0], c[1], c[2]);
           }
-          if (quality::tetra_signed_volume(
-                  {m.points[t[0]], m.points[t[1]], m.points[t[2]], m.points[t[3]]}) < 0)
-            std::swap(t[0], t[1]);
-          m.tetrahedra.push_back(t);
-          m.labels.push_back(2);
+          add_positive(m, t, 2);
         }
   m.points[id(1, 1, 1)] = {0.3, 0.35, 0.4};
   return m;
@@ -132,7 +131,7 @@ TEST(ImproveTetMesh, SmoothingLiftsTheWorstElementAndKeepsTheBoundary) {
   EXPECT_GT(lowest_quality(m), 0.5);
   EXPECT_GT(lowest_quality(m), before + 0.3);
   EXPECT_NEAR(total_volume(m), 8.0, 1e-9);
-  for (size_t t = 0; t < m.tetrahedra.size(); ++t) EXPECT_GT(tet_volume(m, t), 0);
+  for (size_t t = 0; t < m.tetrahedra.size(); ++t) EXPECT_GT(signed_volume(m, t), 0);
   // Every point but the centre is on the cube's surface and stays put.
   for (uint32_t v = 0; v < boundary_before.size(); ++v) {
     if (v != 13u) EXPECT_EQ(m.points[v], boundary_before[v]) << "point " << v;
@@ -158,7 +157,7 @@ TEST(ImproveTetMesh, AStopRequestEndsThePassWithAValidMesh) {
   ImproveFigures figures;
   EXPECT_EQ(improve_tet_mesh(m, {}, context, figures).code(), absl::StatusCode::kCancelled);
   EXPECT_NEAR(total_volume(m), 8.0, 1e-9);
-  for (size_t t = 0; t < m.tetrahedra.size(); ++t) EXPECT_GT(tet_volume(m, t), 0);
+  for (size_t t = 0; t < m.tetrahedra.size(); ++t) EXPECT_GT(signed_volume(m, t), 0);
 }
 
 }  // namespace
