@@ -1,6 +1,6 @@
 # labelmesh in a container: Debian 12 with the packages from the same
 # scripts/install-deps.sh that README.md and CI use. The image holds the
-# labelmesh client and the labelmeshd service (with its labelmesh-worker).
+# labelmesh client and the labelmeshd service (its workers are labelmeshd too).
 FROM debian:12
 
 WORKDIR /opt/labelmesh
@@ -10,7 +10,7 @@ RUN bash scripts/install-deps.sh && rm -rf /var/lib/apt/lists/*
 COPY . .
 RUN bash scripts/build.sh release \
  && install -m 0755 build/release/client/labelmesh build/release/server/labelmeshd \
-      build/release/server/labelmesh-worker /usr/local/bin/
+      /usr/local/bin/
 
 # Run as an unprivileged user; volumes and the spool live under /data.
 RUN useradd --system --create-home labelmesh && mkdir -p /data/spool && chown -R labelmesh /data

@@ -1,12 +1,15 @@
-// labelmeshd: the meshing service. Jobs run in labelmesh-worker processes.
+// labelmeshd: the meshing service. Each job runs in a child labelmeshd
+// started in worker mode (`labelmeshd --worker JOB_DIR`).
 #include <signal.h>
 #include <CLI/CLI.hpp>
 
 #include <cstdio>
+#include <string_view>
 #include <thread>
 
 #include "absl/time/time.h"
 #include "server/labelmesh_server.h"
+#include "server/worker_process.h"
 #include "spdlog/sinks/stdout_color_sinks.h"
 #include "spdlog/spdlog.h"
 
@@ -100,6 +103,13 @@ sigset_t stop_signals() {
 }  // namespace
 
 int main(int argc, char** argv) {
+  if (argc >= 2 && std::string_view(argv[1]) == labelmesh::server::kWorkerMode) {
+    if (argc != 3) {
+      std::fprintf(stderr, "usage: labelmeshd --worker JOB_DIR (started by labelmeshd)\n");
+      return 2;
+    }
+    return labelmesh::server::worker_main(argv[2], 3);
+  }
   // Blocked before any thread starts, so every thread inherits the mask.
   const sigset_t signals = stop_signals();
   pthread_sigmask(SIG_BLOCK, &signals, nullptr);

@@ -155,6 +155,9 @@ grpc::Status MeshingService::Submit(grpc::ServerContext* context,
                                    ? config_.max_voxels
                                    : std::min<uint64_t>(options.max_voxels(), config_.max_voxels);
   options.set_max_voxels(voxel_limit);
+  // The job keeps its options as the pipeline reads them, defaults filled in,
+  // so that GetJob shows what the job runs with. check_spec parsed them.
+  options = make_options(*params_from_options(options));
 
   const std::string job_id = new_job_id();
   const std::string extension = *upload_extension(spec.file_name());

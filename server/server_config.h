@@ -45,8 +45,8 @@ struct ServerConfig {
   // Allow a non-loopback listen address without TLS.
   bool insecure = false;
 
-  // The worker started as `<it> JOB_DIR`; empty for labelmesh-worker beside
-  // this process's own executable.
+  // The worker started as `<it> --worker JOB_DIR`; empty for this process's
+  // own executable (labelmeshd in worker mode).
   std::string worker_executable;
 
   bool tls() const { return !tls_cert.empty(); }

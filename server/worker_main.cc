@@ -1,5 +1,6 @@
-// labelmesh-worker JOB_DIR: one job, run with the core library, its events
-// sent to labelmeshd over file descriptor 3. The server kills it to stop it.
+// `labelmeshd --worker JOB_DIR`: one job, run with the core library, its
+// events sent to the parent labelmeshd over file descriptor 3. The server
+// kills it to stop it.
 #include <chrono>
 #include <cstdio>
 #include <fstream>
@@ -116,11 +117,3 @@ int worker_main(const std::string& job_dir, int event_fd) {
 }
 
 }  // namespace labelmesh::server
-
-int main(int argc, char** argv) {
-  if (argc != 2) {
-    std::fprintf(stderr, "usage: labelmesh-worker JOB_DIR (started by labelmeshd)\n");
-    return 2;
-  }
-  return labelmesh::server::worker_main(argv[1], 3);
-}

@@ -12,11 +12,9 @@ namespace labelmesh::server {
 
 WorkerPool::WorkerPool(JobTable& table, const Spool& spool, const ServerConfig& config)
     : table_(table), spool_(spool), config_(config) {
-  executable_ =
-      config.worker_executable.empty()
-          ? (std::filesystem::read_symlink("/proc/self/exe").parent_path() / "labelmesh-worker")
-                .string()
-          : config.worker_executable;
+  executable_ = config.worker_executable.empty()
+                    ? std::filesystem::read_symlink("/proc/self/exe").string()
+                    : config.worker_executable;
 }
 
 WorkerPool::~WorkerPool() { join(); }

@@ -96,7 +96,8 @@ WorkerOutcome run_worker_process(const WorkerRun& run) {
   const int log_fd = ::open(run.log_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0640);
   const int null_fd = ::open("/dev/null", O_RDONLY | O_CLOEXEC);
   std::string executable = run.executable, job_dir = run.job_dir;
-  std::vector<char*> argv{executable.data(), job_dir.data(), nullptr};
+  std::string mode = kWorkerMode;
+  std::vector<char*> argv{executable.data(), mode.data(), job_dir.data(), nullptr};
   const ChildSetup setup{pipe_fds[1], log_fd >= 0 ? log_fd : null_fd, null_fd, run.limits};
 
   const pid_t pid = fork();

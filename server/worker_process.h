@@ -1,4 +1,4 @@
-// Runs one job in a child process (`labelmesh-worker JOB_DIR`) under
+// Runs one job in a child process (`labelmeshd --worker JOB_DIR`) under
 // resource limits: CGAL Poisson and TetGen cannot be interrupted mid-call and
 // may crash on hostile geometry, so a job that must stop is killed, and a
 // crash takes only its own job down.
@@ -45,10 +45,15 @@ struct WorkerRun {
   std::function<StopRequest()> stop_request;
 };
 
+// The first argument that makes labelmeshd a worker rather than a server.
+inline constexpr char kWorkerMode[] = "--worker";
+
 WorkerOutcome run_worker_process(const WorkerRun& run);
 
 // The child's side: runs the pipeline on JOB_DIR/input<ext> into JOB_DIR/out
-// and writes events to `event_fd`. Returns the process exit code.
+// and writes events to `event_fd`. Returns the process exit code. Defined in
+// worker_main.cc, which only labelmeshd links, so that the server library
+// and its tests stay free of the core pipeline.
 int worker_main(const std::string& job_dir, int event_fd);
 
 }  // namespace labelmesh::server

@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # End to end through the real executables: labelmeshd on a free loopback port,
 # `labelmesh submit` of the liver compared with `labelmesh mesh` of the same
-# file and options, the job commands and their exit codes, TLS with a token,
-# and SIGTERM shutdown.
+# file and options, the job commands and their exit codes, the metrics
+# endpoint, `labelmesh watch` across a server restart, TLS with a token, and
+# SIGTERM shutdown.
 # Usage: client_end_to_end_test.sh LABELMESHD LABELMESH SHARED_DATA
 set -euo pipefail
 labelmeshd=$1 labelmesh=$2 data=$3
@@ -34,9 +35,13 @@ start_server() {  # extra flags...
 }
 
 port=$(free_port)
+metrics_port=$(free_port)
 export LABELMESH_SERVER=127.0.0.1:$port
 client_flags=()
-start_server --listen "127.0.0.1:$port"
+# No grace on SIGTERM: a running job is interrupted and runs at next start.
+plain_flags=(--listen "127.0.0.1:$port" --metrics-listen "127.0.0.1:$metrics_port"
+  --shutdown-grace 0s)
+start_server "${plain_flags[@]}"
 
 # The liver through the server and in-process: the same report figures.
 "$labelmesh" submit "$data/liver.inr.gz" --labels 255 --out "$work/remote" --json \
@@ -95,6 +100,45 @@ head -c 5000 /dev/urandom >"$work/noise.nii"
 [ $? -eq 3 ] || fail "submit of a bad volume should exit 3"
 set -e
 grep -q "noise" "$work/server.log" && fail "the server log names an uploaded file"
+
+# The metrics endpoint of the same labelmeshd that runs the jobs counts them.
+metrics=$(curl -sf "http://127.0.0.1:$metrics_port/metrics") || fail "no /metrics"
+/usr/bin/python3 - "$metrics" <<'PY' || fail "metrics do not count the jobs"
+import sys
+samples = {}
+for line in sys.argv[1].splitlines():
+    if line and not line.startswith("#"):
+        name, value = line.rsplit(" ", 1)
+        samples[name] = float(value)
+print({k: v for k, v in samples.items() if k.startswith(("labelmesh_jobs", "labelmesh_rej"))})
+assert samples['labelmesh_jobs_total{outcome="succeeded"}'] == 2
+assert samples["labelmesh_jobs_running"] == 0
+# The noise upload was refused at its header, before it became a job.
+assert sum(v for k, v in samples.items() if k.startswith("labelmesh_rejections_total")) == 1
+PY
+
+# A job interrupted by a restart: SIGTERM (no grace) stops it while it runs,
+# the next labelmeshd on the same spool runs it again, and `labelmesh watch`,
+# started before the restart, reconnects and exits 0 when it succeeds.
+"$labelmesh" phantom sphere --scale 4 --out "$work/sphere.nii.gz" >/dev/null
+job=$("$labelmesh" submit "$work/sphere.nii.gz" --volume tet --detach --json |
+  /usr/bin/python3 -c 'import json,sys; print(json.load(sys.stdin)["job_id"])')
+"$labelmesh" watch "$job" >"$work/watch.txt" 2>&1 &
+watch_pid=$!
+state=
+for _ in $(seq 200); do
+  state=$("$labelmesh" status "$job" --json) || fail "status exited $?"
+  grep -q '"state": "JOB_STATE_RUNNING"' <<<"$state" && break
+  sleep 0.05
+done
+grep -q '"state": "JOB_STATE_RUNNING"' <<<"$state" || fail "the sphere job never ran"
+stop_server
+kill -0 "$watch_pid" 2>/dev/null || fail "watch ended with the server"
+start_server "${plain_flags[@]}"
+wait "$watch_pid" || fail "watch across the restart exited $?: $(tail -3 "$work/watch.txt")"
+state=$("$labelmesh" status "$job" --json) || fail "status exited $?"
+grep -q '"state": "JOB_STATE_SUCCEEDED"' <<<"$state" || fail "the restarted job did not succeed"
+grep -q "spool: 1 jobs queued again" "$work/server.log" || fail "the log does not say the job was queued again"
 stop_server
 
 # TLS and a bearer token: refused without the token, served with it.

@@ -1,11 +1,12 @@
 // The service's contract, in-process: every RPC, its status codes, and what
-// the spool holds afterwards. Jobs run in real labelmesh-worker processes.
+// the spool holds afterwards. Jobs run in real worker processes (labelmeshd --worker).
 #include <gtest/gtest.h>
 
 #include <chrono>
 #include <thread>
 
 #include "absl/strings/match.h"
+#include "core/volume/label_volume.h"
 #include "core/volume/phantom.h"
 #include "core/volume/write_label_volume.h"
 #include "server/metrics.h"
@@ -101,6 +102,11 @@ TEST_F(MeshingServiceTest, WholeJobFromUploadToFetchedArtifacts) {
   EXPECT_EQ(job.state(), v1::JOB_STATE_SUCCEEDED);
   EXPECT_EQ(job.attempts(), 1u);
   EXPECT_DOUBLE_EQ(job.progress(), 1.0);
+  // The job was submitted with every option left unset; GetJob shows the
+  // options it ran with, the same the report prints.
+  EXPECT_EQ(job.options().DebugString(), report.options().DebugString());
+  EXPECT_EQ(job.options().volume(), v1::VOLUME_METHOD_NONE);
+  EXPECT_EQ(job.options().min_angle_deg(), 30);
 
   auto ctx = service.context();
   v1::ListArtifactsRequest list_request;
@@ -150,6 +156,45 @@ TEST_F(MeshingServiceTest, FullQueueRefusesWithResourceExhausted) {
   EXPECT_NE(
       service.server().metrics().text().find("labelmesh_rejections_total{reason=\"queue_full\"} 1"),
       std::string::npos);
+}
+
+// A volume the size of a CT series: 400^3 one-byte voxels, 64 MB as an
+// uncompressed NIfTI file, in 1 MiB chunks. It arrives whole and meshes.
+TEST_F(MeshingServiceTest, UploadOverFiftyMegabytesArrivesWhole) {
+  constexpr int kSide = 400, kRadius = 20;
+  volume::LabelVolume big;
+  big.file_voxel_type = "uint8";
+  big.geometry.dims = {kSide, kSide, kSide};
+  big.voxels = vtkSmartPointer<vtkImageData>::New();
+  big.voxels->SetDimensions(kSide, kSide, kSide);
+  big.voxels->AllocateScalars(VTK_UNSIGNED_CHAR, 1);
+  auto* voxel = static_cast<uint8_t*>(big.voxels->GetScalarPointer());
+  int64_t ball_voxels = 0;
+  for (int z = 0; z < kSide; ++z) {
+    for (int y = 0; y < kSide; ++y) {
+      for (int x = 0; x < kSide; ++x) {
+        const int dx = x - 150, dy = y - 200, dz = z - 250;
+        const bool inside = dx * dx + dy * dy + dz * dz <= kRadius * kRadius;
+        ball_voxels += inside;
+        *voxel++ = inside ? 1 : 0;
+      }
+    }
+  }
+  const fs::path input = dir_ / "big.nii";
+  ASSERT_TRUE(volume::write_label_volume(big, input.string()).ok());
+  ASSERT_GT(fs::file_size(input), 64'000'000u);
+
+  ServiceHarness service(config_);
+  v1::SubmitReply reply;
+  ASSERT_TRUE(service.submit(input, repaired_options(), &reply).ok());
+  EXPECT_EQ(uploads_left(), 0u);
+  const auto events = service.watch(reply.job_id());
+  ASSERT_TRUE(events.back().has_finished()) << events.back().DebugString();
+  const v1::Report& report = events.back().finished().report();
+  ASSERT_EQ(report.input().dims_size(), 3);
+  EXPECT_EQ(report.input().dims(2), kSide);
+  ASSERT_EQ(report.input().labels_size(), 1);
+  EXPECT_EQ(report.input().labels(0).voxels(), ball_voxels);
 }
 
 TEST_F(MeshingServiceTest, BrokenUploadsAreRefusedAndLeaveNothing) {
