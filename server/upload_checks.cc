@@ -43,14 +43,8 @@ absl::Status check_spec(const v1::JobSpec& spec, const ServerConfig& config) {
 absl::Status check_uploaded_volume(const std::string& path, uint64_t max_voxels) {
   volume::ReadLimits limits;
   limits.max_voxels = max_voxels;
-  auto header = volume::check_volume_header(path, limits);
-  absl::Status status = header.status();
-  if (status.ok() && header->data_path != path) {
-    status = absl::InvalidArgumentError(
-        absl::StrCat(path,
-                     ": the header names a separate data file; upload a format that holds "
-                     "its voxels (.nii, .mha, .nrrd with attached data)"));
-  }
+  limits.allow_data_file = false;
+  absl::Status status = volume::check_volume_header(path, limits).status();
   if (status.ok()) return status;
   return absl::Status(status.code(), absl::StrReplaceAll(status.message(), {{path, "upload"}}));
 }

@@ -14,6 +14,11 @@
 
 namespace labelmesh::volume::internal {
 
+// The problem named when ReadLimits::allow_data_file is false.
+inline constexpr std::string_view kNoDataFileHere =
+    "a separate data file is not accepted here; send a file that holds its voxels "
+    "(.nii, .mha, .nrrd with attached data)";
+
 // INVALID_ARGUMENT "<file>: <field>: <problem>".
 absl::Status field_error(std::string_view path, std::string_view field, std::string_view problem);
 

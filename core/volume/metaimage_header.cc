@@ -126,6 +126,9 @@ absl::StatusOr<VolumeHeader> check_metaimage_header(const std::string& path,
     header.data_path = path;
     header.file_offset = h.size;
   } else {
+    if (!limits.allow_data_file) {
+      return field_error(path, "ElementDataFile", kNoDataFileHere);
+    }
     if (data_file.substr(0, 4) == "LIST" || contains(data_file, "%")) {
       return field_error(path, "ElementDataFile", "lists of slice files are not supported");
     }

@@ -182,6 +182,7 @@ absl::StatusOr<VolumeHeader> check_nrrd_header(const std::string& path, const Re
   auto data_file = h.find("data file");
   if (!data_file) data_file = h.find("datafile");
   if (data_file) {
+    if (!limits.allow_data_file) return field_error(path, "data file", kNoDataFileHere);
     if (std::string_view(*data_file).starts_with("LIST") || contains(*data_file, " ") ||
         contains(*data_file, "%")) {
       return field_error(path, "data file", "lists of data files are not supported");

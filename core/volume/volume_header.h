@@ -38,6 +38,10 @@ struct ReadLimits {
   uint64_t max_voxels = uint64_t{1} << 31;
   // Text headers (MetaImage, NRRD, INR, VTI) longer than this are refused, bytes.
   uint64_t max_header_bytes = uint64_t{1} << 16;
+  // False refuses headers that name a separate data file (MetaImage
+  // ElementDataFile, NRRD "data file") before that file is looked for, so an
+  // untrusted header cannot probe which paths exist.
+  bool allow_data_file = true;
 };
 
 // Everything the readers need, taken from a header that passed every check.

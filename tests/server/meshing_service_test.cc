@@ -6,6 +6,7 @@
 #include <thread>
 
 #include "absl/strings/match.h"
+#include "absl/strings/str_cat.h"
 #include "core/volume/label_volume.h"
 #include "core/volume/phantom.h"
 #include "core/volume/write_label_volume.h"
@@ -226,6 +227,18 @@ TEST_F(MeshingServiceTest, BrokenUploadsAreRefusedAndLeaveNothing) {
   v1::JobSpec detached = good;
   detached.set_file_name("scan.mhd");
   expect_invalid(detached, bytes, "spec.file_name");
+  // A NRRD header naming a separate data file is refused the same way whether
+  // or not that file exists: uploads cannot probe the server's disk.
+  for (const std::string data_file : {"job.pb", "no-such-file.raw"}) {
+    const std::string nrrd = absl::StrCat(
+        "NRRD0004\ntype: uint8\ndimension: 3\nsizes: 2 2 2\nencoding: raw\ndata file: ", data_file,
+        "\n\n");
+    v1::JobSpec spec = good;
+    spec.set_file_name("scan.nrrd");
+    spec.set_size_bytes(nrrd.size());
+    spec.set_sha256(digest::sha256_hex(nrrd));
+    expect_invalid(spec, nrrd, "upload: data file: a separate data file is not accepted here");
+  }
   v1::JobSpec bad_option = good;
   bad_option.mutable_options()->set_min_angle_deg(45);
   expect_invalid(bad_option, bytes, "spec.options");
