@@ -117,6 +117,9 @@ absl::StatusOr<MeshResult> run_pipeline(const std::string& path, const MeshParam
       context.report("tet_improve", 0);
       volume_mesh::ImproveParams improve = params.improve;
       improve.max_volume_mm3 = params.tetgen.max_volume_mm3;
+      // Peeling may move the surface as far as Poisson meshing may.
+      improve.max_peel_depth_mm =
+          params.poisson.max_distance_voxels * voxel_size_mm(volume->geometry);
       if (auto s = improve_volume(*tets, improve, context); !s.ok()) return s;
     }
     result.volume = std::move(*tets);

@@ -179,6 +179,9 @@ v1::VolumeMeshSummary make_volume_summary(const VolumeResult& volume) {
     improvement->set_flips_3_2(figures.flips_3_2);
     improvement->set_vertices_moved(figures.vertices_moved);
     improvement->set_vertices_inserted(figures.vertices_inserted);
+    improvement->set_slivers_peeled(figures.slivers_peeled);
+    improvement->set_peeled_volume_mm3(figures.peeled_volume_mm3);
+    improvement->set_peel_depth_mm(figures.peel_depth_mm);
     improvement->set_seconds(figures.seconds);
   }
   for (const auto& file : volume.files) entry.add_files(file);

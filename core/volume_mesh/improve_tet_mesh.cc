@@ -22,14 +22,18 @@ constexpr double kNone = std::numeric_limits<double>::infinity();
 // them dead, and each point knows the live tetrahedra around it.
 class WorkMesh {
  public:
-  WorkMesh(TetMesh& mesh, double max_volume)
-      : max_volume(max_volume), mesh_(mesh), star_(mesh.points.size()) {
+  WorkMesh(TetMesh& mesh, const ImproveParams& params)
+      : max_volume(params.max_volume_mm3),
+        max_peel_depth(params.max_peel_depth_mm),
+        mesh_(mesh),
+        star_(mesh.points.size()) {
     tets_.reserve(mesh.tetrahedra.size() + mesh.tetrahedra.size() / 8);
     for (size_t t = 0; t < mesh.tetrahedra.size(); ++t) add(mesh.tetrahedra[t], mesh.labels[t]);
     mark_boundary_points();
   }
 
-  const double max_volume;  // 0: no bound
+  const double max_volume;      // 0: no bound
+  const double max_peel_depth;  // 0: no peeling
 
   size_t size() const { return tets_.size(); }
   bool alive(uint32_t t) const { return alive_[t]; }
@@ -56,6 +60,12 @@ class WorkMesh {
   void remove(uint32_t t) {
     alive_[t] = false;
     for (uint32_t v : tets_[t]) std::erase(star_[v], t);
+  }
+
+  // Undoes remove(t): t keeps its id, so callers' handles stay valid.
+  void revive(uint32_t t) {
+    alive_[t] = true;
+    for (uint32_t v : tets_[t]) star_[v].push_back(t);
   }
 
   void requalify(uint32_t t) { quality_[t] = quality_of(tets_[t]); }
@@ -351,8 +361,6 @@ bool insert_in_cavity(WorkMesh& w, uint32_t t, std::vector<uint32_t> cavity,
 
   const double old_lowest = lowest_quality(w, cavity);
   const double old_volume = total_volume(w, cavity);
-  std::vector<Tet> old_tets;
-  for (uint32_t c : cavity) old_tets.push_back(w.tet(c));
 
   // The first start inside the cavity's kernel (every new tetrahedron
   // positive, the volume unchanged), going deeper below t's surface faces.
@@ -382,7 +390,7 @@ bool insert_in_cavity(WorkMesh& w, uint32_t t, std::vector<uint32_t> cavity,
   const std::vector<uint32_t> added = w.star(p);
   for (uint32_t a : added) w.remove(a);
   w.drop_last_point();
-  for (const Tet& old : old_tets) w.add(old, label);
+  for (uint32_t c : cavity) w.revive(c);
   return false;
 }
 
@@ -407,6 +415,57 @@ bool insert_vertex(WorkMesh& w, uint32_t t, ImproveFigures& figures) {
   return insert_in_cavity(w, t, around, figures);
 }
 
+// True when some outer face (one with no tetrahedron across it) other than
+// t's has the edge c-d.
+bool edge_on_outer_face(const WorkMesh& w, uint32_t t, uint32_t c, uint32_t d) {
+  for (uint32_t s : w.star(c)) {
+    if (s == t || !w.has(s, d)) continue;
+    for (uint32_t x : w.tet(s)) {
+      if (x != c && x != d && !w.across(s, c, d, x)) return true;
+    }
+  }
+  return false;
+}
+
+// Peels sliver t = a,b,c,d off the surface when its faces a,b,c and a,b,d
+// are outer faces folding over edge a-b and its faces a,c,d and b,c,d border
+// tetrahedra of its label: those two faces become the surface, folding over
+// c-d instead. It is refused when c-d is already an edge of the surface (the
+// surface would stop being a manifold there) or when the sliver is thicker
+// than the peel depth, measured between its edges a-b and c-d.
+bool peel_sliver(WorkMesh& w, uint32_t t, ImproveFigures& figures) {
+  if (!(w.max_peel_depth > 0) ||
+      quality::categorize(w.quality(t)) == quality::QualityCategory::kGood) {
+    return false;
+  }
+  const Tet k = w.tet(t);
+  std::vector<uint32_t> on_outer_faces, on_inner_faces;
+  for (uint8_t across = 0; across < 4; ++across) {
+    const auto [x, y, z] = inward_face(k, across);
+    const auto neighbour = w.across(t, x, y, z);
+    // The point opposite an outer face is on the other outer face only.
+    if (!neighbour) {
+      on_outer_faces.push_back(k[across]);
+    } else if (w.label(*neighbour) == w.label(t)) {
+      on_inner_faces.push_back(k[across]);
+    }
+  }
+  if (on_outer_faces.size() != 2 || on_inner_faces.size() != 2) return false;
+  const uint32_t a = on_inner_faces[0], b = on_inner_faces[1];
+  const uint32_t c = on_outer_faces[0], d = on_outer_faces[1];
+  if (edge_on_outer_face(w, t, c, d)) return false;
+  const double volume = w.volume_of(k);
+  const Vec3 across_edges =
+      geometry::cross(geometry::sub(w.point(b), w.point(a)), geometry::sub(w.point(d), w.point(c)));
+  const double depth = 6 * volume / geometry::norm(across_edges);
+  if (!(depth <= w.max_peel_depth)) return false;
+  w.remove(t);
+  ++figures.slivers_peeled;
+  figures.peeled_volume_mm3 += volume;
+  figures.peel_depth_mm = std::max(figures.peel_depth_mm, depth);
+  return true;
+}
+
 // One attempt to lift tetrahedron t: flips first (they change the
 // connectivity that smoothing cannot), then its interior points.
 bool improve_around(WorkMesh& w, uint32_t t, ImproveFigures& figures) {
@@ -422,7 +481,7 @@ bool improve_around(WorkMesh& w, uint32_t t, ImproveFigures& figures) {
   bool moved = false;
   for (uint32_t v : k) moved |= smooth_vertex(w, v, figures);
   if (moved) return true;
-  return insert_vertex(w, t, figures);
+  return insert_vertex(w, t, figures) || peel_sliver(w, t, figures);
 }
 
 }  // namespace
@@ -431,7 +490,7 @@ absl::Status improve_tet_mesh(TetMesh& mesh, const ImproveParams& params, const 
                               ImproveFigures& figures) {
   const auto start = std::chrono::steady_clock::now();
   figures = ImproveFigures{};
-  WorkMesh w(mesh, params.max_volume_mm3);
+  WorkMesh w(mesh, params);
   auto lowest_alive = [&w] {
     double lowest = kNone;
     for (uint32_t t = 0; t < w.size(); ++t) {

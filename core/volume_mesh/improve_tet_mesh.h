@@ -21,6 +21,9 @@ struct ImproveParams {
   // No operation makes a tetrahedron larger than this (mm³) and larger than
   // those it replaces; 0 for no bound. The pipeline passes TetGen's -a bound.
   double max_volume_mm3 = 0;
+  // How far (mm) peeling a sliver off the surface may move it; 0 turns
+  // peeling off. The pipeline passes the Poisson surface's distance bound.
+  double max_peel_depth_mm = 0;
 };
 
 struct ImproveFigures {
@@ -30,16 +33,24 @@ struct ImproveFigures {
   size_t flips_3_2 = 0;          // edge with three tetrahedra around it removed, leaving two
   size_t vertices_moved = 0;     // accepted smoothing moves of interior vertices
   size_t vertices_inserted = 0;  // points added inside a bad tetrahedron's neighbourhood
+  size_t slivers_peeled = 0;     // questionable slivers with two surface faces removed
+  double peeled_volume_mm3 = 0;  // the volume they held
+  double peel_depth_mm = 0;      // the deepest of them: how far the surface moved
   int sweeps = 0;
   double seconds = 0;
 };
 
-// Improves `mesh` in place. Boundary faces (faces only one tetrahedron has)
-// and the points on them never change, and no tetrahedron changes label:
-// flips and insertions only replace tetrahedra of one label inside the region
-// they fill, and smoothing moves only points no boundary face uses. Every operation is kept
-// only if it raises the lowest Q among the tetrahedra it replaces, so the
-// worst element never gets worse, and none becomes inverted.
+// Improves `mesh` in place. Points on boundary faces (faces only one
+// tetrahedron has) never move, and no tetrahedron changes label: flips and
+// insertions only replace tetrahedra of one label inside the region they
+// fill, and smoothing moves only points no boundary face uses. Every
+// operation is kept only if it raises the lowest Q among the tetrahedra it
+// replaces, so the worst element never gets worse, and none becomes inverted.
+//
+// The one exception to a fixed boundary is peeling: a questionable sliver
+// (Q <= 0.2) that nothing else lifts, whose two outer surface faces fold over
+// an edge, is removed when it is no thicker than `max_peel_depth_mm`. The
+// surface then runs over its other two faces, through the same points.
 //
 // Existing points keep their order (inserted points are appended);
 // tetrahedra are renumbered.

@@ -1,6 +1,6 @@
 // The improvement pass on meshes built to need one operation each: a 3-2 flip,
-// a 2-3 flip, smoothing of an interior point, and that the boundary and the
-// region never change.
+// a 2-3 flip, smoothing of an interior point, peeling a sliver off the
+// surface; and that otherwise the boundary and the region never change.
 #include "core/volume_mesh/improve_tet_mesh.h"
 
 #include <gtest/gtest.h>
@@ -136,6 +136,49 @@ TEST(ImproveTetMesh, SmoothingLiftsTheWorstElementAndKeepsTheBoundary) {
   for (uint32_t v = 0; v < boundary_before.size(); ++v) {
     if (v != 13u) EXPECT_EQ(m.points[v], boundary_before[v]) << "point " << v;
   }
+}
+
+// A flat sliver a,b,c,d of label 3: its faces a,b,c and a,b,d are the
+// surface, a low roof over the edge c-d. Below, tetrahedra b,e,c,d (label
+// 3), e,f,c,d (label 4) and f,a,c,d (label 3) close the ring around c-d.
+// Label 3 wraps 300 degrees around c-d, so a point inserted in it has to sit
+// under the low roof, and no point insertion lifts the sliver.
+TetMesh roof_sliver(double height) {
+  TetMesh m;
+  m.points = {{1, -1, height}, {1, 1, height},  {0, 0, 0},
+              {2, 0, 0},       {1, 0.75, -1.3}, {1, -0.75, -1.3}};
+  const uint32_t a = 0, b = 1, c = 2, d = 3, e = 4, f = 5;
+  add_positive(m, {a, b, c, d}, 3);
+  add_positive(m, {b, e, c, d}, 3);
+  add_positive(m, {e, f, c, d}, 4);
+  add_positive(m, {f, a, c, d}, 3);
+  return m;
+}
+
+TEST(ImproveTetMesh, ASliverUnderTheSurfaceIsPeeledWithinTheDepthBound) {
+  TetMesh m = roof_sliver(0.1);
+  const double volume = total_volume(m);
+  const double sliver_volume = signed_volume(m, 0);
+  ASSERT_LT(lowest_quality(m), 0.2);
+  ImproveFigures figures;
+  // Deeper than the bound: the sliver stays.
+  ASSERT_TRUE(improve_tet_mesh(m, {.max_peel_depth_mm = 0.05}, RunContext{}, figures).ok());
+  EXPECT_EQ(figures.slivers_peeled, 0u);
+  EXPECT_LT(lowest_quality(m), 0.2);
+  EXPECT_EQ(m.tetrahedra.size(), 4u);
+
+  m = roof_sliver(0.1);
+  ASSERT_TRUE(improve_tet_mesh(m, {.max_peel_depth_mm = 0.2}, RunContext{}, figures).ok());
+  EXPECT_EQ(figures.slivers_peeled, 1u);
+  EXPECT_EQ(m.tetrahedra.size(), 3u);
+  EXPECT_GT(lowest_quality(m), 0.2);
+  // The sliver is 0.1 thick between its edges a-b and c-d.
+  EXPECT_NEAR(figures.peel_depth_mm, 0.1, 1e-12);
+  EXPECT_NEAR(figures.peeled_volume_mm3, sliver_volume, 1e-12);
+  EXPECT_NEAR(total_volume(m), volume - sliver_volume, 1e-12);
+  EXPECT_EQ(m.points.size(), 6u);
+  EXPECT_EQ(m.labels, (std::vector<int32_t>{3, 4, 3}));
+  EXPECT_TRUE(check_tet_mesh(m).ok());
 }
 
 TEST(ImproveTetMesh, AGoodMeshIsLeftAlone) {
