@@ -10,6 +10,7 @@
 #include <CGAL/Polygon_mesh_processing/polygon_soup_to_polygon_mesh.h>
 #include <CGAL/Surface_mesh.h>
 
+#include "core/surface/surface_statistics.h"
 #include "core/surface/triangle_mesh.h"
 
 namespace labelmesh::surface::cgal {
@@ -29,7 +30,7 @@ inline std::vector<Point> to_points(const TriangleMesh& mesh) {
 // edge or vertex, or inconsistent orientation).
 inline std::optional<Mesh> to_surface_mesh(const TriangleMesh& mesh) {
   namespace PMP = CGAL::Polygon_mesh_processing;
-  if (!PMP::is_polygon_soup_a_polygon_mesh(mesh.triangles)) return std::nullopt;
+  if (!is_oriented_manifold(mesh)) return std::nullopt;
   Mesh result;
   PMP::polygon_soup_to_polygon_mesh(to_points(mesh), mesh.triangles, result);
   return result;

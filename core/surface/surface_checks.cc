@@ -35,24 +35,49 @@ Triangles to_triangles(const TriangleMesh& mesh) {
   return triangles;
 }
 
-// Every vertex of `mesh`, plus, on triangles longer than `spacing`, the points
-// of a barycentric grid whose neighbours are no further apart than `spacing`.
+Point mix(const geometry::Vec3& a, double u, const geometry::Vec3& b, double v,
+          const geometry::Vec3& c, double w) {
+  return Point(u * a[0] + v * b[0] + w * c[0], u * a[1] + v * b[1] + w * c[1],
+               u * a[2] + v * b[2] + w * c[2]);
+}
+
+// Points on `mesh` no further than about `spacing` from their neighbours:
+// every vertex; evenly spaced points along each edge longer than `spacing`,
+// once per edge (not once per triangle: on Marching Cubes surfaces, where
+// most edges just pass the spacing, that sampled each midpoint twice); and
+// the points strictly inside each triangle of a barycentric grid of
+// `spacing`.
 std::vector<Point> sample_points(const TriangleMesh& mesh, double spacing) {
   std::vector<Point> samples = cgal::to_points(mesh);
+  auto steps_along = [spacing](const geometry::Vec3& a, const geometry::Vec3& b) {
+    return static_cast<int>(std::ceil(geometry::norm(geometry::sub(a, b)) / spacing));
+  };
+  std::vector<uint64_t> edges;
+  edges.reserve(3 * mesh.triangles.size());
+  for (const auto& t : mesh.triangles) {
+    for (int e = 0; e < 3; ++e) {
+      const uint32_t a = t[e], b = t[(e + 1) % 3];
+      edges.push_back(uint64_t{std::min(a, b)} << 32 | std::max(a, b));
+    }
+  }
+  std::sort(edges.begin(), edges.end());
+  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+  for (uint64_t edge : edges) {
+    const auto& a = mesh.points[edge >> 32];
+    const auto& b = mesh.points[edge & 0xffffffffu];
+    const int steps = steps_along(a, b);
+    for (int i = 1; i < steps; ++i) {
+      const double u = double(i) / steps;
+      samples.push_back(mix(a, 1 - u, b, u, b, 0));
+    }
+  }
   for (const auto& t : mesh.triangles) {
     const auto &a = mesh.points[t[0]], &b = mesh.points[t[1]], &c = mesh.points[t[2]];
-    const double longest =
-        std::max({geometry::norm(geometry::sub(a, b)), geometry::norm(geometry::sub(b, c)),
-                  geometry::norm(geometry::sub(c, a))});
-    const int steps = static_cast<int>(std::ceil(longest / spacing));
-    if (steps < 2) continue;
-    for (int i = 0; i <= steps; ++i) {
-      for (int j = 0; i + j <= steps; ++j) {
+    const int steps = std::max({steps_along(a, b), steps_along(b, c), steps_along(c, a)});
+    for (int i = 1; i < steps; ++i) {
+      for (int j = 1; i + j < steps; ++j) {
         const int k = steps - i - j;
-        if ((i == steps) || (j == steps) || (k == steps)) continue;  // the corners
-        const double u = double(i) / steps, v = double(j) / steps, w = double(k) / steps;
-        samples.emplace_back(u * a[0] + v * b[0] + w * c[0], u * a[1] + v * b[1] + w * c[1],
-                             u * a[2] + v * b[2] + w * c[2]);
+        samples.push_back(mix(a, double(i) / steps, b, double(j) / steps, c, double(k) / steps));
       }
     }
   }

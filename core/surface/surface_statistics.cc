@@ -91,6 +91,18 @@ uint32_t count_non_manifold_vertices(const TriangleMesh& mesh) {
 
 }  // namespace
 
+bool is_oriented_manifold(const TriangleMesh& mesh) {
+  std::vector<uint64_t> directed;
+  directed.reserve(3 * mesh.triangles.size());
+  for (const auto& t : mesh.triangles) {
+    if (t[0] == t[1] || t[1] == t[2] || t[2] == t[0]) return false;
+    for (int e = 0; e < 3; ++e) directed.push_back(uint64_t{t[e]} << 32 | t[(e + 1) % 3]);
+  }
+  std::sort(directed.begin(), directed.end());
+  if (std::adjacent_find(directed.begin(), directed.end()) != directed.end()) return false;
+  return count_non_manifold_vertices(mesh) == 0;
+}
+
 double signed_volume(const TriangleMesh& mesh) {
   const Vec o = centre_of(mesh);
   double six_volume = 0;

@@ -54,7 +54,8 @@ TEST(SurfaceStatistics, FinOnAnEdgeIsNonManifold) {
   EXPECT_FALSE(s.manifold);
 }
 
-TEST(SurfaceStatistics, TwoTetrahedraSharingAVertexMakeABowtie) {
+// Two tetrahedra touching at one vertex.
+TriangleMesh bowtie() {
   auto m = tetrahedron();
   const auto other = tetrahedron(-1);  // its vertex 1 is (0,0,0) = our vertex 0
   const uint32_t base = static_cast<uint32_t>(m.points.size());
@@ -63,11 +64,33 @@ TEST(SurfaceStatistics, TwoTetrahedraSharingAVertexMakeABowtie) {
     for (auto& v : t) v = v == 1 ? 0 : v + base;
     m.triangles.push_back(t);
   }
-  const auto s = compute_surface_statistics(m);
+  return m;
+}
+
+TEST(SurfaceStatistics, TwoTetrahedraSharingAVertexMakeABowtie) {
+  const auto s = compute_surface_statistics(bowtie());
   EXPECT_EQ(s.non_manifold_vertices, 1u);
   EXPECT_EQ(s.non_manifold_edges, 0u);
   EXPECT_FALSE(s.manifold);
   EXPECT_EQ(s.components, 1u);
+}
+
+TEST(SurfaceStatistics, OrientedManifoldNeedsOneWindingAndOneFanPerPoint) {
+  EXPECT_TRUE(is_oriented_manifold(tetrahedron()));
+  auto open = tetrahedron();
+  open.triangles.pop_back();
+  EXPECT_TRUE(is_oriented_manifold(open));  // a boundary is allowed
+  auto flipped = tetrahedron();
+  std::swap(flipped.triangles[3][0], flipped.triangles[3][1]);
+  EXPECT_FALSE(is_oriented_manifold(flipped));
+  auto fin = tetrahedron();
+  fin.points.push_back({0.5, -1, 0});
+  fin.triangles.push_back({1, 0, 4});
+  EXPECT_FALSE(is_oriented_manifold(fin));
+  EXPECT_FALSE(is_oriented_manifold(bowtie()));
+  auto degenerate = tetrahedron();
+  degenerate.triangles.push_back({2, 3, 2});
+  EXPECT_FALSE(is_oriented_manifold(degenerate));
 }
 
 TEST(SurfaceStatistics, SliverTriangleAngles) {
