@@ -61,8 +61,12 @@ class EventPrinter {
   TerminalProgress live_;
 };
 
+// UNAVAILABLE: the server is down or on its way down. CANCELLED: a server
+// that shuts down cancels the streams still open (this client never cancels
+// its own watch).
 bool worth_retrying(const grpc::Status& status) {
-  return status.error_code() == grpc::StatusCode::UNAVAILABLE;
+  return status.error_code() == grpc::StatusCode::UNAVAILABLE ||
+         status.error_code() == grpc::StatusCode::CANCELLED;
 }
 
 }  // namespace

@@ -133,7 +133,7 @@ for _ in $(seq 200); do
 done
 grep -q '"state": "JOB_STATE_RUNNING"' <<<"$state" || fail "the sphere job never ran"
 stop_server
-kill -0 "$watch_pid" 2>/dev/null || fail "watch ended with the server"
+kill -0 "$watch_pid" 2>/dev/null || fail "watch ended with the server: $(cat "$work/watch.txt")"
 start_server "${plain_flags[@]}"
 wait "$watch_pid" || fail "watch across the restart exited $?: $(tail -3 "$work/watch.txt")"
 state=$("$labelmesh" status "$job" --json) || fail "status exited $?"
