@@ -86,6 +86,22 @@ WorkerOutcome outcome_of_exit(int wait_status) {
                 absl::StrCat("the worker exited with status ", code, " without a result"));
 }
 
+// Why the job must stop now, if it must: a cancel, a shutdown or the deadline.
+std::optional<WorkerOutcome> stop_requested(const WorkerRun& run) {
+  const StopRequest request = run.stop_request ? run.stop_request() : StopRequest::kNone;
+  if (request == StopRequest::kCancel) {
+    return WorkerOutcome{WorkerOutcome::Kind::kCancelled, 0, "", {}};
+  }
+  if (request == StopRequest::kShutdown) {
+    return WorkerOutcome{WorkerOutcome::Kind::kInterrupted, 0, "", {}};
+  }
+  if (absl::Now() >= run.deadline) {
+    return failed(absl::StatusCode::kDeadlineExceeded,
+                  "the job ran over the server's job time limit and was stopped");
+  }
+  return std::nullopt;
+}
+
 }  // namespace
 
 WorkerOutcome run_worker_process(const WorkerRun& run) {
@@ -144,17 +160,14 @@ WorkerOutcome run_worker_process(const WorkerRun& run) {
       }
     }
     if (stopped) break;
-    const StopRequest request = run.stop_request ? run.stop_request() : StopRequest::kNone;
-    if (request == StopRequest::kCancel) {
-      stopped = WorkerOutcome{WorkerOutcome::Kind::kCancelled, 0, "", {}};
-    } else if (request == StopRequest::kShutdown) {
-      stopped = WorkerOutcome{WorkerOutcome::Kind::kInterrupted, 0, "", {}};
-    } else if (absl::Now() >= run.deadline) {
-      stopped = failed(absl::StatusCode::kDeadlineExceeded,
-                       "the job ran over the server's job time limit and was stopped");
+    if (auto stop = stop_requested(run)) {
+      // An outcome the worker has already sent stands: a cancel or the
+      // deadline that arrives while it exits only stops it lingering.
+      if (!result) stopped = std::move(stop);
+      break;
     }
   }
-  if (stopped) ::kill(pid, SIGKILL);
+  if (open || stopped) ::kill(pid, SIGKILL);
   ::close(pipe_fds[0]);
   int wait_status = 0;
   while (waitpid(pid, &wait_status, 0) < 0 && errno == EINTR) {

@@ -1,6 +1,8 @@
 // The service's contract, in-process: every RPC, its status codes, and what
 // the spool holds afterwards. Jobs run in real worker processes (labelmeshd --worker).
+#include <fcntl.h>
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <chrono>
 #include <thread>
@@ -10,6 +12,7 @@
 #include "core/volume/label_volume.h"
 #include "core/volume/phantom.h"
 #include "core/volume/write_label_volume.h"
+#include "server/event_pipe.h"
 #include "server/metrics.h"
 #include "support/service_harness.h"
 
@@ -320,6 +323,38 @@ TEST_F(MeshingServiceTest, JobOverTheDeadlineFailsWithDeadlineExceeded) {
       << events.back().failed().message();
   const v1::Job job = service.get(reply.job_id());
   EXPECT_EQ(job.state(), v1::JOB_STATE_FAILED);
+  EXPECT_LT(job.finished_at() - job.started_at(), 2.5);
+}
+
+// A worker that sends its result and then lingers past the deadline (a
+// scripted stand-in for one slow to exit): the result it sent stands.
+TEST_F(MeshingServiceTest, AResultSentBeforeTheDeadlineStands) {
+  const fs::path events = dir_ / "finished.events";
+  {
+    v1::JobEvent finished;
+    finished.mutable_finished()->mutable_report()->set_labelmesh_version("scripted");
+    const int fd = ::open(events.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0600);
+    ASSERT_GE(fd, 0);
+    ASSERT_TRUE(server::write_event(fd, finished));
+    ::close(fd);
+  }
+  const fs::path lingering = dir_ / "lingering-worker.sh";
+  // Called as `lingering-worker.sh --worker JOB_DIR`.
+  write_file(lingering,
+             absl::StrCat("#!/bin/sh\nmkdir -p \"$2/out\"\necho '{}' >\"$2/out/report.json\"\n",
+                          "cat '", events.string(), "' >&3\nexec sleep 30\n"));
+  fs::permissions(lingering, fs::perms::owner_all);
+  config_.worker_executable = lingering.string();
+  config_.job_timeout = absl::Seconds(1);
+  ServiceHarness service(config_);
+  v1::SubmitReply reply;
+  ASSERT_TRUE(submit_sphere(service, &reply).ok());
+  const auto watched = service.watch(reply.job_id());
+  ASSERT_TRUE(watched.back().has_finished()) << watched.back().DebugString();
+  EXPECT_EQ(watched.back().finished().report().labelmesh_version(), "scripted");
+  const v1::Job job = service.get(reply.job_id());
+  EXPECT_EQ(job.state(), v1::JOB_STATE_SUCCEEDED);
+  // Stopped at the deadline, not left to sleep for 30 s.
   EXPECT_LT(job.finished_at() - job.started_at(), 2.5);
 }
 
