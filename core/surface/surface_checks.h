@@ -25,10 +25,11 @@ struct SurfaceDistance {
   std::array<double, 3> hausdorff_at{0, 0, 0};
 };
 
-// Symmetric distance between `a` and `b`, sampled at every vertex and on a
-// barycentric grid in every triangle longer than `sample_spacing_mm`, with
-// that spacing (deterministic; uses two threads). The Hausdorff figure is a lower bound that is
-// tight to within about the sample spacing times the surfaces' curvature.
+// Symmetric distance between `a` and `b`, sampled at every vertex, along
+// every edge longer than `sample_spacing_mm` and inside every triangle, no
+// more than about that far apart (deterministic; uses two threads). The
+// Hausdorff figure is a lower bound, within half the spacing of the true one
+// (distance to a surface changes no faster than the sample moves).
 SurfaceDistance surface_distance(const TriangleMesh& a, const TriangleMesh& b,
                                  double sample_spacing_mm);
 
