@@ -50,6 +50,18 @@ absl::StatusOr<VolumeSummary> summarise_volume(const std::string& path,
                        volume::compute_label_statistics(*volume)};
 }
 
+volume_mesh::ImproveParams improve_params_for(const MeshParams& params,
+                                              const volume::ImageGeometry& geometry) {
+  volume_mesh::ImproveParams improve = params.improve;
+  improve.max_volume_mm3 = params.tetgen.max_volume_mm3;
+  // Peeling may move a Poisson surface as far as its meshing may; other
+  // surfaces have no such tolerance and stay as they are.
+  if (params.surface == SurfaceMethod::kPoisson) {
+    improve.max_peel_depth_mm = params.poisson.max_distance_voxels * voxel_size_mm(geometry);
+  }
+  return improve;
+}
+
 absl::StatusOr<MeshResult> run_pipeline(const std::string& path, const MeshParams& params,
                                         const RunContext& context) {
   MeshResult result;
@@ -115,11 +127,7 @@ absl::StatusOr<MeshResult> run_pipeline(const std::string& path, const MeshParam
     {
       StageTimer timer(result.stages, "tet_improve");
       context.report("tet_improve", 0);
-      volume_mesh::ImproveParams improve = params.improve;
-      improve.max_volume_mm3 = params.tetgen.max_volume_mm3;
-      // Peeling may move the surface as far as Poisson meshing may.
-      improve.max_peel_depth_mm =
-          params.poisson.max_distance_voxels * voxel_size_mm(volume->geometry);
+      const auto improve = improve_params_for(params, volume->geometry);
       if (auto s = improve_volume(*tets, improve, context); !s.ok()) return s;
     }
     result.volume = std::move(*tets);

@@ -74,6 +74,12 @@ absl::StatusOr<VolumeSummary> summarise_volume(const std::string& path,
                                                const volume::ReadLimits& limits,
                                                const RunContext& context);
 
+// The improvement pass's settings for a run on a volume with `geometry`: the
+// options' target quality, TetGen's volume bound and, for Poisson surfaces,
+// the peel depth (the Poisson distance bound in mm).
+volume_mesh::ImproveParams improve_params_for(const MeshParams& params,
+                                              const volume::ImageGeometry& geometry);
+
 // Runs every stage on `path`. Errors: NOT_FOUND / INVALID_ARGUMENT for bad
 // input or options (naming the file and field), FAILED_PRECONDITION when the
 // volume holds nothing to mesh, CANCELLED, INTERNAL for a failed stage.

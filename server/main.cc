@@ -1,9 +1,11 @@
 // labelmeshd: the meshing service. Each job runs in a child labelmeshd
 // started in worker mode (`labelmeshd --worker JOB_DIR`).
+#include <fcntl.h>
 #include <signal.h>
 #include <CLI/CLI.hpp>
 
 #include <cstdio>
+#include <filesystem>
 #include <string_view>
 #include <thread>
 
@@ -104,8 +106,13 @@ sigset_t stop_signals() {
 
 int main(int argc, char** argv) {
   if (argc >= 2 && std::string_view(argv[1]) == labelmesh::server::kWorkerMode) {
-    if (argc != 3) {
-      std::fprintf(stderr, "usage: labelmeshd --worker JOB_DIR (started by labelmeshd)\n");
+    // Only labelmeshd starts this mode, with the event pipe as descriptor 3:
+    // refuse anything else (`--worker 4` typed for `--workers 4`, say).
+    if (argc != 3 || fcntl(3, F_GETFD) == -1 ||
+        !std::filesystem::is_regular_file(std::filesystem::path(argv[2]) / "job.pb")) {
+      std::fprintf(stderr,
+                   "labelmeshd --worker JOB_DIR is started by labelmeshd itself, with a job "
+                   "directory and an event pipe; did you mean --workers?\n");
       return 2;
     }
     return labelmesh::server::worker_main(argv[2], 3);

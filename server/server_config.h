@@ -46,7 +46,7 @@ struct ServerConfig {
   bool insecure = false;
 
   // The worker started as `<it> --worker JOB_DIR`; empty for this process's
-  // own executable (labelmeshd in worker mode).
+  // own executable (labelmeshd in worker mode), through /proc/self/exe.
   std::string worker_executable;
 
   bool tls() const { return !tls_cert.empty(); }

@@ -2,8 +2,6 @@
 
 #include <unistd.h>
 
-#include <filesystem>
-
 #include "absl/strings/str_cat.h"
 #include "server/worker_process.h"
 #include "spdlog/spdlog.h"
@@ -12,9 +10,10 @@ namespace labelmesh::server {
 
 WorkerPool::WorkerPool(JobTable& table, const Spool& spool, const ServerConfig& config)
     : table_(table), spool_(spool), config_(config) {
-  executable_ = config.worker_executable.empty()
-                    ? std::filesystem::read_symlink("/proc/self/exe").string()
-                    : config.worker_executable;
+  // /proc/self/exe is this very binary even after an upgrade has replaced
+  // the file on disk: workers match the server that starts them.
+  executable_ =
+      config.worker_executable.empty() ? std::string("/proc/self/exe") : config.worker_executable;
 }
 
 WorkerPool::~WorkerPool() { join(); }

@@ -132,38 +132,45 @@ WorkerOutcome run_worker_process(const WorkerRun& run) {
   std::optional<WorkerOutcome> stopped;
   char buffer[1 << 16];
   bool open = true;
-  while (open && !stopped) {
+  // Reads what the pipe holds, waiting up to `wait_ms` for it, and handles
+  // the events in it. False when nothing came.
+  auto read_events = [&](int wait_ms) {
     pollfd watch{pipe_fds[0], POLLIN, 0};
-    const int ready = poll(&watch, 1, 100);
-    if (ready > 0) {
-      const ssize_t n = ::read(pipe_fds[0], buffer, sizeof buffer);
-      if (n > 0) {
-        reader.append(buffer, static_cast<size_t>(n));
-      } else if (n == 0 || errno != EINTR) {
-        open = false;
+    if (poll(&watch, 1, wait_ms) <= 0) return false;
+    const ssize_t n = ::read(pipe_fds[0], buffer, sizeof buffer);
+    if (n > 0) {
+      reader.append(buffer, static_cast<size_t>(n));
+    } else if (n == 0 || errno != EINTR) {
+      open = false;
+    }
+    for (;;) {
+      auto event = reader.next();
+      if (!event.ok()) {
+        stopped = failed(absl::StatusCode::kInternal, std::string(event.status().message()));
+        return false;
       }
-      for (;;) {
-        auto event = reader.next();
-        if (!event.ok()) {
-          stopped = failed(absl::StatusCode::kInternal, std::string(event.status().message()));
-          break;
-        }
-        if (!event->has_value()) break;
-        v1::JobEvent& e = **event;
-        if (e.has_finished()) {
-          result = WorkerOutcome{WorkerOutcome::Kind::kSucceeded, 0, "", e.finished().report()};
-        } else if (e.has_failed()) {
-          result = failed(static_cast<absl::StatusCode>(e.failed().code()), e.failed().message());
-        } else if (run.on_event) {
-          run.on_event(std::move(e));
-        }
+      if (!event->has_value()) break;
+      v1::JobEvent& e = **event;
+      if (e.has_finished()) {
+        result = WorkerOutcome{WorkerOutcome::Kind::kSucceeded, 0, "", e.finished().report()};
+      } else if (e.has_failed()) {
+        result = failed(static_cast<absl::StatusCode>(e.failed().code()), e.failed().message());
+      } else if (run.on_event) {
+        run.on_event(std::move(e));
       }
     }
-    if (stopped) break;
+    return n > 0;
+  };
+  while (open && !stopped) {
+    read_events(100);
+    if (!open || stopped) break;
     if (auto stop = stop_requested(run)) {
-      // An outcome the worker has already sent stands: a cancel or the
-      // deadline that arrives while it exits only stops it lingering.
-      if (!result) stopped = std::move(stop);
+      // An outcome the worker has sent stands, even if it is still in the
+      // pipe: read what is there (a bounded amount) before deciding. A
+      // cancel or the deadline then only stops the worker lingering.
+      for (int reads = 0; reads < 64 && open && !stopped && !result && read_events(0); ++reads) {
+      }
+      if (!result && !stopped) stopped = std::move(stop);
       break;
     }
   }

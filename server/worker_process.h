@@ -52,8 +52,8 @@ WorkerOutcome run_worker_process(const WorkerRun& run);
 
 // The child's side: runs the pipeline on JOB_DIR/input<ext> into JOB_DIR/out
 // and writes events to `event_fd`. Returns the process exit code. Defined in
-// worker_main.cc, which only labelmeshd links, so that the server library
-// and its tests stay free of the core pipeline.
+// worker_main.cc, which only labelmeshd links: the server library itself
+// never calls the core pipeline.
 int worker_main(const std::string& job_dir, int event_fd);
 
 }  // namespace labelmesh::server

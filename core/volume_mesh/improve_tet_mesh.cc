@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 #include <optional>
+#include <unordered_set>
 #include <vector>
 
 #include "core/geometry/vec3.h"
@@ -41,6 +42,9 @@ class WorkMesh {
   int32_t label(uint32_t t) const { return labels_[t]; }
   double quality(uint32_t t) const { return quality_[t]; }
   bool fixed(uint32_t v) const { return fixed_[v]; }
+  // Points of slivers peeled off the surface so far.
+  bool peeled(uint32_t v) const { return peeled_.contains(v); }
+  void mark_peeled(uint32_t v) { peeled_.insert(v); }
   const std::vector<uint32_t>& star(uint32_t v) const { return star_[v]; }
   Vec3& point(uint32_t v) { return mesh_.points[v]; }
 
@@ -129,6 +133,7 @@ class WorkMesh {
   std::vector<double> quality_;
   std::vector<std::vector<uint32_t>> star_;
   std::vector<char> fixed_;
+  std::unordered_set<uint32_t> peeled_;
 };
 
 double lowest_quality(const WorkMesh& w, const std::vector<uint32_t>& tets) {
@@ -431,14 +436,19 @@ bool edge_on_outer_face(const WorkMesh& w, uint32_t t, uint32_t c, uint32_t d) {
 // are outer faces folding over edge a-b and its faces a,c,d and b,c,d border
 // tetrahedra of its label: those two faces become the surface, folding over
 // c-d instead. It is refused when c-d is already an edge of the surface (the
-// surface would stop being a manifold there) or when the sliver is thicker
-// than the peel depth, measured between its edges a-b and c-d.
+// surface would stop being a manifold there), when the sliver is thicker
+// than the peel depth, measured between its edges a-b and c-d, and when it
+// shares a point with a sliver peeled before: peels never stack, so nowhere
+// does the surface move further than the peel depth.
 bool peel_sliver(WorkMesh& w, uint32_t t, ImproveFigures& figures) {
   if (!(w.max_peel_depth > 0) ||
       quality::categorize(w.quality(t)) == quality::QualityCategory::kGood) {
     return false;
   }
   const Tet k = w.tet(t);
+  for (uint32_t v : k) {
+    if (w.peeled(v)) return false;
+  }
   std::vector<uint32_t> on_outer_faces, on_inner_faces;
   for (uint8_t across = 0; across < 4; ++across) {
     const auto [x, y, z] = inward_face(k, across);
@@ -460,6 +470,7 @@ bool peel_sliver(WorkMesh& w, uint32_t t, ImproveFigures& figures) {
   const double depth = 6 * volume / geometry::norm(across_edges);
   if (!(depth <= w.max_peel_depth)) return false;
   w.remove(t);
+  for (uint32_t v : k) w.mark_peeled(v);
   ++figures.slivers_peeled;
   figures.peeled_volume_mm3 += volume;
   figures.peel_depth_mm = std::max(figures.peel_depth_mm, depth);

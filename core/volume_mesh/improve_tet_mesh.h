@@ -22,7 +22,8 @@ struct ImproveParams {
   // those it replaces; 0 for no bound. The pipeline passes TetGen's -a bound.
   double max_volume_mm3 = 0;
   // How far (mm) peeling a sliver off the surface may move it; 0 turns
-  // peeling off. The pipeline passes the Poisson surface's distance bound.
+  // peeling off. The pipeline passes the Poisson surface's distance bound
+  // for Poisson surfaces and 0 for the others.
   double max_peel_depth_mm = 0;
 };
 
@@ -49,8 +50,10 @@ struct ImproveFigures {
 //
 // The one exception to a fixed boundary is peeling: a questionable sliver
 // (Q <= 0.2) that nothing else lifts, whose two outer surface faces fold over
-// an edge, is removed when it is no thicker than `max_peel_depth_mm`. The
-// surface then runs over its other two faces, through the same points.
+// an edge, is removed when it is no thicker than `max_peel_depth_mm` and
+// shares no point with a sliver peeled before. The surface then runs over its
+// other two faces, through the same points, and moves nowhere further than
+// that depth.
 //
 // Existing points keep their order (inserted points are appended);
 // tetrahedra are renumbered.

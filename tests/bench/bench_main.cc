@@ -199,10 +199,10 @@ int bench_tetrahedra(const std::string& path, const std::vector<int32_t>& labels
   const std::vector<double> before = volume.quality;
   const auto tetgen_summary = volume.summary;
   const auto start = Clock::now();
-  if (!labelmesh::improve_volume(volume, labelmesh::volume_mesh::ImproveParams{},
-                                 labelmesh::RunContext{})
-           .ok())
-    return 1;
+  labelmesh::MeshParams defaults;
+  defaults.labels = labels;
+  const auto improve = labelmesh::improve_params_for(defaults, result->input.geometry);
+  if (!labelmesh::improve_volume(volume, improve, labelmesh::RunContext{}).ok()) return 1;
   const double improve_seconds = seconds_since(start);
   const double ours = seconds_since(pipeline_start);
   const auto& s = volume.summary;
@@ -217,8 +217,11 @@ int bench_tetrahedra(const std::string& path, const std::vector<int32_t>& labels
       "(target Q >= 0.2, dihedral >= 10)\n",
       improve_seconds, volume.mesh.tetrahedra.size(), s.min, s.min_dihedral_deg,
       s.max_dihedral_deg);
-  std::printf("  flips 3-2 %zu, 2-3 %zu; points moved %zu, inserted %zu\n", f.flips_3_2,
-              f.flips_2_3, f.vertices_moved, f.vertices_inserted);
+  std::printf(
+      "  flips 3-2 %zu, 2-3 %zu; points moved %zu, inserted %zu; slivers peeled %zu (%.2f mm3, "
+      "%.2f mm deep)\n",
+      f.flips_3_2, f.flips_2_3, f.vertices_moved, f.vertices_inserted, f.slivers_peeled,
+      f.peeled_volume_mm3, f.peel_depth_mm);
   print_quality_histogram("tetgen", before);
   print_quality_histogram("improved", volume.quality);
   std::printf("  file to improved tetrahedra %8.3f s, peak RSS %.1f MiB\n", ours, peak_rss_mib());

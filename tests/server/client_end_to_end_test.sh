@@ -2,8 +2,8 @@
 # End to end through the real executables: labelmeshd on a free loopback port,
 # `labelmesh submit` of the liver compared with `labelmesh mesh` of the same
 # file and options, the job commands and their exit codes, the metrics
-# endpoint, `labelmesh watch` across a server restart, TLS with a token, and
-# SIGTERM shutdown.
+# endpoint, `labelmesh watch` across a server restart, TLS with a token,
+# mutual TLS, and SIGTERM shutdown.
 # Usage: client_end_to_end_test.sh LABELMESHD LABELMESH SHARED_DATA
 set -euo pipefail
 labelmeshd=$1 labelmesh=$2 data=$3

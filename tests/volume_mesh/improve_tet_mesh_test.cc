@@ -181,6 +181,15 @@ TEST(ImproveTetMesh, ASliverUnderTheSurfaceIsPeeledWithinTheDepthBound) {
   EXPECT_TRUE(check_tet_mesh(m).ok());
 }
 
+TEST(ImproveTetMesh, ASliverBorderingAnotherLabelIsNotPeeled) {
+  TetMesh m = roof_sliver(0.1);
+  m.labels[1] = 5;  // b,e,c,d: the sliver's face b,c,d is now an interface
+  ImproveFigures figures;
+  ASSERT_TRUE(improve_tet_mesh(m, {.max_peel_depth_mm = 0.2}, RunContext{}, figures).ok());
+  EXPECT_EQ(figures.slivers_peeled, 0u);
+  EXPECT_NEAR(total_volume(m), total_volume(roof_sliver(0.1)), 1e-12);
+}
+
 TEST(ImproveTetMesh, AGoodMeshIsLeftAlone) {
   TetMesh m = cube_with_displaced_centre();
   m.points[13] = {1, 1, 1};
