@@ -6,6 +6,7 @@
 
 #include <chrono>
 #include <thread>
+#include <tuple>
 
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
@@ -230,18 +231,30 @@ TEST_F(MeshingServiceTest, BrokenUploadsAreRefusedAndLeaveNothing) {
   v1::JobSpec detached = good;
   detached.set_file_name("scan.mhd");
   expect_invalid(detached, bytes, "spec.file_name");
-  // A NRRD header naming a separate data file is refused the same way whether
-  // or not that file exists: uploads cannot probe the server's disk.
-  for (const std::string data_file : {"job.pb", "no-such-file.raw"}) {
+  // A NRRD or MetaImage header naming a separate data file is refused the
+  // same way whether or not that file exists beside the upload (in the
+  // spool's uploads directory): uploads cannot probe the server's disk.
+  const fs::path existing = spool_ / "uploads" / "existing.raw";
+  write_file(existing, std::string(8, '\1'));
+  for (const std::string data_file : {"existing.raw", "no-such-file.raw"}) {
     const std::string nrrd = absl::StrCat(
         "NRRD0004\ntype: uint8\ndimension: 3\nsizes: 2 2 2\nencoding: raw\ndata file: ", data_file,
         "\n\n");
-    v1::JobSpec spec = good;
-    spec.set_file_name("scan.nrrd");
-    spec.set_size_bytes(nrrd.size());
-    spec.set_sha256(digest::sha256_hex(nrrd));
-    expect_invalid(spec, nrrd, "upload: data file: a separate data file is not accepted here");
+    const std::string mha = absl::StrCat(
+        "ObjectType = Image\nNDims = 3\nDimSize = 2 2 2\nElementType = MET_UCHAR\n"
+        "ElementDataFile = ",
+        data_file, "\n");
+    for (const auto& [name, header, field] :
+         {std::tuple{"scan.nrrd", nrrd, "data file"}, {"scan.mha", mha, "ElementDataFile"}}) {
+      v1::JobSpec spec = good;
+      spec.set_file_name(name);
+      spec.set_size_bytes(header.size());
+      spec.set_sha256(digest::sha256_hex(header));
+      expect_invalid(spec, header,
+                     absl::StrCat("upload: ", field, ": a separate data file is not accepted"));
+    }
   }
+  fs::remove(existing);
   v1::JobSpec bad_option = good;
   bad_option.mutable_options()->set_min_angle_deg(45);
   expect_invalid(bad_option, bytes, "spec.options");
