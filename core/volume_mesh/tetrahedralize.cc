@@ -26,7 +26,8 @@ namespace {
 
 using geometry::Vec3;
 
-constexpr std::string_view kStage = "tetrahedralize";
+// The pipeline times this work as its "tetgen" stage; progress says the same.
+constexpr std::string_view kStage = "tetgen";
 
 // The boundary as TetGen gets it: only the points some triangle uses, in input order.
 struct Boundary {

@@ -346,7 +346,7 @@ TEST(Tetrahedralize, StopRequestCancelsAndProgressReachesOne) {
   std::vector<double> fractions;
   RunContext watched;
   watched.progress = [&](std::string_view stage, double fraction) {
-    EXPECT_EQ(stage, "tetrahedralize");
+    EXPECT_EQ(stage, "tetgen");
     fractions.push_back(fraction);
   };
   ASSERT_TRUE(tetrahedralize(surface, 1, TetgenParams{}, watched, figures).ok());
