@@ -190,6 +190,19 @@ TEST(ImproveTetMesh, ASliverBorderingAnotherLabelIsNotPeeled) {
   EXPECT_NEAR(total_volume(m), total_volume(roof_sliver(0.1)), 1e-12);
 }
 
+TEST(ImproveTetMesh, ASliverWhoseOtherEdgeIsOnTheSurfaceIsNotPeeled) {
+  // Without e,f,c,d the faces e,c,d and f,c,d are surface too: peeling would
+  // leave four surface triangles on the edge c-d.
+  TetMesh m = roof_sliver(0.1);
+  m.tetrahedra.erase(m.tetrahedra.begin() + 2);
+  m.labels.erase(m.labels.begin() + 2);
+  const double volume = total_volume(m);
+  ImproveFigures figures;
+  ASSERT_TRUE(improve_tet_mesh(m, {.max_peel_depth_mm = 0.2}, RunContext{}, figures).ok());
+  EXPECT_EQ(figures.slivers_peeled, 0u);
+  EXPECT_NEAR(total_volume(m), volume, 1e-12);
+}
+
 TEST(ImproveTetMesh, AGoodMeshIsLeftAlone) {
   TetMesh m = cube_with_displaced_centre();
   m.points[13] = {1, 1, 1};
