@@ -49,12 +49,17 @@ void add_pipeline_flags(CLI::App& command, PipelineFlags& flags) {
       ->capture_default_str();
   command
       .add_option("--point-reduction", flags.point_reduction,
-                  "Poisson: thin the oriented points with grid, hierarchy or none")
+                  "Poisson: thin the oriented points by a grid, hierarchy clusters, or none")
       ->check(CLI::IsMember({"grid", "hierarchy", "none"}))
       ->capture_default_str();
   command
       .add_option("--point-cell", poisson.point_cell_voxels,
-                  "Poisson: grid cell of the point reduction, voxels")
+                  "Poisson: grid cell of the grid point reduction, voxels")
+      ->capture_default_str();
+  command
+      .add_option("--point-cluster-size", poisson.point_cluster_size,
+                  "Poisson: largest cluster of the hierarchy point reduction, points")
+      ->check(CLI::Range(1u, surface::kMaxClusterSize))
       ->capture_default_str();
   command
       .add_option("--volume", flags.volume,
@@ -111,6 +116,7 @@ v1::MeshOptions to_mesh_options(const PipelineFlags& flags) {
   proto.set_max_distance_voxels(poisson.max_distance_voxels);
   proto.set_min_component_voxels(poisson.min_component_voxels);
   proto.set_point_cell_voxels(poisson.point_cell_voxels);
+  proto.set_point_cluster_size(poisson.point_cluster_size);
   proto.set_prune_strands(!flags.keep_strands);
   proto.set_smoothing_iterations(poisson.smoothing.iterations);
   proto.set_smoothing_pass_band(poisson.smoothing.pass_band);

@@ -97,6 +97,7 @@ surface::PoissonParams poisson_params(const PoissonOptions& options, double voxe
   params.max_distance_mm = options.max_distance_voxels * voxel;
   params.reduction = options.point_reduction;
   params.reduction_cell_mm = options.point_cell_voxels * voxel;
+  params.cluster_size = options.point_cluster_size;
   return params;
 }
 

@@ -90,6 +90,13 @@ absl::Status read_poisson_options(const v1::MeshOptions& options, PoissonOptions
     default:
       return absl::InvalidArgumentError("normals: unknown weighting");
   }
+  if (options.has_point_cluster_size()) {
+    poisson.point_cluster_size = options.point_cluster_size();
+    if (poisson.point_cluster_size < 1 || poisson.point_cluster_size > surface::kMaxClusterSize) {
+      return absl::InvalidArgumentError(cat("point_cluster_size: ", poisson.point_cluster_size,
+                                            " is outside 1..", surface::kMaxClusterSize));
+    }
+  }
   switch (options.point_reduction()) {
     case v1::POINT_REDUCTION_UNSPECIFIED:
     case v1::POINT_REDUCTION_GRID:
@@ -262,6 +269,7 @@ v1::MeshOptions make_options(const MeshParams& params) {
                           : v1::NORMAL_WEIGHTING_UNIFORM);
   options.set_point_reduction(to_proto(poisson.point_reduction));
   options.set_point_cell_voxels(poisson.point_cell_voxels);
+  options.set_point_cluster_size(poisson.point_cluster_size);
   options.set_prune_strands(poisson.prune_strands);
   options.set_smoothing_iterations(poisson.smoothing.iterations);
   options.set_smoothing_pass_band(poisson.smoothing.pass_band);

@@ -215,6 +215,10 @@ absl::Status check_params(const PoissonParams& params) {
   if (params.reduction == PointReduction::kGrid &&
       (!(params.reduction_cell_mm > 0) || !std::isfinite(params.reduction_cell_mm)))
     return absl::InvalidArgumentError("point-cell: must be a positive length");
+  if (params.reduction == PointReduction::kHierarchy &&
+      !(params.cluster_size >= 1 && params.cluster_size <= kMaxClusterSize))
+    return absl::InvalidArgumentError(
+        cat("point-cluster-size: ", params.cluster_size, " is outside 1..", kMaxClusterSize));
   return absl::OkStatus();
 }
 
@@ -228,9 +232,11 @@ void reduce_points(std::vector<OrientedPoint>& points, const PoissonParams& para
                    points.end());
       return;
     case PointReduction::kHierarchy:
-      points.erase(
-          CGAL::hierarchy_simplify_point_set(points, CGAL::parameters::point_map(PointMap())),
-          points.end());
+      // CGAL's variation bound stays at its default: any 3 points are
+      // coplanar, so at the sizes worth using the size decides.
+      points.erase(CGAL::hierarchy_simplify_point_set(
+                       points, CGAL::parameters::point_map(PointMap()).size(params.cluster_size)),
+                   points.end());
       return;
   }
 }

@@ -21,10 +21,18 @@ enum class PointReduction {
   // adds no position error; the input surface is within cell * sqrt(3) of
   // some kept point.
   kGrid,
-  // CGAL hierarchy simplification with its default clusters (at most 10
-  // points, variation 1/3): centroids, so points move off the input surface.
+  // CGAL hierarchy simplification: the point set is split in halves across
+  // its main axis until each cluster holds at most `cluster_size` points, and
+  // each cluster keeps its point nearest the centroid. Kept points lie on the
+  // input surface, as with the grid, but the density follows the points
+  // rather than a fixed lattice. On the liver, clusters of 3 keep the
+  // one-voxel grid's Hausdorff distance with 44 % fewer points, but the
+  // sphere's vertices come out rougher (README, "Point reduction").
   kHierarchy,
 };
+
+// Clusters larger than this thin the points more than any use we measured.
+inline constexpr uint32_t kMaxClusterSize = 64;
 
 struct PoissonParams {
   // Surface mesher criteria (CGAL Surface_mesh_default_criteria_3).
@@ -38,6 +46,7 @@ struct PoissonParams {
   double max_distance_mm = 0;
   PointReduction reduction = PointReduction::kGrid;
   double reduction_cell_mm = 0;
+  uint32_t cluster_size = 3;
   // Relative residual at which the conjugate gradient solve stops.
   double solver_tolerance = 1e-6;
 };

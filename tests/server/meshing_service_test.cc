@@ -258,6 +258,9 @@ TEST_F(MeshingServiceTest, BrokenUploadsAreRefusedAndLeaveNothing) {
   v1::JobSpec bad_option = good;
   bad_option.mutable_options()->set_min_angle_deg(45);
   expect_invalid(bad_option, bytes, "spec.options");
+  v1::JobSpec bad_cluster = good;
+  bad_cluster.mutable_options()->set_point_cluster_size(0);
+  expect_invalid(bad_cluster, bytes, "point_cluster_size");
   // Bytes that are not a NIfTI file: our header check names the file "upload".
   const std::string garbage(4096, 'x');
   v1::JobSpec not_nifti = good;

@@ -106,6 +106,27 @@ TEST(PoissonSurface, TorusKeepsGenusOne) {
   EXPECT_NEAR(smooth->statistics.volume_mm3 / phantom.truth[0].volume_mm3, 1.0, 0.06);
 }
 
+TEST(PoissonSurface, HierarchyClustersBoundThePointCount) {
+  const auto path = phantom_file(PhantomShape::kTorus, "torus.mha");
+  size_t previous_points = SIZE_MAX;
+  for (uint32_t cluster : {2u, 3u, 5u}) {
+    MeshParams params;
+    params.poisson.point_reduction = surface::PointReduction::kHierarchy;
+    params.poisson.point_cluster_size = cluster;
+    const MeshResult result = mesh_file(path, params);
+    const SurfaceResult* smooth = find_stage(result, 1, "poisson");
+    ASSERT_NE(smooth, nullptr);
+    expect_quality_surface(*smooth);
+    EXPECT_EQ(smooth->statistics.euler_characteristic, 0) << cluster;
+    // Every cluster holds at most `cluster` points and gives one point, and
+    // larger clusters give fewer.
+    const auto& figures = *smooth->poisson;
+    EXPECT_GE(figures.used_points * cluster, figures.input_points) << cluster;
+    EXPECT_LT(figures.used_points, previous_points) << cluster;
+    previous_points = figures.used_points;
+  }
+}
+
 TEST(PoissonSurface, EveryComponentComesOutClosedAndSmallOnesAreCounted) {
   // Three separate balls of radius 6 and one 2x2x2 speck, all label 1.
   const auto v = testing::label_grid({56, 20, 20}, [](int i, int j, int k) -> uint8_t {
