@@ -59,7 +59,6 @@ void add_pipeline_flags(CLI::App& command, PipelineFlags& flags) {
   command
       .add_option("--point-cluster-size", poisson.point_cluster_size,
                   "Poisson: largest cluster of the hierarchy point reduction, points")
-      ->check(CLI::Range(1u, surface::kMaxClusterSize))
       ->capture_default_str();
   command
       .add_option("--volume", flags.volume,
