@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <iterator>
+#include <memory>
 #include <thread>
 #include <vector>
 
@@ -89,15 +90,41 @@ struct OneSided {
   Point farthest = Point(0, 0, 0);
   double sum = 0;
   size_t count = 0;
+
+  void add(const OneSided& later) {
+    if (later.max_squared > max_squared) {
+      max_squared = later.max_squared;
+      farthest = later.farthest;
+    }
+    sum += later.sum;
+    count += later.count;
+  }
 };
 
-OneSided distances_to(const std::vector<Point>& samples, const Triangles& target) {
+// One direction of the distance: where the samples are and what they are
+// measured against.
+struct Direction {
+  std::vector<Point> samples;
+  Triangles target;
+  std::unique_ptr<Tree> tree;
+};
+
+Direction prepare(const TriangleMesh& from, const TriangleMesh& to, double spacing) {
+  Direction direction{sample_points(from, spacing), to_triangles(to), nullptr};
+  if (!direction.target.empty()) {
+    direction.tree = std::make_unique<Tree>(direction.target.begin(), direction.target.end());
+    direction.tree->build();
+    direction.tree->accelerate_distance_queries();
+  }
+  return direction;
+}
+
+OneSided distances(const Direction& direction, size_t begin, size_t end) {
   OneSided result;
-  if (target.empty()) return result;
-  Tree tree(target.begin(), target.end());
-  tree.accelerate_distance_queries();
-  for (const Point& p : samples) {
-    const double squared = CGAL::to_double(tree.squared_distance(p));
+  if (!direction.tree) return result;
+  for (size_t i = begin; i < end; ++i) {
+    const Point& p = direction.samples[i];
+    const double squared = CGAL::to_double(direction.tree->squared_distance(p));
     if (squared > result.max_squared) {
       result.max_squared = squared;
       result.farthest = p;
@@ -120,19 +147,35 @@ std::optional<uint64_t> count_self_intersections(const TriangleMesh& mesh) {
 
 SurfaceDistance surface_distance(const TriangleMesh& a, const TriangleMesh& b,
                                  double sample_spacing_mm) {
-  // The two directions are independent: run one on a second thread. Each sum
-  // runs in a fixed order, so the figures do not depend on scheduling.
-  OneSided a_to_b;
-  std::thread forward(
-      [&] { a_to_b = distances_to(sample_points(a, sample_spacing_mm), to_triangles(b)); });
-  const OneSided b_to_a = distances_to(sample_points(b, sample_spacing_mm), to_triangles(a));
-  forward.join();
+  // Each direction is prepared on its own thread, then both threads query.
+  // Each thread's share is a fixed range and the partial sums are added in a
+  // fixed order, so the figures do not depend on scheduling.
+  Direction a_to_b;
+  std::thread preparing([&] { a_to_b = prepare(a, b, sample_spacing_mm); });
+  const Direction b_to_a = prepare(b, a, sample_spacing_mm);
+  preparing.join();
+
+  // Each direction's samples are halved between the threads: per query, the
+  // direction into the denser mesh costs twice the other.
+  const size_t a_half = a_to_b.samples.size() / 2, b_half = b_to_a.samples.size() / 2;
+  OneSided first_forward, first_backward, second_forward, second_backward;
+  std::thread querying([&] {
+    second_forward = distances(a_to_b, a_half, a_to_b.samples.size());
+    second_backward = distances(b_to_a, b_half, b_to_a.samples.size());
+  });
+  first_forward = distances(a_to_b, 0, a_half);
+  first_backward = distances(b_to_a, 0, b_half);
+  querying.join();
+  first_forward.add(second_forward);
+  first_backward.add(second_backward);
+
   SurfaceDistance distance;
-  const OneSided& worse = a_to_b.max_squared >= b_to_a.max_squared ? a_to_b : b_to_a;
+  const OneSided& worse =
+      first_forward.max_squared >= first_backward.max_squared ? first_forward : first_backward;
   distance.hausdorff_mm = std::sqrt(worse.max_squared);
   distance.hausdorff_at = {worse.farthest.x(), worse.farthest.y(), worse.farthest.z()};
-  const size_t count = a_to_b.count + b_to_a.count;
-  distance.mean_mm = count > 0 ? (a_to_b.sum + b_to_a.sum) / double(count) : 0;
+  const size_t count = first_forward.count + first_backward.count;
+  distance.mean_mm = count > 0 ? (first_forward.sum + first_backward.sum) / double(count) : 0;
   return distance;
 }
 
