@@ -6,8 +6,9 @@ set -euo pipefail
 shopt -s inherit_errexit # a command failing inside $(...) fails the run too
 cd "$(dirname "$0")/.."
 
-CLI=build/dev/client/labelmesh
-SERVER=build/dev/server/labelmeshd
+BIN=${LABELMESH_BIN:-build/dev} # scripts/bench.sh passes its release-flag build
+CLI=$BIN/client/labelmesh
+SERVER=$BIN/server/labelmeshd
 PY=/usr/bin/python3 # Debian's interpreter, never whichever python3 comes first on PATH
 T=$(mktemp -d)
 PIDS=()
