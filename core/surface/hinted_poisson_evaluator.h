@@ -7,6 +7,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <utility>
 #include <vector>
 
@@ -56,10 +57,17 @@ class HintedEvaluator {
     // The second bound keeps a flat or empty box from asking for more.
     step_ = std::max(std::cbrt(volume / double(1 << 21)), longest / 1024);
     origin_ = {box.xmin(), box.ymin(), box.zmin()};
-    for (int axis = 0; axis < 3; ++axis)
-      size_[axis] = int((box.max(axis) - box.min(axis)) / step_) + 1;
+    // A triangulation that is not yet a volume gets no grid (and no walks
+    // from it); the solve never leaves one, but the box would be infinite.
+    if (tr_.dimension() == 3) {
+      for (int axis = 0; axis < 3; ++axis)
+        size_[axis] = int((box.max(axis) - box.min(axis)) / step_) + 1;
+    }
     slots_.assign(size_t(size_[0]) * size_[1] * size_[2], Cell_handle());
     last_ = tr_.infinite_cell();
+    // Epick points start uninitialised; NaN matches no query.
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    for (auto& entry : recent_) entry.first = Point(nan, nan, nan);
   }
 
   Answer evaluate(const Point& p) {

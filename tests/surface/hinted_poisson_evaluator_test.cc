@@ -54,38 +54,69 @@ TEST_F(HintedPoissonEvaluatorTest, GivesCgalsValueAndAContainingCell) {
   HintedEvaluator evaluator(function_, context_);
   const auto& tr = function_.tr();
   std::mt19937 random(7);
-  // Inside the points' box, which CGAL's refinement keeps within the hull:
-  // far jumps as the mesher makes them, then a bisection down to each.
+  // Far jumps as the mesher makes them, then a bisection down to each; twice
+  // over the same targets, so the second pass walks from the grid's cells.
+  // The box is a little larger than the torus's, inside CGAL's refinement.
   std::uniform_real_distribution<double> xy(-15, 15), z(-5, 5);
-  int inside = 0;
+  std::vector<std::pair<Point, Point>> jumps;
   for (int jump = 0; jump < 2000; ++jump) {
-    Point a(xy(random), xy(random), z(random));
-    const Point b(xy(random), xy(random), z(random));
-    for (int step = 0; step < 8; ++step, a = CGAL::midpoint(a, b)) {
-      const auto [value, cell, infinite] = evaluator.evaluate(a);
-      ASSERT_FALSE(infinite);
-      EXPECT_NEAR(value, function_(a), 1e-9 * scale_);
-      HintedEvaluator::Triangulation::Locate_type type;
-      int i, j;
-      EXPECT_NE(tr.side_of_cell(a, cell, type, i, j), CGAL::ON_UNBOUNDED_SIDE);
-      inside += value < 0;
+    jumps.emplace_back(Point(xy(random), xy(random), z(random)),
+                       Point(xy(random), xy(random), z(random)));
+  }
+  int inside = 0;
+  for (int pass = 0; pass < 2; ++pass) {
+    for (auto [a, b] : jumps) {
+      for (int step = 0; step < 8; ++step, a = CGAL::midpoint(a, b)) {
+        const auto [value, cell, infinite] = evaluator.evaluate(a);
+        ASSERT_FALSE(infinite);
+        EXPECT_NEAR(value, function_(a), 1e-9 * scale_);
+        HintedEvaluator::Triangulation::Locate_type type;
+        int i, j;
+        EXPECT_NE(tr.side_of_cell(a, cell, type, i, j), CGAL::ON_UNBOUNDED_SIDE);
+        inside += value < 0;
+      }
     }
   }
   // The queries did cross the surface: some fell inside the tube.
-  EXPECT_GT(inside, 100);
-  EXPECT_LT(inside, 15000);
+  EXPECT_GT(inside, 200);
+  EXPECT_LT(inside, 30000);
 }
 
-TEST_F(HintedPoissonEvaluatorTest, RepeatedQuestionsGetTheSameAnswer) {
+TEST_F(HintedPoissonEvaluatorTest, OutsideTheHullGivesAHullVertexValue) {
+  // The mesher's ball is five times the points' radius; CGAL refines to 1.5.
+  HintedEvaluator evaluator(function_, context_);
+  const auto& tr = function_.tr();
+  for (int k = 0; k < 200; ++k) {
+    const double angle = 0.1 * k;
+    const Point far(60 * std::cos(angle), 60 * std::sin(angle), 20 * std::sin(3 * angle));
+    const auto [value, cell, infinite] = evaluator.evaluate(far);
+    const auto cgal = function_.special_func(far);
+    ASSERT_TRUE(infinite);
+    EXPECT_TRUE(boost::get<2>(cgal));
+    EXPECT_TRUE(tr.is_infinite(cell));
+    bool from_a_vertex = false;
+    for (int v = 0; v < 4; ++v) {
+      if (!tr.is_infinite(cell->vertex(v))) from_a_vertex |= cell->vertex(v)->f() == value;
+    }
+    EXPECT_TRUE(from_a_vertex);
+    // Far outside, the function is positive, as CGAL's is.
+    EXPECT_GT(value, 0);
+    EXPECT_GT(boost::get<0>(cgal), 0);
+  }
+}
+
+TEST_F(HintedPoissonEvaluatorTest, RepeatedQuestionsGetCgalsAnswer) {
   HintedEvaluator evaluator(function_, context_);
   const Point p(10, 0, 3.9), q(-10, 0, -3.9);
-  const auto first_p = evaluator.evaluate(p);
-  const auto first_q = evaluator.evaluate(q);
-  EXPECT_EQ(boost::get<0>(evaluator.evaluate(p)), boost::get<0>(first_p));
-  EXPECT_EQ(boost::get<1>(evaluator.evaluate(q)), boost::get<1>(first_q));
-  // Just inside the tube at both points: the function is negative inside.
-  EXPECT_LT(boost::get<0>(first_p), 0);
-  EXPECT_LT(boost::get<0>(first_q), 0);
+  for (int round = 0; round < 3; ++round) {
+    for (const Point& point : {p, q}) {
+      const auto answer = evaluator.evaluate(point);
+      const auto cgal = function_.special_func(point);
+      EXPECT_NEAR(boost::get<0>(answer), boost::get<0>(cgal), 1e-9 * scale_);
+      // Just inside the tube: the function is negative inside.
+      EXPECT_LT(boost::get<0>(answer), 0);
+    }
+  }
 }
 
 TEST_F(HintedPoissonEvaluatorTest, StopsWhenAskedTo) {
