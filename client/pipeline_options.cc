@@ -57,6 +57,11 @@ void add_pipeline_flags(CLI::App& command, PipelineFlags& flags) {
                   "Poisson: grid cell of the grid point reduction, voxels")
       ->capture_default_str();
   command
+      .add_option("--max-points", poisson.max_points,
+                  "Poisson: point budget of the grid reduction per component; a larger surface "
+                  "gets a coarser cell (0: no budget)")
+      ->capture_default_str();
+  command
       .add_option("--point-cluster-size", poisson.point_cluster_size,
                   "Poisson: largest cluster of the hierarchy point reduction, points")
       ->capture_default_str();
@@ -116,6 +121,7 @@ v1::MeshOptions to_mesh_options(const PipelineFlags& flags) {
   proto.set_min_component_voxels(poisson.min_component_voxels);
   proto.set_point_cell_voxels(poisson.point_cell_voxels);
   proto.set_point_cluster_size(poisson.point_cluster_size);
+  proto.set_max_points(poisson.max_points);
   proto.set_prune_strands(!flags.keep_strands);
   proto.set_smoothing_iterations(poisson.smoothing.iterations);
   proto.set_smoothing_pass_band(poisson.smoothing.pass_band);

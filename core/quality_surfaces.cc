@@ -1,5 +1,6 @@
 #include "core/quality_surfaces.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "core/surface/extract_surfaces.h"
@@ -75,6 +76,7 @@ class PieceProgress {
 void add_poisson_figures(surface::PoissonFigures& sum, const surface::PoissonFigures& part) {
   sum.input_points += part.input_points;
   sum.used_points += part.used_points;
+  sum.point_cell_mm = std::max(sum.point_cell_mm, part.point_cell_mm);
   sum.solver_iterations += part.solver_iterations;
   sum.solve_seconds += part.solve_seconds;
   sum.mesh_seconds += part.mesh_seconds;
@@ -98,6 +100,7 @@ surface::PoissonParams poisson_params(const PoissonOptions& options, double voxe
   params.reduction = options.point_reduction;
   params.reduction_cell_mm = options.point_cell_voxels * voxel;
   params.cluster_size = options.point_cluster_size;
+  params.max_points = options.max_points;
   return params;
 }
 

@@ -97,6 +97,14 @@ absl::Status read_poisson_options(const v1::MeshOptions& options, PoissonOptions
                                             " is outside 1..", surface::kMaxClusterSize));
     }
   }
+  if (options.has_max_points()) {
+    poisson.max_points = options.max_points();
+    if (poisson.max_points != 0 && poisson.max_points < surface::kMinPointBudget) {
+      return absl::InvalidArgumentError(cat("max_points: ", poisson.max_points,
+                                            " is neither 0 (no budget) nor at least ",
+                                            surface::kMinPointBudget));
+    }
+  }
   switch (options.point_reduction()) {
     case v1::POINT_REDUCTION_UNSPECIFIED:
     case v1::POINT_REDUCTION_GRID:
@@ -227,6 +235,7 @@ void add_quality_figures(const SurfaceResult& surface, v1::SurfaceSummary& entry
     poisson->set_solver_iterations(static_cast<uint32_t>(p.solver_iterations));
     poisson->set_solve_seconds(p.solve_seconds);
     poisson->set_mesh_seconds(p.mesh_seconds);
+    poisson->set_point_cell_mm(p.point_cell_mm);
   }
 }
 
@@ -270,6 +279,7 @@ v1::MeshOptions make_options(const MeshParams& params) {
   options.set_point_reduction(to_proto(poisson.point_reduction));
   options.set_point_cell_voxels(poisson.point_cell_voxels);
   options.set_point_cluster_size(poisson.point_cluster_size);
+  options.set_max_points(poisson.max_points);
   options.set_prune_strands(poisson.prune_strands);
   options.set_smoothing_iterations(poisson.smoothing.iterations);
   options.set_smoothing_pass_band(poisson.smoothing.pass_band);

@@ -33,6 +33,8 @@ enum class PointReduction {
 
 // Clusters larger than this thin the points more than any use we measured.
 inline constexpr uint32_t kMaxClusterSize = 64;
+// A point budget below this thins even a small organ's surface.
+inline constexpr uint64_t kMinPointBudget = 1000;
 
 struct PoissonParams {
   // Surface mesher criteria (CGAL Surface_mesh_default_criteria_3).
@@ -47,6 +49,11 @@ struct PoissonParams {
   PointReduction reduction = PointReduction::kGrid;
   double reduction_cell_mm = 0;
   uint32_t cluster_size = 3;
+  // Grid reduction only: when the grid of `reduction_cell_mm` keeps more than
+  // this many points, the cell grows by the square root of the excess (points
+  // on a surface go as one over the cell's area), so about this many remain.
+  // 0: no budget.
+  uint64_t max_points = 0;
   // Relative residual at which the conjugate gradient solve stops.
   double solver_tolerance = 1e-6;
 };
@@ -54,6 +61,8 @@ struct PoissonParams {
 struct PoissonFigures {
   size_t input_points = 0;
   size_t used_points = 0;
+  // Grid reduction: the cell used, after any growth for the point budget.
+  double point_cell_mm = 0;
   int solver_iterations = 0;
   double solve_seconds = 0;  // Delaunay refinement + linear solve
   double mesh_seconds = 0;   // surface meshing of the zero level

@@ -149,6 +149,9 @@ TEST(Cli, BadPoissonOptionsAreUsageErrors) {
   EXPECT_EQ(run_cli(mesh + " --point-reduction octree").exit_code, 2);
   EXPECT_EQ(run_cli(mesh + " --point-reduction hierarchy --point-cluster-size 0").exit_code, 2);
   EXPECT_EQ(run_cli(mesh + " --point-cluster-size 65").exit_code, 2);
+  const CliRun budget = run_cli(mesh + " --max-points 500");
+  EXPECT_EQ(budget.exit_code, 2);
+  EXPECT_NE(budget.output.find("max_points"), std::string::npos) << budget.output;
   const CliRun band = run_cli(mesh + " --smoothing-pass-band 2.5");
   EXPECT_EQ(band.exit_code, 2);
   EXPECT_NE(band.output.find("smoothing_pass_band"), std::string::npos) << band.output;

@@ -261,6 +261,9 @@ TEST_F(MeshingServiceTest, BrokenUploadsAreRefusedAndLeaveNothing) {
   v1::JobSpec bad_cluster = good;
   bad_cluster.mutable_options()->set_point_cluster_size(0);
   expect_invalid(bad_cluster, bytes, "point_cluster_size");
+  v1::JobSpec bad_budget = good;
+  bad_budget.mutable_options()->set_max_points(10);
+  expect_invalid(bad_budget, bytes, "max_points");
   // Bytes that are not a NIfTI file: our header check names the file "upload".
   const std::string garbage(4096, 'x');
   v1::JobSpec not_nifti = good;

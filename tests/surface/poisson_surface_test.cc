@@ -127,6 +127,37 @@ TEST(PoissonSurface, HierarchyClustersBoundThePointCount) {
   }
 }
 
+TEST(PoissonSurface, PointBudgetCoarsensTheGridOfLargeSurfacesOnly) {
+  const auto path = phantom_file(PhantomShape::kTorus, "torus.mha");
+  MeshParams unbounded;
+  unbounded.poisson.max_points = 0;
+  const MeshResult full_result = mesh_file(path, unbounded);
+  const SurfaceResult* full = find_stage(full_result, 1, "poisson");
+  ASSERT_NE(full, nullptr);
+  const size_t full_points = full->poisson->used_points;
+  // The phantom's voxels are 1 mm: the 1-voxel grid is a 1 mm cell.
+  EXPECT_DOUBLE_EQ(full->poisson->point_cell_mm, 1.0);
+
+  // The default budget is far above this small surface: nothing changes.
+  const MeshResult by_default = mesh_file(path);
+  const SurfaceResult* same = find_stage(by_default, 1, "poisson");
+  ASSERT_NE(same, nullptr);
+  EXPECT_EQ(same->poisson->used_points, full_points);
+  EXPECT_EQ(same->statistics.nodes, full->statistics.nodes);
+
+  // Half the points as a budget: a cell about sqrt(2) larger keeps about half.
+  MeshParams halved;
+  halved.poisson.max_points = full_points / 2;
+  const MeshResult result = mesh_file(path, halved);
+  const SurfaceResult* thinned = find_stage(result, 1, "poisson");
+  ASSERT_NE(thinned, nullptr);
+  expect_quality_surface(*thinned);
+  EXPECT_EQ(thinned->statistics.euler_characteristic, 0);
+  EXPECT_NEAR(thinned->poisson->point_cell_mm, std::sqrt(2.0), 0.15);
+  EXPECT_LT(thinned->poisson->used_points, 0.65 * double(full_points));
+  EXPECT_GT(thinned->poisson->used_points, 0.35 * double(full_points));
+}
+
 TEST(PoissonSurface, EveryComponentComesOutClosedAndSmallOnesAreCounted) {
   // Three separate balls of radius 6 and one 2x2x2 speck, all label 1.
   const auto v = testing::label_grid({56, 20, 20}, [](int i, int j, int k) -> uint8_t {
