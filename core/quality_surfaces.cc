@@ -191,7 +191,8 @@ absl::Status add_quality_surfaces(const volume::LabelVolume& volume,
     output.self_intersections = surface::count_self_intersections(output.mesh);
     if (auto s = context.check_stop(); !s.ok()) return s;
     output.distance_to_marching_cubes =
-        surface::surface_distance(output.mesh, marching_cubes, voxel);
+        surface::surface_distance(output.mesh, marching_cubes, voxel, context);
+    if (auto s = context.check_stop(); !s.ok()) return s;
     context.report("surface_checks", 1);
   }
   // The repaired surface is only an intermediate when Poisson follows: its

@@ -119,10 +119,13 @@ Direction prepare(const TriangleMesh& from, const TriangleMesh& to, double spaci
   return direction;
 }
 
-OneSided distances(const Direction& direction, size_t begin, size_t end) {
+OneSided distances(const Direction& direction, size_t begin, size_t end,
+                   const RunContext& context) {
   OneSided result;
   if (!direction.tree) return result;
   for (size_t i = begin; i < end; ++i) {
+    // About 10 ms of queries between looks at a stop request.
+    if ((i - begin) % 4096 == 4095 && context.stop_requested()) break;
     const Point& p = direction.samples[i];
     const double squared = CGAL::to_double(direction.tree->squared_distance(p));
     if (squared > result.max_squared) {
@@ -146,7 +149,7 @@ std::optional<uint64_t> count_self_intersections(const TriangleMesh& mesh) {
 }
 
 SurfaceDistance surface_distance(const TriangleMesh& a, const TriangleMesh& b,
-                                 double sample_spacing_mm) {
+                                 double sample_spacing_mm, const RunContext& context) {
   // Each direction is prepared on its own thread, then both threads query.
   // Each thread's share is a fixed range and the partial sums are added in a
   // fixed order, so the figures do not depend on scheduling.
@@ -160,11 +163,11 @@ SurfaceDistance surface_distance(const TriangleMesh& a, const TriangleMesh& b,
   const size_t a_half = a_to_b.samples.size() / 2, b_half = b_to_a.samples.size() / 2;
   OneSided first_forward, first_backward, second_forward, second_backward;
   std::thread querying([&] {
-    second_forward = distances(a_to_b, a_half, a_to_b.samples.size());
-    second_backward = distances(b_to_a, b_half, b_to_a.samples.size());
+    second_forward = distances(a_to_b, a_half, a_to_b.samples.size(), context);
+    second_backward = distances(b_to_a, b_half, b_to_a.samples.size(), context);
   });
-  first_forward = distances(a_to_b, 0, a_half);
-  first_backward = distances(b_to_a, 0, b_half);
+  first_forward = distances(a_to_b, 0, a_half, context);
+  first_backward = distances(b_to_a, 0, b_half, context);
   querying.join();
   first_forward.add(second_forward);
   first_backward.add(second_backward);

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <optional>
 
+#include "core/run_context.h"
 #include "core/surface/triangle_mesh.h"
 
 namespace labelmesh::surface {
@@ -29,8 +30,10 @@ struct SurfaceDistance {
 // every edge longer than `sample_spacing_mm` and inside every triangle, no
 // more than about that far apart (deterministic; uses two threads). The
 // Hausdorff figure is a lower bound, within half the spacing of the true one
-// (distance to a surface changes no faster than the sample moves).
+// (distance to a surface changes no faster than the sample moves). The
+// queries stop early when `context` asks to: the figures are then partial,
+// and the caller checks for the stop before using them.
 SurfaceDistance surface_distance(const TriangleMesh& a, const TriangleMesh& b,
-                                 double sample_spacing_mm);
+                                 double sample_spacing_mm, const RunContext& context = {});
 
 }  // namespace labelmesh::surface
