@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <exception>
 #include <iterator>
 #include <memory>
 #include <thread>
@@ -138,6 +139,29 @@ OneSided distances(const Direction& direction, size_t begin, size_t end,
   return result;
 }
 
+// Runs `there` on a second thread and `here` on this one. An exception from
+// either (bad_alloc, say) is rethrown once both are done, instead of ending
+// the process through a joinable thread's destructor.
+template <typename There, typename Here>
+void side_by_side(There&& there, Here&& here) {
+  std::exception_ptr there_error;
+  std::thread thread([&] {
+    try {
+      there();
+    } catch (...) {
+      there_error = std::current_exception();
+    }
+  });
+  try {
+    here();
+  } catch (...) {
+    thread.join();
+    throw;
+  }
+  thread.join();
+  if (there_error) std::rethrow_exception(there_error);
+}
+
 }  // namespace
 
 std::optional<uint64_t> count_self_intersections(const TriangleMesh& mesh) {
@@ -153,22 +177,23 @@ SurfaceDistance surface_distance(const TriangleMesh& a, const TriangleMesh& b,
   // Each direction is prepared on its own thread, then both threads query.
   // Each thread's share is a fixed range and the partial sums are added in a
   // fixed order, so the figures do not depend on scheduling.
-  Direction a_to_b;
-  std::thread preparing([&] { a_to_b = prepare(a, b, sample_spacing_mm); });
-  const Direction b_to_a = prepare(b, a, sample_spacing_mm);
-  preparing.join();
+  Direction a_to_b, b_to_a;
+  side_by_side([&] { a_to_b = prepare(a, b, sample_spacing_mm); },
+               [&] { b_to_a = prepare(b, a, sample_spacing_mm); });
 
   // Each direction's samples are halved between the threads: per query, the
   // direction into the denser mesh costs twice the other.
   const size_t a_half = a_to_b.samples.size() / 2, b_half = b_to_a.samples.size() / 2;
   OneSided first_forward, first_backward, second_forward, second_backward;
-  std::thread querying([&] {
-    second_forward = distances(a_to_b, a_half, a_to_b.samples.size(), context);
-    second_backward = distances(b_to_a, b_half, b_to_a.samples.size(), context);
-  });
-  first_forward = distances(a_to_b, 0, a_half, context);
-  first_backward = distances(b_to_a, 0, b_half, context);
-  querying.join();
+  side_by_side(
+      [&] {
+        second_forward = distances(a_to_b, a_half, a_to_b.samples.size(), context);
+        second_backward = distances(b_to_a, b_half, b_to_a.samples.size(), context);
+      },
+      [&] {
+        first_forward = distances(a_to_b, 0, a_half, context);
+        first_backward = distances(b_to_a, 0, b_half, context);
+      });
   first_forward.add(second_forward);
   first_backward.add(second_backward);
 
