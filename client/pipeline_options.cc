@@ -30,6 +30,8 @@ void add_pipeline_flags(CLI::App& command, PipelineFlags& flags) {
   command
       .add_option("--min-component-voxels", poisson.min_component_voxels,
                   "Drop connected components of a label with fewer voxels (repaired, poisson)")
+      // CLI11 reads "-1" into an unsigned option as its largest value.
+      ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   command.add_flag("--keep-strands", flags.keep_strands,
                    "Keep strands one voxel thick (repaired, poisson); by default they are pruned");
@@ -60,6 +62,7 @@ void add_pipeline_flags(CLI::App& command, PipelineFlags& flags) {
       .add_option("--max-points", poisson.max_points,
                   "Poisson: point budget of the grid reduction per component; a larger surface "
                   "gets a coarser cell (0: no budget)")
+      ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   command
       .add_option("--point-cluster-size", poisson.point_cluster_size,

@@ -231,11 +231,12 @@ void reduce_points(std::vector<OrientedPoint>& points, const PoissonParams& para
       double cell = params.reduction_cell_mm;
       auto kept = grid_simplified(points, cell);
       // The square-root rule undershoots (the liver: 139 k points after one
-      // step for a budget of 125 k), so up to three steps, each from the
-      // unthinned points.
-      for (int step = 0; step < 3 && params.max_points != 0 && kept.size() > params.max_points;
+      // step for a budget of 125 k), so it steps again, from the unthinned
+      // points, growing at least 2 % a step: ten steps reach the budget
+      // unless the cell started far below the points' spacing.
+      for (int step = 0; step < 10 && params.max_points != 0 && kept.size() > params.max_points;
            ++step) {
-        cell *= std::sqrt(double(kept.size()) / double(params.max_points));
+        cell *= std::max(std::sqrt(double(kept.size()) / double(params.max_points)), 1.02);
         kept = grid_simplified(points, cell);
       }
       figures.point_cell_mm = cell;

@@ -51,8 +51,8 @@ struct PoissonParams {
   uint32_t cluster_size = 3;
   // Grid reduction only: when the grid of `reduction_cell_mm` keeps more than
   // this many points, the cell grows by the square root of the excess (points
-  // on a surface go as one over the cell's area), so about this many remain.
-  // 0: no budget.
+  // on a surface go as one over the cell's area), in up to ten steps, until
+  // no more than this many remain. 0: no budget.
   uint64_t max_points = 0;
   // Relative residual at which the conjugate gradient solve stops.
   double solver_tolerance = 1e-6;

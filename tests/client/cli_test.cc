@@ -101,6 +101,9 @@ TEST(Cli, JsonReportOnStdout) {
   EXPECT_FALSE(report.surfaces(0).has_hausdorff_mm());
   EXPECT_EQ(poisson.components_kept(), 1u);
   EXPECT_GT(poisson.poisson().used_points(), 100u);
+  // The torus phantom has 1 mm voxels and is far below the point budget: the
+  // 1-voxel grid.
+  EXPECT_DOUBLE_EQ(poisson.poisson().point_cell_mm(), 1.0);
   EXPECT_EQ(report.options().surface(), v1::SURFACE_METHOD_POISSON);
   EXPECT_EQ(report.options().min_angle_deg(), 30);
   EXPECT_TRUE(std::filesystem::exists(dir / "o" / "surface-label1.stl"));
@@ -152,6 +155,8 @@ TEST(Cli, BadPoissonOptionsAreUsageErrors) {
   const CliRun budget = run_cli(mesh + " --max-points 500");
   EXPECT_EQ(budget.exit_code, 2);
   EXPECT_NE(budget.output.find("max_points"), std::string::npos) << budget.output;
+  EXPECT_EQ(run_cli(mesh + " --max-points -1").exit_code, 2);
+  EXPECT_EQ(run_cli(mesh + " --min-component-voxels -1").exit_code, 2);
   const CliRun band = run_cli(mesh + " --smoothing-pass-band 2.5");
   EXPECT_EQ(band.exit_code, 2);
   EXPECT_NE(band.output.find("smoothing_pass_band"), std::string::npos) << band.output;

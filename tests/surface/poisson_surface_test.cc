@@ -154,7 +154,7 @@ TEST(PoissonSurface, PointBudgetCoarsensTheGridOfLargeSurfacesOnly) {
   expect_quality_surface(*thinned);
   EXPECT_EQ(thinned->statistics.euler_characteristic, 0);
   EXPECT_NEAR(thinned->poisson->point_cell_mm, std::sqrt(2.0), 0.15);
-  EXPECT_LT(thinned->poisson->used_points, 0.65 * double(full_points));
+  EXPECT_LE(thinned->poisson->used_points, halved.poisson.max_points);
   EXPECT_GT(thinned->poisson->used_points, 0.35 * double(full_points));
 }
 
@@ -247,6 +247,18 @@ TEST(PoissonSurface, CancellingStopsWithinASecond) {
   canceller.join();
   EXPECT_EQ(result.status().code(), absl::StatusCode::kCancelled);
   EXPECT_LT(std::chrono::duration<double>(returned - asked).count(), 1.0);
+}
+
+TEST(PoissonSurface, AStopDuringTheChecksCancelsTheRun) {
+  const auto path = phantom_file(PhantomShape::kTorus, "torus-cancel-checks.nii.gz");
+  std::atomic<bool> stop{false};
+  RunContext context;
+  context.stop = &stop;
+  context.progress = [&](std::string_view stage, double) {
+    if (stage == "surface_checks") stop = true;
+  };
+  auto result = run_pipeline(path, MeshParams{}, context);
+  EXPECT_EQ(result.status().code(), absl::StatusCode::kCancelled);
 }
 
 TEST(PoissonSurface, RepairedStageWritesTheRepairedSurface) {
