@@ -65,6 +65,12 @@ void add_pipeline_flags(CLI::App& command, PipelineFlags& flags) {
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   command
+      .add_option("--split-points", poisson.split_points,
+                  "Poisson: solve a component with more points than this as two halves on two "
+                  "threads (0: always one solve)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  command
       .add_option("--point-cluster-size", poisson.point_cluster_size,
                   "Poisson: largest cluster of the hierarchy point reduction, points")
       ->capture_default_str();
@@ -125,6 +131,7 @@ v1::MeshOptions to_mesh_options(const PipelineFlags& flags) {
   proto.set_point_cell_voxels(poisson.point_cell_voxels);
   proto.set_point_cluster_size(poisson.point_cluster_size);
   proto.set_max_points(poisson.max_points);
+  proto.set_split_points(poisson.split_points);
   proto.set_prune_strands(!flags.keep_strands);
   proto.set_smoothing_iterations(poisson.smoothing.iterations);
   proto.set_smoothing_pass_band(poisson.smoothing.pass_band);

@@ -105,6 +105,14 @@ absl::Status read_poisson_options(const v1::MeshOptions& options, PoissonOptions
                                             surface::kMinPointBudget));
     }
   }
+  if (options.has_split_points()) {
+    poisson.split_points = options.split_points();
+    if (poisson.split_points != 0 && poisson.split_points < surface::kMinPointBudget) {
+      return absl::InvalidArgumentError(cat("split_points: ", poisson.split_points,
+                                            " is neither 0 (never) nor at least ",
+                                            surface::kMinPointBudget));
+    }
+  }
   switch (options.point_reduction()) {
     case v1::POINT_REDUCTION_UNSPECIFIED:
     case v1::POINT_REDUCTION_GRID:
@@ -236,6 +244,7 @@ void add_quality_figures(const SurfaceResult& surface, v1::SurfaceSummary& entry
     poisson->set_solve_seconds(p.solve_seconds);
     poisson->set_mesh_seconds(p.mesh_seconds);
     poisson->set_point_cell_mm(p.point_cell_mm);
+    poisson->set_solved_in_halves(p.solved_in_halves);
   }
 }
 
@@ -280,6 +289,7 @@ v1::MeshOptions make_options(const MeshParams& params) {
   options.set_point_cell_voxels(poisson.point_cell_voxels);
   options.set_point_cluster_size(poisson.point_cluster_size);
   options.set_max_points(poisson.max_points);
+  options.set_split_points(poisson.split_points);
   options.set_prune_strands(poisson.prune_strands);
   options.set_smoothing_iterations(poisson.smoothing.iterations);
   options.set_smoothing_pass_band(poisson.smoothing.pass_band);

@@ -6,6 +6,7 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <memory>
 #include <unordered_map>
 #include <utility>
 
@@ -26,6 +27,7 @@
 #include <CGAL/property_map.h>
 #include <Eigen/IterativeLinearSolvers>
 
+#include "core/side_by_side.h"
 #include "core/surface/cgal_mesh.h"
 #include "core/surface/hinted_poisson_evaluator.h"
 #include "core/text.h"
@@ -98,21 +100,68 @@ class CancellableSolver {
   int* iterations_;
 };
 
+// The solved function that is meshed: one solve, or two solves of
+// overlapping halves of the points blended across the middle of the overlap.
+class SolvedFunction {
+ public:
+  explicit SolvedFunction(HintedEvaluator* whole) : low_(whole) {}
+
+  // `low` holds the points below `at` along `axis`, `high` those above, each
+  // reaching `overlap` past `at`; the offsets are subtracted from each.
+  SolvedFunction(HintedEvaluator* low, double low_offset, HintedEvaluator* high, double high_offset,
+                 int axis, double at, double overlap)
+      : low_(low),
+        high_(high),
+        low_offset_(low_offset),
+        high_offset_(high_offset),
+        axis_(axis),
+        blend_from_(at - overlap / 2),
+        blend_width_(overlap) {}
+
+  HintedEvaluator::Answer evaluate(const Point& p) const {
+    if (high_ == nullptr) return low_->evaluate(p);
+    const double t = (p[axis_] - blend_from_) / blend_width_;
+    if (t <= 0) return shifted(low_->evaluate(p), low_offset_);
+    if (t >= 1) return shifted(high_->evaluate(p), high_offset_);
+    // Smoothstep: the blend and its slope are continuous at both ends.
+    const double w = t * t * (3 - 2 * t);
+    const auto low = low_->evaluate(p), high = high_->evaluate(p);
+    const double value =
+        (1 - w) * (boost::get<0>(low) - low_offset_) + w * (boost::get<0>(high) - high_offset_);
+    // The cell lets the oracle interpolate linearly once a crossing's ends
+    // share one; across a 20-voxel blend, one cell is nearly linear too.
+    const auto& nearer = w < 0.5 ? low : high;
+    return {value, boost::get<1>(nearer), boost::get<2>(nearer)};
+  }
+
+ private:
+  static HintedEvaluator::Answer shifted(HintedEvaluator::Answer answer, double offset) {
+    boost::get<0>(answer) -= offset;
+    return answer;
+  }
+
+  HintedEvaluator* low_;
+  HintedEvaluator* high_ = nullptr;
+  double low_offset_ = 0, high_offset_ = 0;
+  int axis_ = 0;
+  double blend_from_ = 0, blend_width_ = 1;
+};
+
 // The function as CGAL's Poisson surface oracle calls it; the mesher copies
-// it freely, so it only points at the evaluator.
+// it freely, so it only points at the solved function.
 class MesherFunction {
  public:
   using FT = Kernel::FT;
   using Point = Kernel::Point_3;
   using Cell_handle = PoissonFunction::Cell_handle;
 
-  explicit MesherFunction(HintedEvaluator* evaluator) : evaluator_(evaluator) {}
+  explicit MesherFunction(const SolvedFunction* function) : function_(function) {}
 
-  FT operator()(const Point& p) const { return boost::get<0>(evaluator_->evaluate(p)); }
-  HintedEvaluator::Answer special_func(const Point& p) const { return evaluator_->evaluate(p); }
+  FT operator()(const Point& p) const { return boost::get<0>(function_->evaluate(p)); }
+  HintedEvaluator::Answer special_func(const Point& p) const { return function_->evaluate(p); }
 
  private:
-  HintedEvaluator* evaluator_;
+  const SolvedFunction* function_;
 };
 
 // Adds CGAL's creation-order time stamp to a vertex or cell base. CGAL then
@@ -209,6 +258,12 @@ absl::Status check_params(const PoissonParams& params) {
     return absl::InvalidArgumentError(cat("max-points: ", params.max_points,
                                           " is neither 0 (no budget) nor at least ",
                                           kMinPointBudget));
+  if (params.split_points != 0 && params.split_points < kMinPointBudget)
+    return absl::InvalidArgumentError(cat("split-points: ", params.split_points,
+                                          " is neither 0 (never) nor at least ", kMinPointBudget));
+  if (params.split_points != 0 &&
+      (!(params.split_overlap_mm > 0) || !std::isfinite(params.split_overlap_mm)))
+    return absl::InvalidArgumentError("split overlap: must be a positive length");
   if (params.reduction == PointReduction::kHierarchy &&
       !(params.cluster_size >= 1 && params.cluster_size <= kMaxClusterSize))
     return absl::InvalidArgumentError(
@@ -253,6 +308,156 @@ void reduce_points(std::vector<OrientedPoint>& points, const PoissonParams& para
   }
 }
 
+struct Solve {
+  std::unique_ptr<PoissonFunction> function;
+  int iterations = 0;
+  bool converged = false;
+};
+
+Solve solve(const std::vector<OrientedPoint>& points, const PoissonParams& params,
+            const RunContext& context) {
+  Solve result;
+  result.function = std::make_unique<PoissonFunction>(points.begin(), points.end(), PointMap(),
+                                                      NormalMap(), CancellableInsertion{&context});
+  CancellableSolver solver(&context, params.solver_tolerance, &result.iterations);
+  result.converged =
+      result.function->compute_implicit_function(solver, CancellableInsertion{&context});
+  return result;
+}
+
+// Two overlapping halves of the points, split at their median along the
+// longest side of their box.
+struct Halves {
+  int axis = 0;
+  double at = 0;
+  std::vector<OrientedPoint> low, high;
+};
+
+Halves split_points(const std::vector<OrientedPoint>& points, double overlap) {
+  std::array<double, 3> low_corner{}, high_corner{};
+  for (int axis = 0; axis < 3; ++axis) {
+    const auto [min, max] = std::minmax_element(
+        points.begin(), points.end(),
+        [axis](const auto& a, const auto& b) { return a.first[axis] < b.first[axis]; });
+    low_corner[axis] = min->first[axis];
+    high_corner[axis] = max->first[axis];
+  }
+  Halves halves;
+  for (int axis = 1; axis < 3; ++axis) {
+    if (high_corner[axis] - low_corner[axis] > high_corner[halves.axis] - low_corner[halves.axis])
+      halves.axis = axis;
+  }
+  std::vector<double> along;
+  along.reserve(points.size());
+  for (const auto& point : points) along.push_back(point.first[halves.axis]);
+  std::nth_element(along.begin(), along.begin() + along.size() / 2, along.end());
+  halves.at = along[along.size() / 2];
+  for (const auto& point : points) {
+    const double x = point.first[halves.axis];
+    if (x < halves.at + overlap) halves.low.push_back(point);
+    if (x >= halves.at - overlap) halves.high.push_back(point);
+  }
+  return halves;
+}
+
+// CGAL contours each half at the median of its function over all of that
+// half's points, some of them near its open cut, where the function bends;
+// the median over the points on the half's own side of the split is the
+// contour value that matches the other half (without it the liver's volume
+// moved by 0.05 % and its Hausdorff distance by 0.3 mm).
+double own_side_median(HintedEvaluator& evaluator, const std::vector<OrientedPoint>& points,
+                       const Halves& halves, bool low) {
+  std::vector<double> values;
+  for (const auto& point : points) {
+    const double x = point.first[halves.axis];
+    if (low ? x < halves.at : x >= halves.at)
+      values.push_back(boost::get<0>(evaluator.evaluate(point.first)));
+  }
+  std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
+  return values[values.size() / 2];
+}
+
+// Delaunay refinement of the zero level of `function` inside a ball around
+// `inner` (a point where the function is negative) of `radius`.
+absl::StatusOr<TriangleMesh> mesh_zero_level(const SolvedFunction& function, const Point& inner,
+                                             double radius, const PoissonParams& params) {
+  // As in CGAL's examples, a ball well beyond the points. Bisection of a
+  // crossing stops at a twentieth of the distance bound (CGAL solves exactly
+  // once both ends share a tetrahedron, where the function is linear).
+  const double ball_radius = 5 * radius;
+  const double bisection_error = params.max_distance_mm / 20 / ball_radius;
+  ImplicitSurface surface(MesherFunction(&function),
+                          Kernel::Sphere_3(inner, ball_radius * ball_radius), bisection_error);
+  CGAL::Surface_mesh_default_criteria_3<Triangulation> criteria(
+      params.min_angle_deg, params.max_edge_mm / 2, params.max_distance_mm);
+  Triangulation triangulation;
+  Complex complex(triangulation);
+  CGAL::make_surface_mesh(complex, surface, criteria, CGAL::Manifold_tag());
+  auto mesh = complex_to_mesh(complex, triangulation);
+  if (mesh.ok() && mesh->triangles.empty())
+    return absl::InternalError("poisson: meshing found no surface in the implicit function");
+  return mesh;
+}
+
+absl::StatusOr<TriangleMesh> reconstruct_whole(const std::vector<OrientedPoint>& points,
+                                               const PoissonParams& params,
+                                               const RunContext& context, PoissonFigures& figures) {
+  auto start = std::chrono::steady_clock::now();
+  Solve whole = solve(points, params, context);
+  figures.solver_iterations = whole.iterations;
+  figures.solve_seconds = seconds_since(start);
+  if (!whole.converged) return absl::InternalError("poisson: the linear solve did not converge");
+
+  start = std::chrono::steady_clock::now();
+  HintedEvaluator evaluator(*whole.function, context);
+  const SolvedFunction function(&evaluator);
+  auto mesh =
+      mesh_zero_level(function, whole.function->get_inner_point(),
+                      std::sqrt(whole.function->bounding_sphere().squared_radius()), params);
+  figures.mesh_seconds = seconds_since(start);
+  return mesh;
+}
+
+absl::StatusOr<TriangleMesh> reconstruct_in_halves(const std::vector<OrientedPoint>& points,
+                                                   const PoissonParams& params,
+                                                   const RunContext& context,
+                                                   PoissonFigures& figures) {
+  auto start = std::chrono::steady_clock::now();
+  const Halves halves = split_points(points, params.split_overlap_mm);
+  Solve low, high;
+  side_by_side([&] { high = solve(halves.high, params, context); },
+               [&] { low = solve(halves.low, params, context); });
+  figures.solver_iterations = low.iterations + high.iterations;
+  figures.solve_seconds = seconds_since(start);
+  figures.solved_in_halves = true;
+  if (!low.converged || !high.converged)
+    return absl::InternalError("poisson: the linear solve did not converge");
+
+  start = std::chrono::steady_clock::now();
+  HintedEvaluator low_evaluator(*low.function, context), high_evaluator(*high.function, context);
+  const double low_offset = own_side_median(low_evaluator, points, halves, true);
+  const double high_offset = own_side_median(high_evaluator, points, halves, false);
+  const SolvedFunction function(&low_evaluator, low_offset, &high_evaluator, high_offset,
+                                halves.axis, halves.at, params.split_overlap_mm);
+  // The mesher starts from a point inside: the deepest point of either half
+  // that the blended function also puts inside.
+  Point inner = low.function->get_inner_point();
+  if (!(boost::get<0>(function.evaluate(inner)) < 0)) inner = high.function->get_inner_point();
+  if (!(boost::get<0>(function.evaluate(inner)) < 0))
+    return absl::InternalError("poisson: the halves' functions found no inside point");
+  const CGAL::Bbox_3 box =
+      CGAL::bbox_3(CGAL::make_transform_iterator_from_property_map(points.begin(), PointMap()),
+                   CGAL::make_transform_iterator_from_property_map(points.end(), PointMap()));
+  const Point centre((box.xmin() + box.xmax()) / 2, (box.ymin() + box.ymax()) / 2,
+                     (box.zmin() + box.zmax()) / 2);
+  const double half_diagonal =
+      std::sqrt(CGAL::squared_distance(centre, Point(box.xmax(), box.ymax(), box.zmax())));
+  auto mesh = mesh_zero_level(
+      function, inner, half_diagonal + std::sqrt(CGAL::squared_distance(centre, inner)), params);
+  figures.mesh_seconds = seconds_since(start);
+  return mesh;
+}
+
 }  // namespace
 
 absl::StatusOr<TriangleMesh> reconstruct_poisson_surface(const std::vector<geometry::Vec3>& points,
@@ -281,35 +486,9 @@ absl::StatusOr<TriangleMesh> reconstruct_poisson_surface(const std::vector<geome
   }
 
   try {
-    auto start = std::chrono::steady_clock::now();
-    PoissonFunction function(oriented.begin(), oriented.end(), PointMap(), NormalMap(),
-                             CancellableInsertion{&context});
-    CancellableSolver solver(&context, params.solver_tolerance, &figures.solver_iterations);
-    const bool solved = function.compute_implicit_function(solver, CancellableInsertion{&context});
-    figures.solve_seconds = seconds_since(start);
-    if (!solved) return absl::InternalError("poisson: the linear solve did not converge");
-
-    start = std::chrono::steady_clock::now();
-    const Point inner = function.get_inner_point();
-    const double radius = std::sqrt(function.bounding_sphere().squared_radius());
-    // As in CGAL's examples, a ball well beyond the points. Bisection of a
-    // crossing stops at a twentieth of the distance bound (CGAL solves exactly
-    // once both ends share a tetrahedron, where the function is linear).
-    const double ball_radius = 5 * radius;
-    const double bisection_error = params.max_distance_mm / 20 / ball_radius;
-    HintedEvaluator evaluator(function, context);
-    ImplicitSurface surface(MesherFunction(&evaluator),
-                            Kernel::Sphere_3(inner, ball_radius * ball_radius), bisection_error);
-    CGAL::Surface_mesh_default_criteria_3<Triangulation> criteria(
-        params.min_angle_deg, params.max_edge_mm / 2, params.max_distance_mm);
-    Triangulation triangulation;
-    Complex complex(triangulation);
-    CGAL::make_surface_mesh(complex, surface, criteria, CGAL::Manifold_tag());
-    auto mesh = complex_to_mesh(complex, triangulation);
-    if (mesh.ok() && mesh->triangles.empty())
-      return absl::InternalError("poisson: meshing found no surface in the implicit function");
-    figures.mesh_seconds = seconds_since(start);
-    return mesh;
+    if (params.split_points != 0 && oriented.size() > params.split_points)
+      return reconstruct_in_halves(oriented, params, context, figures);
+    return reconstruct_whole(oriented, params, context, figures);
   } catch (const Cancelled&) {
     return absl::CancelledError("the run was cancelled");
   }

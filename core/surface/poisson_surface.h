@@ -54,6 +54,13 @@ struct PoissonParams {
   // on a surface go as one over the cell's area), in up to ten steps, until
   // no more than this many remain. 0: no budget.
   uint64_t max_points = 0;
+  // More points than this (after reduction) are solved as two halves at once,
+  // split at their median along the longest side of their box, each reaching
+  // `split_overlap_mm` past the split; the two functions are blended across
+  // the middle of the overlap. 0: always one solve. The result depends only
+  // on the points, not on the machine's cores.
+  uint64_t split_points = 0;
+  double split_overlap_mm = 0;
   // Relative residual at which the conjugate gradient solve stops.
   double solver_tolerance = 1e-6;
 };
@@ -63,6 +70,8 @@ struct PoissonFigures {
   size_t used_points = 0;
   // Grid reduction: the cell used, after any growth for the point budget.
   double point_cell_mm = 0;
+  // The points were solved as two halves (split_points).
+  bool solved_in_halves = false;
   int solver_iterations = 0;
   double solve_seconds = 0;  // Delaunay refinement + linear solve
   double mesh_seconds = 0;   // surface meshing of the zero level

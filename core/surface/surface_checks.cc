@@ -2,10 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <exception>
 #include <iterator>
 #include <memory>
-#include <thread>
 #include <vector>
 
 #include <CGAL/AABB_traits.h>
@@ -14,6 +12,7 @@
 #include <CGAL/Polygon_mesh_processing/self_intersections.h>
 
 #include "core/geometry/vec3.h"
+#include "core/side_by_side.h"
 #include "core/surface/cgal_mesh.h"
 
 namespace labelmesh::surface {
@@ -137,29 +136,6 @@ OneSided distances(const Direction& direction, size_t begin, size_t end,
     ++result.count;
   }
   return result;
-}
-
-// Runs `there` on a second thread and `here` on this one. An exception from
-// either (bad_alloc, say) is rethrown once both are done, instead of ending
-// the process through a joinable thread's destructor.
-template <typename There, typename Here>
-void side_by_side(There&& there, Here&& here) {
-  std::exception_ptr there_error;
-  std::thread thread([&] {
-    try {
-      there();
-    } catch (...) {
-      there_error = std::current_exception();
-    }
-  });
-  try {
-    here();
-  } catch (...) {
-    thread.join();
-    throw;
-  }
-  thread.join();
-  if (there_error) std::rethrow_exception(there_error);
 }
 
 }  // namespace

@@ -156,6 +156,9 @@ TEST(Cli, BadPoissonOptionsAreUsageErrors) {
   EXPECT_EQ(budget.exit_code, 2);
   EXPECT_NE(budget.output.find("max_points"), std::string::npos) << budget.output;
   EXPECT_EQ(run_cli(mesh + " --max-points -1").exit_code, 2);
+  const CliRun split = run_cli(mesh + " --split-points 999");
+  EXPECT_EQ(split.exit_code, 2);
+  EXPECT_NE(split.output.find("split_points"), std::string::npos) << split.output;
   EXPECT_EQ(run_cli(mesh + " --min-component-voxels -1").exit_code, 2);
   const CliRun band = run_cli(mesh + " --smoothing-pass-band 2.5");
   EXPECT_EQ(band.exit_code, 2);

@@ -264,6 +264,9 @@ TEST_F(MeshingServiceTest, BrokenUploadsAreRefusedAndLeaveNothing) {
   v1::JobSpec bad_budget = good;
   bad_budget.mutable_options()->set_max_points(10);
   expect_invalid(bad_budget, bytes, "max_points");
+  v1::JobSpec bad_split = good;
+  bad_split.mutable_options()->set_split_points(10);
+  expect_invalid(bad_split, bytes, "split_points");
   // Bytes that are not a NIfTI file: our header check names the file "upload".
   const std::string garbage(4096, 'x');
   v1::JobSpec not_nifti = good;

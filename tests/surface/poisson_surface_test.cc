@@ -6,10 +6,12 @@
 #include <chrono>
 #include <cmath>
 #include <memory>
+#include <numbers>
 #include <random>
 #include <thread>
 
 #include "core/pipeline.h"
+#include "core/surface/poisson_surface.h"
 #include "core/surface/surface_statistics.h"
 #include "core/volume/phantom.h"
 #include "core/volume/write_label_volume.h"
@@ -158,6 +160,39 @@ TEST(PoissonSurface, PointBudgetCoarsensTheGridOfLargeSurfacesOnly) {
   EXPECT_GT(thinned->poisson->used_points, 0.35 * double(full_points));
 }
 
+TEST(PoissonSurface, TwoHalvesGiveTheOneSolveSurface) {
+  const auto path = phantom_file(PhantomShape::kTorus, "torus-halves.nrrd");
+  MeshParams one;
+  one.poisson.split_points = 0;
+  MeshParams halves;
+  halves.poisson.split_points = surface::kMinPointBudget;  // far below the torus's points
+  const MeshResult one_result = mesh_file(path, one);
+  const MeshResult halves_result = mesh_file(path, halves);
+  const MeshResult again = mesh_file(path, halves);
+  const SurfaceResult* whole = find_stage(one_result, 1, "poisson");
+  const SurfaceResult* split = find_stage(halves_result, 1, "poisson");
+  const SurfaceResult* split_again = find_stage(again, 1, "poisson");
+  ASSERT_NE(whole, nullptr);
+  ASSERT_NE(split, nullptr);
+  ASSERT_NE(split_again, nullptr);
+  EXPECT_FALSE(whole->poisson->solved_in_halves);
+  EXPECT_TRUE(split->poisson->solved_in_halves);
+  EXPECT_GT(split->poisson->solver_iterations, 0);
+  expect_quality_surface(*split);
+  EXPECT_EQ(split->statistics.euler_characteristic, 0);
+  // The same surface as one solve, up to the mesher's sampling: the volume
+  // within 0.5 %, the distances to Marching Cubes within a tenth of a voxel.
+  EXPECT_NEAR(split->statistics.volume_mm3 / whole->statistics.volume_mm3, 1.0, 0.005);
+  ASSERT_TRUE(split->distance_to_marching_cubes.has_value());
+  EXPECT_NEAR(split->distance_to_marching_cubes->hausdorff_mm,
+              whole->distance_to_marching_cubes->hausdorff_mm, 0.1);
+  EXPECT_NEAR(split->distance_to_marching_cubes->mean_mm,
+              whole->distance_to_marching_cubes->mean_mm, 0.02);
+  // Deterministic although two threads solve.
+  EXPECT_EQ(split_again->mesh.points, split->mesh.points);
+  EXPECT_EQ(split_again->mesh.triangles, split->mesh.triangles);
+}
+
 TEST(PoissonSurface, EveryComponentComesOutClosedAndSmallOnesAreCounted) {
   // Three separate balls of radius 6 and one 2x2x2 speck, all label 1.
   const auto v = testing::label_grid({56, 20, 20}, [](int i, int j, int k) -> uint8_t {
@@ -259,6 +294,37 @@ TEST(PoissonSurface, AStopDuringTheChecksCancelsTheRun) {
   };
   auto result = run_pipeline(path, MeshParams{}, context);
   EXPECT_EQ(result.status().code(), absl::StatusCode::kCancelled);
+}
+
+TEST(PoissonSurface, AStopCancelsBothHalves) {
+  // Points and normals on a sphere of radius 10, enough to be split.
+  std::vector<geometry::Vec3> points, normals;
+  for (int i = 0; i < 60; ++i) {
+    const double polar = std::numbers::pi * (i + 0.5) / 60;
+    for (int j = 0; j < 120; ++j) {
+      const double around = 2 * std::numbers::pi * j / 120;
+      const geometry::Vec3 n{std::sin(polar) * std::cos(around), std::sin(polar) * std::sin(around),
+                             std::cos(polar)};
+      normals.push_back(n);
+      points.push_back({10 * n[0], 10 * n[1], 10 * n[2]});
+    }
+  }
+  surface::PoissonParams params;
+  params.max_edge_mm = 4;
+  params.max_distance_mm = 0.25;
+  params.reduction = surface::PointReduction::kNone;
+  params.split_points = surface::kMinPointBudget;
+  params.split_overlap_mm = 5;
+  surface::PoissonFigures figures;
+  const auto whole = surface::reconstruct_poisson_surface(points, normals, params, {}, figures);
+  ASSERT_TRUE(whole.ok()) << whole.status();
+  EXPECT_TRUE(figures.solved_in_halves);
+  std::atomic<bool> stop{true};
+  RunContext stopping;
+  stopping.stop = &stop;
+  const auto stopped =
+      surface::reconstruct_poisson_surface(points, normals, params, stopping, figures);
+  EXPECT_EQ(stopped.status().code(), absl::StatusCode::kCancelled);
 }
 
 TEST(PoissonSurface, RepairedStageWritesTheRepairedSurface) {
