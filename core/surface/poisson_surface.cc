@@ -129,7 +129,9 @@ class SolvedFunction {
     const double value =
         (1 - w) * (boost::get<0>(low) - low_offset_) + w * (boost::get<0>(high) - high_offset_);
     // The cell lets the oracle interpolate linearly once a crossing's ends
-    // share one; across a 20-voxel blend, one cell is nearly linear too.
+    // share one. The blend is not linear within a cell, so that crossing is an
+    // approximation, within one cell of the surface; the blend changes over
+    // 20 voxels, the cells there are about one voxel across.
     const auto& nearer = w < 0.5 ? low : high;
     return {value, boost::get<1>(nearer), boost::get<2>(nearer)};
   }
@@ -424,6 +426,13 @@ absl::StatusOr<TriangleMesh> reconstruct_in_halves(const std::vector<OrientedPoi
                                                    PoissonFigures& figures) {
   auto start = std::chrono::steady_clock::now();
   const Halves halves = split_points(points, params.split_overlap_mm);
+  // Many points on one plane across the split axis can leave the low side
+  // (below the median) nearly empty: then one solve.
+  const auto low_side = std::count_if(points.begin(), points.end(), [&](const auto& point) {
+    return point.first[halves.axis] < halves.at;
+  });
+  if (size_t(low_side) < points.size() / 4)
+    return reconstruct_whole(points, params, context, figures);
   Solve low, high;
   side_by_side([&] { high = solve(halves.high, params, context); },
                [&] { low = solve(halves.low, params, context); });

@@ -12,6 +12,7 @@
 
 #include "core/pipeline.h"
 #include "core/surface/poisson_surface.h"
+#include "core/surface/surface_checks.h"
 #include "core/surface/surface_statistics.h"
 #include "core/volume/phantom.h"
 #include "core/volume/write_label_volume.h"
@@ -188,6 +189,14 @@ TEST(PoissonSurface, TwoHalvesGiveTheOneSolveSurface) {
               whole->distance_to_marching_cubes->hausdorff_mm, 0.1);
   EXPECT_NEAR(split->distance_to_marching_cubes->mean_mm,
               whole->distance_to_marching_cubes->mean_mm, 0.02);
+  // And the two surfaces directly, where a seam would show. Each mesh may
+  // stray from its function's zero level by the distance bound (half a voxel,
+  // 0.5 mm here), so two meshes of one level can be twice that apart.
+  // Measured: 0.82 mm at most, 0.12 mm on average.
+  const auto apart = surface::surface_distance(split->mesh, whole->mesh, 0.5);
+  EXPECT_LT(apart.hausdorff_mm, 1.0)
+      << apart.hausdorff_at[0] << " " << apart.hausdorff_at[1] << " " << apart.hausdorff_at[2];
+  EXPECT_LT(apart.mean_mm, 0.2);
   // Deterministic although two threads solve.
   EXPECT_EQ(split_again->mesh.points, split->mesh.points);
   EXPECT_EQ(split_again->mesh.triangles, split->mesh.triangles);
