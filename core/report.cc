@@ -39,14 +39,6 @@ absl::Status check_voxels(std::string_view field, double value) {
   return absl::InvalidArgumentError(cat(field, ": ", value, " is not a positive number of voxels"));
 }
 
-// A point count where 0 turns the feature off and anything else must be at
-// least kMinPointBudget.
-absl::Status check_point_count(std::string_view field, uint64_t value) {
-  if (value == 0 || value >= surface::kMinPointBudget) return absl::OkStatus();
-  return absl::InvalidArgumentError(
-      cat(field, ": ", value, " is neither 0 (off) nor at least ", surface::kMinPointBudget));
-}
-
 absl::Status read_poisson_options(const v1::MeshOptions& options, PoissonOptions& poisson) {
   if (options.has_min_angle_deg()) {
     poisson.min_angle_deg = options.min_angle_deg();
@@ -107,11 +99,12 @@ absl::Status read_poisson_options(const v1::MeshOptions& options, PoissonOptions
   }
   if (options.has_max_points()) {
     poisson.max_points = options.max_points();
-    if (auto s = check_point_count("max_points", poisson.max_points); !s.ok()) return s;
+    if (auto s = surface::check_point_count("max_points", poisson.max_points); !s.ok()) return s;
   }
   if (options.has_split_points()) {
     poisson.split_points = options.split_points();
-    if (auto s = check_point_count("split_points", poisson.split_points); !s.ok()) return s;
+    if (auto s = surface::check_point_count("split_points", poisson.split_points); !s.ok())
+      return s;
   }
   switch (options.point_reduction()) {
     case v1::POINT_REDUCTION_UNSPECIFIED:

@@ -256,13 +256,8 @@ absl::Status check_params(const PoissonParams& params) {
   if (params.reduction == PointReduction::kGrid &&
       (!(params.reduction_cell_mm > 0) || !std::isfinite(params.reduction_cell_mm)))
     return absl::InvalidArgumentError("point-cell: must be a positive length");
-  if (params.max_points != 0 && params.max_points < kMinPointBudget)
-    return absl::InvalidArgumentError(cat("max-points: ", params.max_points,
-                                          " is neither 0 (no budget) nor at least ",
-                                          kMinPointBudget));
-  if (params.split_points != 0 && params.split_points < kMinPointBudget)
-    return absl::InvalidArgumentError(cat("split-points: ", params.split_points,
-                                          " is neither 0 (never) nor at least ", kMinPointBudget));
+  if (auto s = check_point_count("max-points", params.max_points); !s.ok()) return s;
+  if (auto s = check_point_count("split-points", params.split_points); !s.ok()) return s;
   if (params.split_points != 0 &&
       (!(params.split_overlap_mm > 0) || !std::isfinite(params.split_overlap_mm)))
     return absl::InvalidArgumentError("split overlap: must be a positive length");
@@ -333,21 +328,24 @@ struct Halves {
   int axis = 0;
   double at = 0;
   std::vector<OrientedPoint> low, high;
+  // Points strictly below the split: few when many share one plane there.
+  size_t below = 0;
+  // The box of all the points.
+  std::array<double, 3> low_corner{}, high_corner{};
 };
 
 Halves split_points(const std::vector<OrientedPoint>& points, double overlap) {
-  std::array<double, 3> low_corner{}, high_corner{};
+  Halves halves;
   for (int axis = 0; axis < 3; ++axis) {
     const auto [min, max] = std::minmax_element(
         points.begin(), points.end(),
         [axis](const auto& a, const auto& b) { return a.first[axis] < b.first[axis]; });
-    low_corner[axis] = min->first[axis];
-    high_corner[axis] = max->first[axis];
+    halves.low_corner[axis] = min->first[axis];
+    halves.high_corner[axis] = max->first[axis];
   }
-  Halves halves;
+  auto extent = [&](int axis) { return halves.high_corner[axis] - halves.low_corner[axis]; };
   for (int axis = 1; axis < 3; ++axis) {
-    if (high_corner[axis] - low_corner[axis] > high_corner[halves.axis] - low_corner[halves.axis])
-      halves.axis = axis;
+    if (extent(axis) > extent(halves.axis)) halves.axis = axis;
   }
   std::vector<double> along;
   along.reserve(points.size());
@@ -358,6 +356,7 @@ Halves split_points(const std::vector<OrientedPoint>& points, double overlap) {
     const double x = point.first[halves.axis];
     if (x < halves.at + overlap) halves.low.push_back(point);
     if (x >= halves.at - overlap) halves.high.push_back(point);
+    if (x < halves.at) ++halves.below;
   }
   return halves;
 }
@@ -431,11 +430,7 @@ absl::StatusOr<TriangleMesh> reconstruct_in_halves(const std::vector<OrientedPoi
   const Halves halves = split_points(points, params.split_overlap_mm);
   // Many points on one plane across the split axis can leave the low side
   // (below the median) nearly empty: then one solve.
-  const auto low_side = std::count_if(points.begin(), points.end(), [&](const auto& point) {
-    return point.first[halves.axis] < halves.at;
-  });
-  if (size_t(low_side) < points.size() / 4)
-    return reconstruct_whole(points, params, context, figures);
+  if (halves.below < points.size() / 4) return reconstruct_whole(points, params, context, figures);
   Solve low, high;
   side_by_side([&] { high = solve(halves.high, params, context); },
                [&] { low = solve(halves.low, params, context); });
@@ -457,13 +452,11 @@ absl::StatusOr<TriangleMesh> reconstruct_in_halves(const std::vector<OrientedPoi
   if (!(boost::get<0>(function.evaluate(inner)) < 0)) inner = high.function->get_inner_point();
   if (!(boost::get<0>(function.evaluate(inner)) < 0))
     return absl::InternalError("poisson: the halves' functions found no inside point");
-  const CGAL::Bbox_3 box =
-      CGAL::bbox_3(CGAL::make_transform_iterator_from_property_map(points.begin(), PointMap()),
-                   CGAL::make_transform_iterator_from_property_map(points.end(), PointMap()));
-  const Point centre((box.xmin() + box.xmax()) / 2, (box.ymin() + box.ymax()) / 2,
-                     (box.zmin() + box.zmax()) / 2);
+  const auto& lo = halves.low_corner;
+  const auto& hi = halves.high_corner;
+  const Point centre((lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, (lo[2] + hi[2]) / 2);
   const double half_diagonal =
-      std::sqrt(CGAL::squared_distance(centre, Point(box.xmax(), box.ymax(), box.zmax())));
+      std::sqrt(CGAL::squared_distance(centre, Point(hi[0], hi[1], hi[2])));
   auto mesh = mesh_zero_level(
       function, inner, half_diagonal + std::sqrt(CGAL::squared_distance(centre, inner)), params);
   figures.mesh_seconds = seconds_since(start);
@@ -471,6 +464,12 @@ absl::StatusOr<TriangleMesh> reconstruct_in_halves(const std::vector<OrientedPoi
 }
 
 }  // namespace
+
+absl::Status check_point_count(std::string_view field, uint64_t value) {
+  if (value == 0 || value >= kMinPointBudget) return absl::OkStatus();
+  return absl::InvalidArgumentError(
+      cat(field, ": ", value, " is neither 0 (off) nor at least ", kMinPointBudget));
+}
 
 absl::StatusOr<TriangleMesh> reconstruct_poisson_surface(const std::vector<geometry::Vec3>& points,
                                                          const std::vector<geometry::Vec3>& normals,

@@ -3,6 +3,8 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
+#include <string_view>
 #include <vector>
 
 #include "absl/status/statusor.h"
@@ -35,6 +37,10 @@ enum class PointReduction {
 inline constexpr uint32_t kMaxClusterSize = 64;
 // A point budget below this thins even a small organ's surface.
 inline constexpr uint64_t kMinPointBudget = 1000;
+
+// A point count that 0 turns off (max_points, split_points): otherwise at
+// least kMinPointBudget. INVALID_ARGUMENT names `field`.
+absl::Status check_point_count(std::string_view field, uint64_t value);
 
 struct PoissonParams {
   // Surface mesher criteria (CGAL Surface_mesh_default_criteria_3).

@@ -258,15 +258,15 @@ TEST_F(MeshingServiceTest, BrokenUploadsAreRefusedAndLeaveNothing) {
   v1::JobSpec bad_option = good;
   bad_option.mutable_options()->set_min_angle_deg(45);
   expect_invalid(bad_option, bytes, "spec.options");
-  v1::JobSpec bad_cluster = good;
-  bad_cluster.mutable_options()->set_point_cluster_size(0);
-  expect_invalid(bad_cluster, bytes, "point_cluster_size");
-  v1::JobSpec bad_budget = good;
-  bad_budget.mutable_options()->set_max_points(10);
-  expect_invalid(bad_budget, bytes, "max_points");
-  v1::JobSpec bad_split = good;
-  bad_split.mutable_options()->set_split_points(10);
-  expect_invalid(bad_split, bytes, "split_points");
+  // Point counts out of range: the refusal names the field.
+  auto expect_bad_option = [&](auto set, const std::string& field) {
+    v1::JobSpec spec = good;
+    set(*spec.mutable_options());
+    expect_invalid(spec, bytes, field);
+  };
+  expect_bad_option([](v1::MeshOptions& o) { o.set_point_cluster_size(0); }, "point_cluster_size");
+  expect_bad_option([](v1::MeshOptions& o) { o.set_max_points(10); }, "max_points");
+  expect_bad_option([](v1::MeshOptions& o) { o.set_split_points(10); }, "split_points");
   // Bytes that are not a NIfTI file: our header check names the file "upload".
   const std::string garbage(4096, 'x');
   v1::JobSpec not_nifti = good;
