@@ -6,6 +6,7 @@
 
 #include "core/quality_surfaces.h"
 #include "core/report.h"
+#include "core/side_by_side.h"
 #include "core/surface/extract_surfaces.h"
 #include "core/surface/write_surface.h"
 #include "core/text.h"
@@ -37,6 +38,31 @@ absl::StatusOr<std::vector<int32_t>> choose_labels(const std::string& path,
     if (std::find(labels.begin(), labels.end(), label) == labels.end()) labels.push_back(label);
   }
   return labels;
+}
+
+// TetGen on each label's output surface, then the improvement pass.
+absl::Status add_volume_mesh(const MeshParams& params, const volume::ImageGeometry& geometry,
+                             const RunContext& context, MeshResult& result) {
+  std::vector<LabelBoundary> boundaries;
+  for (const auto& surface : result.surfaces) {
+    if (surface.is_output)
+      boundaries.push_back({surface.label, &surface.mesh, surface.self_intersections});
+  }
+  absl::StatusOr<VolumeResult> tets;
+  {
+    StageTimer timer(result.stages, "tetgen");
+    context.report("tetgen", 0);
+    tets = tetrahedralize_labels(boundaries, params.tetgen, context);
+  }
+  if (!tets.ok()) return tets.status();
+  {
+    StageTimer timer(result.stages, "tet_improve");
+    context.report("tet_improve", 0);
+    const auto improve = improve_params_for(params, geometry);
+    if (auto s = improve_volume(*tets, improve, context); !s.ok()) return s;
+  }
+  result.volume = std::move(*tets);
+  return absl::OkStatus();
 }
 
 }  // namespace
@@ -87,51 +113,66 @@ absl::StatusOr<MeshResult> run_pipeline(const std::string& path, const MeshParam
     surfaces = surface::extract_surfaces(*volume, result.input.statistics, *labels, context);
   }
   if (!surfaces.ok()) return surfaces.status();
-  {
-    StageTimer timer(result.stages, "surface_statistics");
+  // The Marching Cubes figures. When quality surfaces follow, the Marching
+  // Cubes meshes are only measured, on a second thread while the quality
+  // surfaces' first stages (components, repair) keep one core busy, and then
+  // dropped.
+  const bool quality = params.surface != SurfaceMethod::kMarchingCubes;
+  std::vector<StageTiming> statistics_stage;
+  auto measure_marching_cubes = [&] {
+    StageTimer timer(statistics_stage, "surface_statistics");
     for (auto& extracted : *surfaces) {
       SurfaceResult surface;
       surface.label = extracted.label;
       surface.stage = "marching_cubes";
-      surface.is_output = params.surface == SurfaceMethod::kMarchingCubes;
+      surface.is_output = !quality;
       surface.statistics = surface::compute_surface_statistics(extracted.mesh);
-      surface.mesh = std::move(extracted.mesh);
+      if (!quality) surface.mesh = std::move(extracted.mesh);
+      extracted.mesh = {};
       result.surfaces.push_back(std::move(surface));
     }
-  }
-  if (params.surface != SurfaceMethod::kMarchingCubes) {
-    // The Marching Cubes surfaces were kept for their figures only.
-    for (auto& surface : result.surfaces) surface.mesh = {};
-    for (int32_t label : *labels) {
-      const auto* statistics = result.input.statistics.find(label);
-      if (auto s = add_quality_surfaces(*volume, *statistics, params, context, result.surfaces,
-                                        result.stages);
-          !s.ok()) {
-        return s;
+  };
+  // Listed where it runs first, whatever finishes first.
+  result.stages.push_back({"surface_statistics", 0});
+  std::vector<SurfaceResult> quality_surfaces;
+  absl::Status quality_status;
+  if (!quality) {
+    measure_marching_cubes();
+  } else {
+    side_by_side(measure_marching_cubes, [&] {
+      for (int32_t label : *labels) {
+        const auto* statistics = result.input.statistics.find(label);
+        quality_status = add_quality_surfaces(*volume, *statistics, params, context,
+                                              quality_surfaces, result.stages);
+        if (!quality_status.ok()) return;
       }
-    }
+    });
   }
+  add_stage_time(result.stages, "surface_statistics", statistics_stage.front().seconds);
+  if (!quality_status.ok()) return quality_status;
+  for (auto& surface : quality_surfaces) result.surfaces.push_back(std::move(surface));
+  // The distances to Marching Cubes are measured beside TetGen, which needs
+  // only the surfaces and their self-intersection counts; progress then comes
+  // from TetGen alone (the callback expects one stage at a time).
+  std::vector<StageTiming> distance_stage;
+  absl::Status distance_status;
+  auto measure = [&](const RunContext& measure_context) {
+    StageTimer timer(distance_stage, "surface_distance");
+    distance_status = measure_distances(result.surfaces, measure_context);
+  };
   if (params.volume == VolumeMethod::kTetgen) {
-    std::vector<LabelBoundary> boundaries;
-    for (const auto& surface : result.surfaces) {
-      if (surface.is_output)
-        boundaries.push_back({surface.label, &surface.mesh, surface.self_intersections});
-    }
-    absl::StatusOr<VolumeResult> tets;
-    {
-      StageTimer timer(result.stages, "tetgen");
-      context.report("tetgen", 0);
-      tets = tetrahedralize_labels(boundaries, params.tetgen, context);
-    }
-    if (!tets.ok()) return tets.status();
-    {
-      StageTimer timer(result.stages, "tet_improve");
-      context.report("tet_improve", 0);
-      const auto improve = improve_params_for(params, volume->geometry);
-      if (auto s = improve_volume(*tets, improve, context); !s.ok()) return s;
-    }
-    result.volume = std::move(*tets);
+    RunContext quiet = context;
+    quiet.progress = nullptr;
+    absl::Status volume_status;
+    side_by_side(
+        [&] { measure(quiet); },
+        [&] { volume_status = add_volume_mesh(params, volume->geometry, context, result); });
+    if (!volume_status.ok()) return volume_status;
+  } else {
+    measure(context);
   }
+  if (quality) add_stage_time(result.stages, "surface_distance", distance_stage.front().seconds);
+  if (!distance_status.ok()) return distance_status;
   return result;
 }
 

@@ -2,9 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 
+#include "core/side_by_side.h"
 #include "core/surface/extract_surfaces.h"
 #include "core/surface/smooth_surface.h"
+#include "core/surface/surface_checks.h"
 #include "core/surface/vertex_normals.h"
 #include "core/text.h"
 #include "core/volume/label_components.h"
@@ -93,6 +96,24 @@ void add_repair_counts(surface::RepairCounts& sum, const surface::RepairCounts& 
   sum.holes_filled += part.holes_filled;
 }
 
+// Repairs each component's surface in place and adds it to `repaired`.
+absl::Status repair_pieces(double voxel, const RunContext& context,
+                           std::vector<TriangleMesh>& pieces, SurfaceResult& repaired) {
+  surface::RepairParams repair_params;
+  repair_params.max_collapse_length_mm = voxel;
+  PieceProgress progress(context, "repair", pieces);
+  for (auto& piece : pieces) {
+    surface::RepairCounts counts;
+    auto fixed = surface::repair_surface(piece, repair_params, context, counts);
+    if (!fixed.ok()) return fixed.status();
+    add_repair_counts(*repaired.repair, counts);
+    progress.done(piece);
+    piece = std::move(*fixed);
+    repaired.mesh.append(piece);
+  }
+  return absl::OkStatus();
+}
+
 surface::PoissonParams poisson_params(const PoissonOptions& options, double voxel) {
   surface::PoissonParams params;
   params.min_angle_deg = options.min_angle_deg;
@@ -135,21 +156,28 @@ absl::Status add_quality_surfaces(const volume::LabelVolume& volume,
   repaired.stage = "repaired";
   repaired.components = pieces->counts;
   repaired.repair.emplace();
+  // The Marching Cubes side of the distance check is built beside the
+  // repair, on the core the repair leaves idle.
+  std::shared_ptr<surface::DistanceReference> marching_cubes_reference;
+  absl::Status repair_status;
   {
     StageTimer timer(stages, "repair");
-    surface::RepairParams repair_params;
-    repair_params.max_collapse_length_mm = voxel;
-    PieceProgress progress(context, "repair", pieces->meshes);
-    for (auto& piece : pieces->meshes) {
-      surface::RepairCounts counts;
-      auto fixed = surface::repair_surface(piece, repair_params, context, counts);
-      if (!fixed.ok()) return fixed.status();
-      add_repair_counts(*repaired.repair, counts);
-      progress.done(piece);
-      piece = std::move(*fixed);
-      repaired.mesh.append(piece);
-    }
+    side_by_side(
+        [&] {
+          marching_cubes_reference =
+              std::make_shared<surface::DistanceReference>(marching_cubes, voxel);
+        },
+        [&] { repair_status = repair_pieces(voxel, context, pieces->meshes, repaired); });
   }
+  if (!repair_status.ok()) return repair_status;
+  marching_cubes = {};
+  {
+    StageTimer timer(stages, "surface_statistics");
+    repaired.statistics = surface::compute_surface_statistics(repaired.mesh);
+  }
+  // The repaired surface is only an intermediate when Poisson follows: its
+  // figures stay in the report, its triangles need not stay in memory.
+  if (params.surface == SurfaceMethod::kPoisson) repaired.mesh = {};
 
   SurfaceResult poisson;
   if (params.surface == SurfaceMethod::kPoisson) {
@@ -184,27 +212,30 @@ absl::Status add_quality_surfaces(const volume::LabelVolume& volume,
 
   SurfaceResult& output = params.surface == SurfaceMethod::kPoisson ? poisson : repaired;
   output.is_output = true;
-  {
+  if (params.surface == SurfaceMethod::kPoisson) {
     StageTimer timer(stages, "surface_statistics");
-    repaired.statistics = surface::compute_surface_statistics(repaired.mesh);
-    if (params.surface == SurfaceMethod::kPoisson)
-      poisson.statistics = surface::compute_surface_statistics(poisson.mesh);
+    poisson.statistics = surface::compute_surface_statistics(poisson.mesh);
   }
   {
-    StageTimer timer(stages, "surface_checks");
-    context.report("surface_checks", 0);
+    StageTimer timer(stages, "self_intersections");
     output.self_intersections = surface::count_self_intersections(output.mesh);
-    if (auto s = context.check_stop(); !s.ok()) return s;
-    output.distance_to_marching_cubes =
-        surface::surface_distance(output.mesh, marching_cubes, voxel, context);
-    if (auto s = context.check_stop(); !s.ok()) return s;
-    context.report("surface_checks", 1);
   }
-  // The repaired surface is only an intermediate when Poisson follows: its
-  // figures stay in the report, its triangles need not stay in memory.
-  if (params.surface == SurfaceMethod::kPoisson) repaired.mesh = {};
+  output.marching_cubes_reference = std::move(marching_cubes_reference);
   surfaces.push_back(std::move(repaired));
   if (params.surface == SurfaceMethod::kPoisson) surfaces.push_back(std::move(poisson));
+  return absl::OkStatus();
+}
+
+absl::Status measure_distances(std::vector<SurfaceResult>& surfaces, const RunContext& context) {
+  context.report("surface_distance", 0);
+  for (auto& surface : surfaces) {
+    if (!surface.marching_cubes_reference) continue;
+    surface.distance_to_marching_cubes =
+        surface::surface_distance(surface.mesh, *surface.marching_cubes_reference, context);
+    surface.marching_cubes_reference.reset();
+    if (auto s = context.check_stop(); !s.ok()) return s;
+  }
+  context.report("surface_distance", 1);
   return absl::OkStatus();
 }
 

@@ -19,13 +19,19 @@ namespace labelmesh {
 double voxel_size_mm(const volume::ImageGeometry& geometry);
 
 // Appends the "repaired" surface of `label` and, for SurfaceMethod::kPoisson,
-// the "poisson" one; the last appended is marked as the output. Adds stage
-// times to `stages`. Errors: INVALID_ARGUMENT for bad options,
+// the "poisson" one; the last appended is marked as the output and carries
+// the Marching Cubes reference for measure_distances. Adds stage times to
+// `stages`. Errors: INVALID_ARGUMENT for bad options,
 // FAILED_PRECONDITION when every component is under the size threshold,
 // INTERNAL for a failed stage, CANCELLED.
 absl::Status add_quality_surfaces(const volume::LabelVolume& volume,
                                   const volume::LabelStatistics& label, const MeshParams& params,
                                   const RunContext& context, std::vector<SurfaceResult>& surfaces,
                                   std::vector<StageTiming>& stages);
+
+// Measures each surface that carries a Marching Cubes reference against it
+// (distance_to_marching_cubes), then drops the reference. Uses two threads.
+// Errors: CANCELLED.
+absl::Status measure_distances(std::vector<SurfaceResult>& surfaces, const RunContext& context);
 
 }  // namespace labelmesh

@@ -55,15 +55,15 @@ class HintedEvaluator {
         std::max({box.xmax() - box.xmin(), box.ymax() - box.ymin(), box.zmax() - box.zmin(), 1e-9});
     // About two million cubes (16 MB): a few cells across each on the liver.
     // The second bound keeps a flat or empty box from asking for more.
-    step_ = std::max(std::cbrt(volume / double(1 << 21)), longest / 1024);
-    origin_ = {box.xmin(), box.ymin(), box.zmin()};
+    const double step = std::max(std::cbrt(volume / double(1 << 21)), longest / 1024);
     // A triangulation that is not yet a volume gets no grid (and no walks
     // from it); the solve never leaves one, but the box would be infinite.
-    if (tr_.dimension() == 3) {
-      for (int axis = 0; axis < 3; ++axis)
-        size_[axis] = int((box.max(axis) - box.min(axis)) / step_) + 1;
-    }
-    slots_.assign(size_t(size_[0]) * size_[1] * size_[2], Cell_handle());
+    const bool volume_ok = tr_.dimension() == 3;
+    fine_ = Grid(box, step, volume_ok);
+    // The first question in a cube of the fine grid starts from the coarse
+    // one's cell, 4 cubes across: the last answer may be across the organ
+    // (on the liver, those walks were a third of the locating time).
+    coarse_ = Grid(box, 4 * step, volume_ok);
     last_ = tr_.infinite_cell();
     // Epick points start uninitialised; NaN matches no query.
     const double nan = std::numeric_limits<double>::quiet_NaN();
@@ -76,12 +76,19 @@ class HintedEvaluator {
     }
     if ((++calls_ & 4095) == 0 && context_.stop_requested()) throw Cancelled{};
     // Bisection asks next door to its last question: walk from there.
-    Cell_handle* slot = slot_for(p);
-    const bool near_last = CGAL::squared_distance(p, last_point_) < step_ * step_;
-    const Cell_handle start =
-        !near_last && slot != nullptr && *slot != Cell_handle() ? *slot : last_;
+    Cell_handle* slot = fine_.slot_for(p);
+    Cell_handle* coarse_slot = coarse_.slot_for(p);
+    Cell_handle start = last_;
+    if (CGAL::squared_distance(p, last_point_) >= fine_.step * fine_.step) {
+      if (slot != nullptr && *slot != Cell_handle()) {
+        start = *slot;
+      } else if (coarse_slot != nullptr && *coarse_slot != Cell_handle()) {
+        start = *coarse_slot;
+      }
+    }
     const Cell_handle cell = tr_.locate(p, start);
     if (slot != nullptr && *slot == Cell_handle()) *slot = cell;
+    if (coarse_slot != nullptr && *coarse_slot == Cell_handle()) *coarse_slot = cell;
     last_ = cell;
     last_point_ = p;
     const Answer answer = value_in(cell, p);
@@ -91,15 +98,34 @@ class HintedEvaluator {
   }
 
  private:
-  Cell_handle* slot_for(const Point& p) {
-    size_t index = 0;
-    for (int axis = 2; axis >= 0; --axis) {
-      const double at = (p[axis] - origin_[axis]) / step_;
-      if (!(at >= 0 && at < size_[axis])) return nullptr;
-      index = index * size_[axis] + size_t(at);
+  // Cubes over the triangulation's box, each holding the cell first found
+  // in it.
+  struct Grid {
+    Grid() = default;
+    Grid(const CGAL::Bbox_3& box, double cube, bool sized) : step(cube) {
+      origin = {box.xmin(), box.ymin(), box.zmin()};
+      if (sized) {
+        for (int axis = 0; axis < 3; ++axis)
+          size[axis] = int((box.max(axis) - box.min(axis)) / step) + 1;
+      }
+      slots.assign(size_t(size[0]) * size[1] * size[2], Cell_handle());
     }
-    return &slots_[index];
-  }
+
+    Cell_handle* slot_for(const Point& p) {
+      size_t index = 0;
+      for (int axis = 2; axis >= 0; --axis) {
+        const double at = (p[axis] - origin[axis]) / step;
+        if (!(at >= 0 && at < size[axis])) return nullptr;
+        index = index * size[axis] + size_t(at);
+      }
+      return &slots[index];
+    }
+
+    double step = 1;
+    std::array<double, 3> origin{};
+    std::array<int, 3> size{};
+    std::vector<Cell_handle> slots;
+  };
 
   // Linear interpolation of the vertex values, as CGAL's own operator();
   // outside the convex hull, the value of a hull vertex.
@@ -122,10 +148,7 @@ class HintedEvaluator {
 
   const Triangulation& tr_;
   const RunContext& context_;
-  double step_ = 1;
-  std::array<double, 3> origin_{};
-  std::array<int, 3> size_{};
-  std::vector<Cell_handle> slots_;
+  Grid fine_, coarse_;
   Cell_handle last_;
   Point last_point_ = Point(CGAL::ORIGIN);
   std::array<std::pair<Point, Answer>, 4> recent_{};

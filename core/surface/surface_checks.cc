@@ -102,27 +102,49 @@ struct OneSided {
 };
 
 // One direction of the distance: where the samples are and what they are
-// measured against.
+// measured against (the samples of one surface, the tree of the other).
 struct Direction {
+  const std::vector<Point>& samples;
+  const Tree* tree;
+};
+
+}  // namespace
+
+constexpr size_t kSeedEvery = 4;
+
+struct DistanceReference::Parts {
   std::vector<Point> samples;
-  Triangles target;
+  Triangles triangles;
   std::unique_ptr<Tree> tree;
 };
 
-Direction prepare(const TriangleMesh& from, const TriangleMesh& to, double spacing) {
-  Direction direction{sample_points(from, spacing), to_triangles(to), nullptr};
-  if (!direction.target.empty()) {
-    direction.tree = std::make_unique<Tree>(direction.target.begin(), direction.target.end());
-    direction.tree->build();
-    direction.tree->accelerate_distance_queries();
+DistanceReference::DistanceReference(const TriangleMesh& mesh, double sample_spacing_mm)
+    : parts_(std::make_unique<Parts>()), sample_spacing_mm_(sample_spacing_mm) {
+  parts_->samples = sample_points(mesh, sample_spacing_mm);
+  parts_->triangles = to_triangles(mesh);
+  if (!parts_->triangles.empty()) {
+    parts_->tree = std::make_unique<Tree>(parts_->triangles.begin(), parts_->triangles.end());
+    parts_->tree->build();
+    // The first corner of every fourth triangle seeds each query's search:
+    // a quarter of CGAL's default memory, about as near a start.
+    std::vector<std::pair<Point, Primitive::Id>> seeds;
+    seeds.reserve(parts_->triangles.size() / kSeedEvery + 1);
+    for (size_t t = 0; t < parts_->triangles.size(); t += kSeedEvery) {
+      const auto id = parts_->triangles.cbegin() + std::ptrdiff_t(t);
+      seeds.emplace_back(id->vertex(0), id);
+    }
+    parts_->tree->accelerate_distance_queries(seeds.begin(), seeds.end());
   }
-  return direction;
 }
+
+DistanceReference::~DistanceReference() = default;
+
+namespace {
 
 OneSided distances(const Direction& direction, size_t begin, size_t end,
                    const RunContext& context) {
   OneSided result;
-  if (!direction.tree) return result;
+  if (direction.tree == nullptr) return result;
   for (size_t i = begin; i < end; ++i) {
     // About 10 ms of queries between looks at a stop request.
     if ((i - begin) % 4096 == 4095 && context.stop_requested()) break;
@@ -150,13 +172,16 @@ std::optional<uint64_t> count_self_intersections(const TriangleMesh& mesh) {
 
 SurfaceDistance surface_distance(const TriangleMesh& a, const TriangleMesh& b,
                                  double sample_spacing_mm, const RunContext& context) {
-  // Each direction is prepared on its own thread, then both threads query.
+  return surface_distance(a, DistanceReference(b, sample_spacing_mm), context);
+}
+
+SurfaceDistance surface_distance(const TriangleMesh& a, const DistanceReference& b,
+                                 const RunContext& context) {
+  const DistanceReference a_parts(a, b.sample_spacing_mm());
+  const Direction a_to_b{a_parts.parts().samples, b.parts().tree.get()};
+  const Direction b_to_a{b.parts().samples, a_parts.parts().tree.get()};
   // Each thread's share is a fixed range and the partial sums are added in a
   // fixed order, so the figures do not depend on scheduling.
-  Direction a_to_b, b_to_a;
-  side_by_side([&] { a_to_b = prepare(a, b, sample_spacing_mm); },
-               [&] { b_to_a = prepare(b, a, sample_spacing_mm); });
-
   // Each direction's samples are halved between the threads: per query, the
   // direction into the denser mesh costs twice the other.
   const size_t a_half = a_to_b.samples.size() / 2, b_half = b_to_a.samples.size() / 2;

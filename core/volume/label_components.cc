@@ -66,31 +66,43 @@ uint64_t prune_strands(const Box& box, std::vector<uint8_t>& mask) {
 }
 
 // Provisional set per voxel, united with the 13 neighbours already visited
-// (the half of the 26-neighbourhood that precedes it in memory order).
+// (the half of the 26-neighbourhood that precedes it in memory order). When
+// the voxel before it in the row is set, that voxel was already united with
+// every such neighbour they share, so only the four in the next column
+// (i + 1) can bring another set: about a third of the lookups on a solid
+// organ.
 absl::Status label_mask(const Box& box, const std::vector<uint8_t>& mask,
                         std::vector<uint32_t>& sets_of_voxels, geometry::DisjointSets& sets,
                         const RunContext& context) {
+  struct Offset {
+    int64_t di, dj, dk;
+  };
+  static constexpr Offset kAllEarlier[13] = {
+      {-1, -1, -1}, {0, -1, -1}, {1, -1, -1}, {-1, 0, -1}, {0, 0, -1}, {1, 0, -1}, {-1, 1, -1},
+      {0, 1, -1},   {1, 1, -1},  {-1, -1, 0}, {0, -1, 0},  {1, -1, 0}, {-1, 0, 0}};
+  static constexpr Offset kNextColumn[4] = {{1, -1, -1}, {1, 0, -1}, {1, 1, -1}, {1, -1, 0}};
   for (int64_t k = 1; k + 1 < box.size[2]; ++k) {
     if (auto s = context.check_stop(); !s.ok()) return s;
     for (int64_t j = 1; j + 1 < box.size[1]; ++j) {
       for (int64_t i = 1; i + 1 < box.size[0]; ++i) {
         const int64_t n = box.index(i, j, k);
         if (!mask[static_cast<size_t>(n)]) continue;
-        uint32_t set = kBackground;
-        for (int64_t dk = -1; dk <= 0; ++dk) {
-          for (int64_t dj = -1; dj <= 1; ++dj) {
-            for (int64_t di = -1; di <= 1; ++di) {
-              if (dk == 0 && (dj > 0 || (dj == 0 && di >= 0))) continue;
-              const uint32_t other =
-                  sets_of_voxels[static_cast<size_t>(box.index(i + di, j + dj, k + dk))];
-              if (other == kBackground) continue;
-              if (set == kBackground) {
-                set = other;
-              } else {
-                sets.unite(set, other);
-              }
-            }
+        const uint32_t left = sets_of_voxels[static_cast<size_t>(n - 1)];
+        uint32_t set = left;
+        auto unite_with = [&](const Offset& o) {
+          const uint32_t other =
+              sets_of_voxels[static_cast<size_t>(box.index(i + o.di, j + o.dj, k + o.dk))];
+          if (other == kBackground) return;
+          if (set == kBackground) {
+            set = other;
+          } else {
+            sets.unite(set, other);
           }
+        };
+        if (left != kBackground) {
+          for (const auto& o : kNextColumn) unite_with(o);
+        } else {
+          for (const auto& o : kAllEarlier) unite_with(o);
         }
         if (set == kBackground) set = sets.add();
         sets_of_voxels[static_cast<size_t>(n)] = set;

@@ -299,7 +299,7 @@ TEST(PoissonSurface, AStopDuringTheChecksCancelsTheRun) {
   RunContext context;
   context.stop = &stop;
   context.progress = [&](std::string_view stage, double) {
-    if (stage == "surface_checks") stop = true;
+    if (stage == "surface_distance") stop = true;
   };
   auto result = run_pipeline(path, MeshParams{}, context);
   EXPECT_EQ(result.status().code(), absl::StatusCode::kCancelled);
