@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <optional>
 #include <utility>
 #include <vector>
 
@@ -134,6 +135,14 @@ class HintedEvaluator {
       const int i = cell->index(tr_.infinite_vertex());
       return {cell->vertex((i + 1) & 3)->f(), cell, true};
     }
+    const auto weights = barycentric(cell, p);
+    double value = 0;
+    for (int i = 0; i < 4; ++i) value += weights[i] * cell->vertex(i)->f();
+    return {value, cell, false};
+  }
+
+  // `p`'s barycentric coordinates in a finite `cell` (negative outside it).
+  static std::array<double, 4> barycentric(Cell_handle cell, const Point& p) {
     const Point& d = cell->vertex(3)->point();
     const Vector da = cell->vertex(0)->point() - d, db = cell->vertex(1)->point() - d,
                  dc = cell->vertex(2)->point() - d, dp = p - d;
@@ -141,11 +150,35 @@ class HintedEvaluator {
     const double a = CGAL::determinant(dp, db, dc) / whole;
     const double b = CGAL::determinant(da, dp, dc) / whole;
     const double c = CGAL::determinant(da, db, dp) / whole;
-    const double value = a * cell->vertex(0)->f() + b * cell->vertex(1)->f() +
-                         c * cell->vertex(2)->f() + (1 - a - b - c) * cell->vertex(3)->f();
-    return {value, cell, false};
+    return {a, b, c, 1 - a - b - c};
   }
 
+ public:
+  // How many questions needed a located point so far.
+  uint64_t located() const { return calls_; }
+
+  // The point of segment [p1, p2] where the linear function of the finite
+  // `cell`, minus `offset`, is zero, if that point lies in the cell (where
+  // the function is that linear function): the exact crossing of the
+  // piecewise linear function there, found from one located cell.
+  std::optional<Point> zero_in_cell(Cell_handle cell, double offset, const Point& p1,
+                                    const Point& p2) const {
+    if (tr_.is_infinite(cell)) return std::nullopt;
+    const double g1 = boost::get<0>(value_in(cell, p1)) - offset;
+    const double g2 = boost::get<0>(value_in(cell, p2)) - offset;
+    if (!(g1 != g2)) return std::nullopt;
+    const double s = g1 / (g1 - g2);
+    if (!(s >= 0 && s <= 1)) return std::nullopt;
+    const Point zero = p1 + s * (p2 - p1);
+    // A zero on a face of the cell is the neighbour's zero too.
+    constexpr double kOnFace = -1e-12;
+    for (double weight : barycentric(cell, zero)) {
+      if (!(weight >= kOnFace)) return std::nullopt;
+    }
+    return zero;
+  }
+
+ private:
   const Triangulation& tr_;
   const RunContext& context_;
   Grid fine_, coarse_;
@@ -153,7 +186,8 @@ class HintedEvaluator {
   Point last_point_ = Point(CGAL::ORIGIN);
   std::array<std::pair<Point, Answer>, 4> recent_{};
   size_t next_recent_ = 0;
-  uint32_t calls_ = 0;
+  // Questions answered by locating the point (not from the last answers).
+  uint64_t calls_ = 0;
 };
 
 }  // namespace labelmesh::surface::poisson

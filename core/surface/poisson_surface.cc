@@ -12,7 +12,6 @@
 
 #include <CGAL/Delaunay_triangulation_3.h>
 #include <CGAL/Delaunay_triangulation_cell_base_with_circumcenter_3.h>
-#include <CGAL/Poisson_implicit_surface_3.h>
 #include <CGAL/Poisson_reconstruction_function.h>
 #include <CGAL/Polygon_mesh_processing/orient_polygon_soup.h>
 #include <CGAL/Polygon_mesh_processing/orientation.h>
@@ -30,6 +29,7 @@
 #include "core/side_by_side.h"
 #include "core/surface/cgal_mesh.h"
 #include "core/surface/hinted_poisson_evaluator.h"
+#include "core/surface/zero_level_oracle.h"
 #include "core/text.h"
 
 namespace labelmesh::surface {
@@ -45,6 +45,9 @@ using PoissonFunction = CGAL::Poisson_reconstruction_function<Kernel>;
 
 using poisson::Cancelled;
 using poisson::HintedEvaluator;
+using poisson::SolvedFunction;
+using poisson::ZeroLevel;
+using poisson::ZeroLevelOracle;
 
 // CGAL calls this before inserting each input point into its triangulation.
 struct CancellableInsertion {
@@ -100,72 +103,6 @@ class CancellableSolver {
   int* iterations_;
 };
 
-// The solved function that is meshed: one solve, or two solves of
-// overlapping halves of the points blended across the middle of the overlap.
-class SolvedFunction {
- public:
-  explicit SolvedFunction(HintedEvaluator* whole) : low_(whole) {}
-
-  // `low` holds the points below `at` along `axis`, `high` those above, each
-  // reaching `overlap` past `at`; the offsets are subtracted from each.
-  SolvedFunction(HintedEvaluator* low, double low_offset, HintedEvaluator* high, double high_offset,
-                 int axis, double at, double overlap)
-      : low_(low),
-        high_(high),
-        low_offset_(low_offset),
-        high_offset_(high_offset),
-        axis_(axis),
-        blend_from_(at - overlap / 2),
-        blend_width_(overlap) {}
-
-  HintedEvaluator::Answer evaluate(const Point& p) const {
-    if (high_ == nullptr) return low_->evaluate(p);
-    const double t = (p[axis_] - blend_from_) / blend_width_;
-    if (t <= 0) return shifted(low_->evaluate(p), low_offset_);
-    if (t >= 1) return shifted(high_->evaluate(p), high_offset_);
-    // Smoothstep: the blend and its slope are continuous at both ends.
-    const double w = t * t * (3 - 2 * t);
-    const auto low = low_->evaluate(p), high = high_->evaluate(p);
-    const double value =
-        (1 - w) * (boost::get<0>(low) - low_offset_) + w * (boost::get<0>(high) - high_offset_);
-    // The cell lets the oracle interpolate linearly once a crossing's ends
-    // share one. The blend is not linear within a cell, so that crossing is an
-    // approximation, within one cell of the surface; the blend changes over
-    // 20 voxels, the cells there are about one voxel across.
-    const auto& nearer = w < 0.5 ? low : high;
-    return {value, boost::get<1>(nearer), boost::get<2>(nearer)};
-  }
-
- private:
-  static HintedEvaluator::Answer shifted(HintedEvaluator::Answer answer, double offset) {
-    boost::get<0>(answer) -= offset;
-    return answer;
-  }
-
-  HintedEvaluator* low_;
-  HintedEvaluator* high_ = nullptr;
-  double low_offset_ = 0, high_offset_ = 0;
-  int axis_ = 0;
-  double blend_from_ = 0, blend_width_ = 1;
-};
-
-// The function as CGAL's Poisson surface oracle calls it; the mesher copies
-// it freely, so it only points at the solved function.
-class MesherFunction {
- public:
-  using FT = Kernel::FT;
-  using Point = Kernel::Point_3;
-  using Cell_handle = PoissonFunction::Cell_handle;
-
-  explicit MesherFunction(const SolvedFunction* function) : function_(function) {}
-
-  FT operator()(const Point& p) const { return boost::get<0>(function_->evaluate(p)); }
-  HintedEvaluator::Answer special_func(const Point& p) const { return function_->evaluate(p); }
-
- private:
-  const SolvedFunction* function_;
-};
-
 // Adds CGAL's creation-order time stamp to a vertex or cell base. CGAL then
 // orders and hashes handles by that stamp instead of by address, so the
 // surface mesher's sets of bad vertices and edges are walked in the same order
@@ -196,7 +133,6 @@ using MesherCellBase = TimeStamped<CGAL::Delaunay_triangulation_cell_base_with_c
 using Triangulation = CGAL::Delaunay_triangulation_3<
     MesherTraits, CGAL::Triangulation_data_structure_3<MesherVertexBase, MesherCellBase>>;
 using Complex = CGAL::Surface_mesh_complex_2_in_triangulation_3<Triangulation>;
-using ImplicitSurface = CGAL::Poisson_implicit_surface_3<Kernel, MesherFunction>;
 using OutputMesh = cgal::Mesh;
 
 // The triangles of the restricted Delaunay surface, in the triangulation's
@@ -385,18 +321,18 @@ double own_side_median(const PoissonFunction& function, const Halves& halves, bo
 // `inner` (a point where the function is negative) of `radius`.
 absl::StatusOr<TriangleMesh> mesh_zero_level(const SolvedFunction& function, const Point& inner,
                                              double radius, const PoissonParams& params) {
-  // As in CGAL's examples, a ball well beyond the points. Bisection of a
-  // crossing stops at a twentieth of the distance bound (CGAL solves exactly
-  // once both ends share a tetrahedron, where the function is linear).
+  // As in CGAL's examples, a ball well beyond the points. A crossing is
+  // exact where a tetrahedron's linear piece holds it, and otherwise found
+  // to a twentieth of the distance bound.
   const double ball_radius = 5 * radius;
-  const double bisection_error = params.max_distance_mm / 20 / ball_radius;
-  ImplicitSurface surface(MesherFunction(&function),
-                          Kernel::Sphere_3(inner, ball_radius * ball_radius), bisection_error);
+  const double bisection_error = params.max_distance_mm / 20;
+  const ZeroLevel level{&function, Kernel::Sphere_3(inner, ball_radius * ball_radius),
+                        bisection_error * bisection_error};
   CGAL::Surface_mesh_default_criteria_3<Triangulation> criteria(
       params.min_angle_deg, params.max_edge_mm / 2, params.max_distance_mm);
   Triangulation triangulation;
   Complex complex(triangulation);
-  CGAL::make_surface_mesh(complex, surface, criteria, CGAL::Manifold_tag());
+  CGAL::make_surface_mesh(complex, level, ZeroLevelOracle(), criteria, CGAL::Manifold_tag());
   auto mesh = complex_to_mesh(complex, triangulation);
   if (mesh.ok() && mesh->triangles.empty())
     return absl::InternalError("poisson: meshing found no surface in the implicit function");

@@ -286,27 +286,30 @@ bool smooth_vertex(WorkMesh& w, uint32_t v, ImproveFigures& figures) {
   for (double s : {1.0, 0.5, 0.25}) {
     try_point(geometry::add(start, geometry::scale(geometry::sub(centroid, start), s)));
   }
-  // Gradient ascent on the current worst tetrahedron, from the best point so far.
+  // Gradient ascent on the worst tetrahedra, from the best point so far: the
+  // direction that raises every one within 0.01 of the worst (the sum of
+  // their unit gradients), so that two tied worst ones do not undo each
+  // other's step.
   for (int step = 0; step < 12; ++step) {
     p = best_point;
-    uint32_t worst = w.star(v).front();
     double worst_q = kNone;
-    for (uint32_t t : w.star(v)) {
-      const double q = w.quality_of(w.tet(t));
-      if (q < worst_q) {
-        worst_q = q;
-        worst = t;
-      }
-    }
+    for (uint32_t t : w.star(v)) worst_q = std::min(worst_q, w.quality_of(w.tet(t)));
     const double h = 1e-4 * length;
-    Vec3 gradient;
-    for (int k = 0; k < 3; ++k) {
+    Vec3 gradient = {0, 0, 0};
+    for (uint32_t t : w.star(v)) {
+      if (!(w.quality_of(w.tet(t)) < worst_q + 0.01)) continue;
+      Vec3 one;
+      for (int k = 0; k < 3; ++k) {
+        p = best_point;
+        p[k] += h;
+        const double up = w.quality_of(w.tet(t));
+        p[k] -= 2 * h;
+        const double down = w.quality_of(w.tet(t));
+        one[k] = (up - down) / (2 * h);
+      }
       p = best_point;
-      p[k] += h;
-      const double up = w.quality_of(w.tet(worst));
-      p[k] -= 2 * h;
-      const double down = w.quality_of(w.tet(worst));
-      gradient[k] = (up - down) / (2 * h);
+      const double size = geometry::norm(one);
+      if (size > 0) gradient = geometry::add(gradient, geometry::scale(one, 1 / size));
     }
     const double g = geometry::norm(gradient);
     if (!(g > 0)) break;

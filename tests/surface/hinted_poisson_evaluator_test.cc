@@ -5,50 +5,15 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <numbers>
 #include <random>
 #include <vector>
 
-#include <CGAL/property_map.h>
+#include "support/solved_torus.h"
 
 namespace labelmesh::surface::poisson {
 namespace {
 
-using OrientedPoint = std::pair<Point, Vector>;
-
-// Oriented points on a torus (ring radius 10, tube radius 4) around z.
-std::vector<OrientedPoint> torus_points() {
-  std::vector<OrientedPoint> points;
-  constexpr int kAround = 90, kTube = 36;
-  for (int i = 0; i < kAround; ++i) {
-    const double u = 2 * std::numbers::pi * i / kAround;
-    for (int j = 0; j < kTube; ++j) {
-      const double v = 2 * std::numbers::pi * j / kTube;
-      const Vector normal(std::cos(v) * std::cos(u), std::cos(v) * std::sin(u), std::sin(v));
-      const Point centre(10 * std::cos(u), 10 * std::sin(u), 0);
-      points.emplace_back(centre + 4 * normal, normal);
-    }
-  }
-  return points;
-}
-
-class HintedPoissonEvaluatorTest : public testing::Test {
- protected:
-  void SetUp() override {
-    ASSERT_TRUE(function_.compute_implicit_function());
-    for (auto v = function_.tr().finite_vertices_begin(); v != function_.tr().finite_vertices_end();
-         ++v)
-      scale_ = std::max(scale_, std::abs(v->f()));
-    ASSERT_GT(scale_, 0);
-  }
-
-  std::vector<OrientedPoint> points_ = torus_points();
-  PoissonFunction function_{points_.begin(), points_.end(),
-                            CGAL::First_of_pair_property_map<OrientedPoint>(),
-                            CGAL::Second_of_pair_property_map<OrientedPoint>()};
-  double scale_ = 0;
-  RunContext context_;
-};
+using HintedPoissonEvaluatorTest = testing::SolvedTorusTest;
 
 TEST_F(HintedPoissonEvaluatorTest, GivesCgalsValueAndAContainingCell) {
   HintedEvaluator evaluator(function_, context_);
