@@ -118,10 +118,13 @@ absl::StatusOr<MeshResult> run_pipeline(const std::string& path, const MeshParam
   // surfaces' first stages (components, repair) keep one core busy, and then
   // dropped.
   const bool quality = params.surface != SurfaceMethod::kMarchingCubes;
+  const bool tetrahedra = params.volume == VolumeMethod::kTetgen;
   std::vector<StageTiming> statistics_stage;
   auto measure_marching_cubes = [&] {
     StageTimer timer(statistics_stage, "surface_statistics");
     for (auto& extracted : *surfaces) {
+      // The caller checks for the stop once both threads are done.
+      if (context.stop_requested()) return;
       SurfaceResult surface;
       surface.label = extracted.label;
       surface.stage = "marching_cubes";
@@ -135,6 +138,10 @@ absl::StatusOr<MeshResult> run_pipeline(const std::string& path, const MeshParam
   // Listed where it runs first, whatever finishes first.
   result.stages.push_back({"surface_statistics", 0});
   std::vector<SurfaceResult> quality_surfaces;
+  // The distances to Marching Cubes are measured after each label, so one
+  // label's Marching Cubes side is in memory at a time; or, when TetGen
+  // follows, beside it (below).
+  std::vector<PendingDistance> pending;
   absl::Status quality_status;
   if (!quality) {
     measure_marching_cubes();
@@ -143,36 +150,40 @@ absl::StatusOr<MeshResult> run_pipeline(const std::string& path, const MeshParam
       for (int32_t label : *labels) {
         const auto* statistics = result.input.statistics.find(label);
         quality_status = add_quality_surfaces(*volume, *statistics, params, context,
-                                              quality_surfaces, result.stages);
+                                              quality_surfaces, pending, result.stages);
+        if (!quality_status.ok()) return;
+        if (tetrahedra) continue;
+        StageTimer timer(result.stages, "surface_distance");
+        quality_status = measure_distances(quality_surfaces, pending, context);
         if (!quality_status.ok()) return;
       }
     });
   }
   add_stage_time(result.stages, "surface_statistics", statistics_stage.front().seconds);
   if (!quality_status.ok()) return quality_status;
+  if (auto s = context.check_stop(); !s.ok()) return s;
+  const size_t first_quality = result.surfaces.size();
   for (auto& surface : quality_surfaces) result.surfaces.push_back(std::move(surface));
-  // The distances to Marching Cubes are measured beside TetGen, which needs
-  // only the surfaces and their self-intersection counts; progress then comes
-  // from TetGen alone (the callback expects one stage at a time).
-  std::vector<StageTiming> distance_stage;
-  absl::Status distance_status;
-  auto measure = [&](const RunContext& measure_context) {
-    StageTimer timer(distance_stage, "surface_distance");
-    distance_status = measure_distances(result.surfaces, measure_context);
-  };
-  if (params.volume == VolumeMethod::kTetgen) {
+  for (auto& measure : pending) measure.surface += first_quality;
+
+  if (tetrahedra) {
+    // TetGen needs only the surfaces and their self-intersection counts.
+    // Progress then comes from TetGen alone (the callback expects one stage
+    // at a time).
     RunContext quiet = context;
     quiet.progress = nullptr;
-    absl::Status volume_status;
+    std::vector<StageTiming> distance_stage;
+    absl::Status distance_status, volume_status;
     side_by_side(
-        [&] { measure(quiet); },
+        [&] {
+          StageTimer timer(distance_stage, "surface_distance");
+          distance_status = measure_distances(result.surfaces, pending, quiet);
+        },
         [&] { volume_status = add_volume_mesh(params, volume->geometry, context, result); });
+    if (quality) add_stage_time(result.stages, "surface_distance", distance_stage.front().seconds);
     if (!volume_status.ok()) return volume_status;
-  } else {
-    measure(context);
+    if (!distance_status.ok()) return distance_status;
   }
-  if (quality) add_stage_time(result.stages, "surface_distance", distance_stage.front().seconds);
-  if (!distance_status.ok()) return distance_status;
   return result;
 }
 

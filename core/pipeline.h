@@ -2,7 +2,6 @@
 // volume, count labels, extract surfaces, measure them, write the results.
 #pragma once
 
-#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -58,8 +57,6 @@ struct SurfaceResult {
   std::optional<uint64_t> self_intersections;
   // To the Marching Cubes surface of the kept components.
   std::optional<surface::SurfaceDistance> distance_to_marching_cubes;
-  // That surface's side of the distance, until the distance is measured.
-  std::shared_ptr<const surface::DistanceReference> marching_cubes_reference;
   // Files written for it, relative to the output directory.
   std::vector<std::string> files;
 };

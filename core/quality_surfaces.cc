@@ -139,6 +139,7 @@ double voxel_size_mm(const volume::ImageGeometry& geometry) {
 absl::Status add_quality_surfaces(const volume::LabelVolume& volume,
                                   const volume::LabelStatistics& label, const MeshParams& params,
                                   const RunContext& context, std::vector<SurfaceResult>& surfaces,
+                                  std::vector<PendingDistance>& pending,
                                   std::vector<StageTiming>& stages) {
   const double voxel = voxel_size_mm(volume.geometry);
   absl::StatusOr<Pieces> pieces;
@@ -158,14 +159,14 @@ absl::Status add_quality_surfaces(const volume::LabelVolume& volume,
   repaired.repair.emplace();
   // The Marching Cubes side of the distance check is built beside the
   // repair, on the core the repair leaves idle.
-  std::shared_ptr<surface::DistanceReference> marching_cubes_reference;
+  std::unique_ptr<surface::DistanceReference> marching_cubes_reference;
   absl::Status repair_status;
   {
     StageTimer timer(stages, "repair");
     side_by_side(
         [&] {
           marching_cubes_reference =
-              std::make_shared<surface::DistanceReference>(marching_cubes, voxel);
+              std::make_unique<surface::DistanceReference>(marching_cubes, voxel);
         },
         [&] { repair_status = repair_pieces(voxel, context, pieces->meshes, repaired); });
   }
@@ -218,23 +219,27 @@ absl::Status add_quality_surfaces(const volume::LabelVolume& volume,
   }
   {
     StageTimer timer(stages, "self_intersections");
+    context.report("self_intersections", 0);
     output.self_intersections = surface::count_self_intersections(output.mesh);
+    context.report("self_intersections", 1);
   }
-  output.marching_cubes_reference = std::move(marching_cubes_reference);
   surfaces.push_back(std::move(repaired));
   if (params.surface == SurfaceMethod::kPoisson) surfaces.push_back(std::move(poisson));
+  pending.push_back({surfaces.size() - 1, std::move(marching_cubes_reference)});
   return absl::OkStatus();
 }
 
-absl::Status measure_distances(std::vector<SurfaceResult>& surfaces, const RunContext& context) {
+absl::Status measure_distances(std::vector<SurfaceResult>& surfaces,
+                               std::vector<PendingDistance>& pending, const RunContext& context) {
   context.report("surface_distance", 0);
-  for (auto& surface : surfaces) {
-    if (!surface.marching_cubes_reference) continue;
+  for (auto& measure : pending) {
+    auto& surface = surfaces[measure.surface];
     surface.distance_to_marching_cubes =
-        surface::surface_distance(surface.mesh, *surface.marching_cubes_reference, context);
-    surface.marching_cubes_reference.reset();
+        surface::surface_distance(surface.mesh, *measure.marching_cubes, context);
+    measure.marching_cubes.reset();
     if (auto s = context.check_stop(); !s.ok()) return s;
   }
+  pending.clear();
   context.report("surface_distance", 1);
   return absl::OkStatus();
 }

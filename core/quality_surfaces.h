@@ -3,12 +3,14 @@
 // with Poisson, then check the result against the Marching Cubes surface.
 #pragma once
 
+#include <memory>
 #include <vector>
 
 #include "absl/status/status.h"
 #include "core/mesh_params.h"
 #include "core/pipeline.h"
 #include "core/run_context.h"
+#include "core/surface/surface_checks.h"
 #include "core/volume/label_statistics.h"
 #include "core/volume/label_volume.h"
 
@@ -18,20 +20,29 @@ namespace labelmesh {
 // voxel volume.
 double voxel_size_mm(const volume::ImageGeometry& geometry);
 
+// A surface whose distance to Marching Cubes is still to be measured: its
+// index in the surfaces vector and the Marching Cubes side of the distance.
+struct PendingDistance {
+  size_t surface;
+  std::unique_ptr<surface::DistanceReference> marching_cubes;
+};
+
 // Appends the "repaired" surface of `label` and, for SurfaceMethod::kPoisson,
-// the "poisson" one; the last appended is marked as the output and carries
-// the Marching Cubes reference for measure_distances. Adds stage times to
-// `stages`. Errors: INVALID_ARGUMENT for bad options,
+// the "poisson" one; the last appended is marked as the output, and its
+// distance to Marching Cubes is left in `pending` for measure_distances. Adds
+// stage times to `stages`. Errors: INVALID_ARGUMENT for bad options,
 // FAILED_PRECONDITION when every component is under the size threshold,
 // INTERNAL for a failed stage, CANCELLED.
 absl::Status add_quality_surfaces(const volume::LabelVolume& volume,
                                   const volume::LabelStatistics& label, const MeshParams& params,
                                   const RunContext& context, std::vector<SurfaceResult>& surfaces,
+                                  std::vector<PendingDistance>& pending,
                                   std::vector<StageTiming>& stages);
 
-// Measures each surface that carries a Marching Cubes reference against it
-// (distance_to_marching_cubes), then drops the reference. Uses two threads.
+// Measures each pending surface of `surfaces` against its Marching Cubes
+// reference (distance_to_marching_cubes; two threads) and empties `pending`.
 // Errors: CANCELLED.
-absl::Status measure_distances(std::vector<SurfaceResult>& surfaces, const RunContext& context);
+absl::Status measure_distances(std::vector<SurfaceResult>& surfaces,
+                               std::vector<PendingDistance>& pending, const RunContext& context);
 
 }  // namespace labelmesh

@@ -67,6 +67,18 @@ TEST(VolumeMeshes, SphereFillsItsPoissonSurface) {
   const auto sums = region_volumes(volume);
   ASSERT_EQ(sums.size(), 1u);
   EXPECT_NEAR(sums.at(1) / output_surface_volume(result, 1), 1.0, 1e-9);
+  // The distance to Marching Cubes, measured beside TetGen, is in the result
+  // as without tetrahedra: within a voxel (1 mm) of it.
+  bool measured = false;
+  for (const auto& surface : result.surfaces) {
+    if (!surface.is_output) continue;
+    ASSERT_TRUE(surface.distance_to_marching_cubes.has_value());
+    EXPECT_GT(surface.distance_to_marching_cubes->hausdorff_mm, 0.1);
+    EXPECT_LT(surface.distance_to_marching_cubes->hausdorff_mm, 1.0);
+    EXPECT_GT(surface.distance_to_marching_cubes->mean_mm, 0.01);
+    measured = true;
+  }
+  EXPECT_TRUE(measured);
 }
 
 TEST(VolumeMeshes, NestedLabelsBecomeRegionsAndShellsKeepTheirCavity) {

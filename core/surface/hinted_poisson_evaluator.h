@@ -31,11 +31,13 @@ struct Cancelled {};
 // Evaluates the solved implicit function for the surface mesher. Each value
 // means locating the point in the solve's triangulation, and CGAL walks there
 // from its previous answer; the mesher's queries jump across the surface, so
-// on the liver 3.3 M such walks took 3.7 of the 5 s of meshing (1.7 s now).
-// Here a long jump starts from the cell first found in the query's cube of a
-// coarse grid, and the oracle's second question about a segment's ends (it
-// asks for their sign, then for their value and cell) is answered from the
-// last answers. Every answer depends only on the order of the queries, so
+// on the liver 3.3 M such walks took 3.7 of the 5 s of meshing. Here a long
+// jump starts from the cell first found in the query's cube of a grid of
+// about two million cubes (or, the first time there, of a grid four times
+// coarser), a short one from the last answer, and the oracle's second
+// question about a segment's ends (it asks for their sign, then for their
+// value and cell) is answered from the last four answers. Every answer
+// depends only on the order of the queries, so
 // meshing stays deterministic. Polls for a stop every few thousand
 // evaluations.
 class HintedEvaluator {
@@ -76,7 +78,8 @@ class HintedEvaluator {
       if (point == p) return answer;
     }
     if ((++calls_ & 4095) == 0 && context_.stop_requested()) throw Cancelled{};
-    // Bisection asks next door to its last question: walk from there.
+    // The oracle's search along a segment asks next door to its last
+    // question: walk from there.
     Cell_handle* slot = fine_.slot_for(p);
     Cell_handle* coarse_slot = coarse_.slot_for(p);
     Cell_handle start = last_;

@@ -37,11 +37,13 @@ class DistanceReference {
   DistanceReference(const DistanceReference&) = delete;
   DistanceReference& operator=(const DistanceReference&) = delete;
 
-  struct Parts;
-  const Parts& parts() const { return *parts_; }
   double sample_spacing_mm() const { return sample_spacing_mm_; }
 
  private:
+  friend SurfaceDistance surface_distance(const TriangleMesh&, const DistanceReference&,
+                                          const RunContext&);
+  struct Parts;
+  const Parts& parts() const { return *parts_; }
   std::unique_ptr<Parts> parts_;
   double sample_spacing_mm_;
 };

@@ -286,40 +286,47 @@ bool smooth_vertex(WorkMesh& w, uint32_t v, ImproveFigures& figures) {
   for (double s : {1.0, 0.5, 0.25}) {
     try_point(geometry::add(start, geometry::scale(geometry::sub(centroid, start), s)));
   }
-  // Gradient ascent on the worst tetrahedra, from the best point so far: the
-  // direction that raises every one within 0.01 of the worst (the sum of
-  // their unit gradients), so that two tied worst ones do not undo each
-  // other's step.
-  for (int step = 0; step < 12; ++step) {
-    p = best_point;
-    double worst_q = kNone;
-    for (uint32_t t : w.star(v)) worst_q = std::min(worst_q, w.quality_of(w.tet(t)));
+  // Gradient ascent on the worst tetrahedra, from the best point so far.
+  // First along the direction that raises every one within 0.01 of the worst
+  // (the sum of their unit gradients), so that two tied worst ones do not
+  // undo each other's step; if that fails, along the worst one's own.
+  auto unit_gradient = [&](uint32_t t) {
     const double h = 1e-4 * length;
-    Vec3 gradient = {0, 0, 0};
-    for (uint32_t t : w.star(v)) {
-      if (!(w.quality_of(w.tet(t)) < worst_q + 0.01)) continue;
-      Vec3 one;
-      for (int k = 0; k < 3; ++k) {
-        p = best_point;
-        p[k] += h;
-        const double up = w.quality_of(w.tet(t));
-        p[k] -= 2 * h;
-        const double down = w.quality_of(w.tet(t));
-        one[k] = (up - down) / (2 * h);
-      }
+    Vec3 gradient;
+    for (int k = 0; k < 3; ++k) {
       p = best_point;
-      const double size = geometry::norm(one);
-      if (size > 0) gradient = geometry::add(gradient, geometry::scale(one, 1 / size));
+      p[k] += h;
+      const double up = w.quality_of(w.tet(t));
+      p[k] -= 2 * h;
+      const double down = w.quality_of(w.tet(t));
+      gradient[k] = (up - down) / (2 * h);
     }
-    const double g = geometry::norm(gradient);
-    if (!(g > 0)) break;
-    const Vec3 direction = geometry::scale(gradient, 1 / g);
+    p = best_point;
+    const double size = geometry::norm(gradient);
+    return size > 0 ? geometry::scale(gradient, 1 / size) : Vec3{0, 0, 0};
+  };
+  auto climb = [&](const Vec3& direction) {
+    const double size = geometry::norm(direction);
+    if (!(size > 0)) return false;
     const double before = best;
     const Vec3 from = best_point;
     for (double s : {0.2, 0.1, 0.05, 0.02, 0.005}) {
-      try_point(geometry::add(from, geometry::scale(direction, s * length)));
+      try_point(geometry::add(from, geometry::scale(direction, s * length / size)));
     }
-    if (!(best > before + 1e-6)) break;
+    return best > before + 1e-6;
+  };
+  for (int step = 0; step < 12; ++step) {
+    p = best_point;
+    uint32_t worst = w.star(v).front();
+    for (uint32_t t : w.star(v)) {
+      if (w.quality_of(w.tet(t)) < w.quality_of(w.tet(worst))) worst = t;
+    }
+    Vec3 together = {0, 0, 0};
+    for (uint32_t t : w.star(v)) {
+      if (w.quality_of(w.tet(t)) < best + 0.01)
+        together = geometry::add(together, unit_gradient(t));
+    }
+    if (!climb(together) && !climb(unit_gradient(worst))) break;
   }
   p = best_point;
   if (best_point == start) return false;

@@ -2,6 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <random>
+#include <vector>
+
 #include "core/volume/label_statistics.h"
 #include "support/label_grid.h"
 
@@ -63,6 +66,58 @@ TEST(LabelComponents, OneVoxelStrandsArePruned) {
   EXPECT_EQ(pruned.pruned_voxels, 7u);
   EXPECT_EQ(pruned.components[0].voxels, 125u);
   EXPECT_EQ(pruned.components[0].max_index, (std::array<int64_t, 3>{5, 5, 5}));
+}
+
+// Random sparse masks, labelled by a plain flood fill over all 26
+// neighbours: every voxel gets the same partition as the scan's (ids in the
+// same order of first voxel), whatever shortcut the scan takes.
+TEST(LabelComponents, MatchAFloodFillOnRandomMasks) {
+  constexpr int kSize = 18;
+  std::mt19937 random(5);
+  for (int round = 0; round < 20; ++round) {
+    const double density = 0.1 + 0.02 * round;  // from dust to one tangle
+    std::bernoulli_distribution filled(density);
+    std::vector<uint8_t> mask(kSize * kSize * kSize, 0);
+    auto at = [](int i, int j, int k) { return i + kSize * (j + kSize * k); };
+    for (int k = 1; k + 1 < kSize; ++k)
+      for (int j = 1; j + 1 < kSize; ++j)
+        for (int i = 1; i + 1 < kSize; ++i) mask[at(i, j, k)] = filled(random) ? 1 : 0;
+    const auto v = testing::label_grid(
+        {kSize, kSize, kSize}, [&](int i, int j, int k) -> uint8_t { return mask[at(i, j, k)]; });
+    const auto found = components_of(v, 1, /*prune=*/false);
+
+    std::vector<int32_t> flood(mask.size(), 0);
+    int32_t next = 0;
+    for (int start = 0; start < int(mask.size()); ++start) {
+      if (!mask[start] || flood[start] != 0) continue;
+      flood[start] = ++next;
+      std::vector<int> stack{start};
+      while (!stack.empty()) {
+        const int n = stack.back();
+        stack.pop_back();
+        const int i = n % kSize, j = n / kSize % kSize, k = n / (kSize * kSize);
+        for (int dk = -1; dk <= 1; ++dk)
+          for (int dj = -1; dj <= 1; ++dj)
+            for (int di = -1; di <= 1; ++di) {
+              const int m = at(i + di, j + dj, k + dk);
+              if (mask[m] && flood[m] == 0) {
+                flood[m] = next;
+                stack.push_back(m);
+              }
+            }
+      }
+    }
+    ASSERT_EQ(found.components.size(), size_t(next)) << "density " << density;
+    int extent[6];
+    found.ids->GetExtent(extent);
+    for (int k = extent[4]; k <= extent[5]; ++k)
+      for (int j = extent[2]; j <= extent[3]; ++j)
+        for (int i = extent[0]; i <= extent[1]; ++i) {
+          ASSERT_EQ(*static_cast<int32_t*>(found.ids->GetScalarPointer(i, j, k)),
+                    flood[at(i, j, k)])
+              << "density " << density << " at " << i << " " << j << " " << k;
+        }
+  }
 }
 
 TEST(LabelComponents, CancelledRunStops) {
