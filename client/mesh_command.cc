@@ -35,6 +35,12 @@ void print_summary(const MeshResult& result, const std::string& out_dir) {
               "triangles", "min_ang", "max_ang", "closed", "manifold", "volume (mm3)", "self_int",
               "hausdorff");
   for (const auto& s : result.surfaces) {
+    if (s.components && s.components->kept == 0) {
+      std::printf(
+          "%8d %-15s every component under --min-component-voxels: %u dropped, no surface\n",
+          s.label, s.stage.c_str(), s.components->dropped);
+      continue;
+    }
     const auto& st = s.statistics;
     const auto& distance = s.distance_to_marching_cubes;
     std::printf("%8d %-15s %9u %9u %8.3f %8.3f %6s %8s %14.3f %9s %9s\n", s.label, s.stage.c_str(),

@@ -162,6 +162,12 @@ absl::StatusOr<MeshResult> run_pipeline(const std::string& path, const MeshParam
   add_stage_time(result.stages, "surface_statistics", statistics_stage.front().seconds);
   if (!quality_status.ok()) return quality_status;
   if (auto s = context.check_stop(); !s.ok()) return s;
+  if (quality && std::none_of(quality_surfaces.begin(), quality_surfaces.end(),
+                              [](const SurfaceResult& s) { return s.is_output; })) {
+    return absl::FailedPreconditionError(
+        cat(path, ": every label's components are smaller than min-component-voxels (",
+            params.poisson.min_component_voxels, "); nothing to mesh"));
+  }
   const size_t first_quality = result.surfaces.size();
   for (auto& surface : quality_surfaces) result.surfaces.push_back(std::move(surface));
   for (auto& measure : pending) measure.surface += first_quality;

@@ -44,12 +44,7 @@ absl::StatusOr<Pieces> kept_component_surfaces(const volume::LabelVolume& volume
     }
   }
   pieces.counts.kept = static_cast<uint32_t>(kept.size());
-  if (kept.empty()) {
-    return absl::FailedPreconditionError(
-        cat("label ", label.label, ": no component of ", min_voxels,
-            " voxels or more (min-component-voxels) is left to mesh; ", pieces.counts.dropped,
-            " smaller ones, ", pieces.counts.pruned_voxels, " voxels in one-voxel strands"));
-  }
+  if (kept.empty()) return pieces;
   auto meshes = surface::extract_component_surfaces(*components, kept, volume.geometry, context);
   if (!meshes.ok()) return meshes.status();
   pieces.meshes = std::move(*meshes);
@@ -149,6 +144,24 @@ absl::Status add_quality_surfaces(const volume::LabelVolume& volume,
     pieces = kept_component_surfaces(volume, label, params.poisson, context);
   }
   if (!pieces.ok()) return pieces.status();
+  if (pieces->meshes.empty()) {
+    const auto& counts = pieces->counts;
+    // A label asked for by name must be meshed. One found by scanning the
+    // volume (a few stray voxels of a label, say) is reported with its
+    // dropped components and no surface, and the other labels go on.
+    if (!params.labels.empty()) {
+      return absl::FailedPreconditionError(
+          cat("label ", label.label, ": no component of ", params.poisson.min_component_voxels,
+              " voxels or more (min-component-voxels) is left to mesh; ", counts.dropped,
+              " smaller ones, ", counts.pruned_voxels, " voxels in one-voxel strands"));
+    }
+    SurfaceResult dropped;
+    dropped.label = label.label;
+    dropped.stage = "repaired";
+    dropped.components = counts;
+    surfaces.push_back(std::move(dropped));
+    return absl::OkStatus();
+  }
   TriangleMesh marching_cubes;
   for (const auto& piece : pieces->meshes) marching_cubes.append(piece);
 

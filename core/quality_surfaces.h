@@ -29,10 +29,12 @@ struct PendingDistance {
 
 // Appends the "repaired" surface of `label` and, for SurfaceMethod::kPoisson,
 // the "poisson" one; the last appended is marked as the output, and its
-// distance to Marching Cubes is left in `pending` for measure_distances. Adds
-// stage times to `stages`. Errors: INVALID_ARGUMENT for bad options,
-// FAILED_PRECONDITION when every component is under the size threshold,
-// INTERNAL for a failed stage, CANCELLED.
+// distance to Marching Cubes is left in `pending` for measure_distances. When
+// every component is under the size threshold, only a "repaired" entry with
+// the dropped counts (and no surface) is appended, unless the label was asked
+// for by name (params.labels): then FAILED_PRECONDITION. Adds stage times to
+// `stages`. Errors: INVALID_ARGUMENT for bad options, INTERNAL for a failed
+// stage, CANCELLED.
 absl::Status add_quality_surfaces(const volume::LabelVolume& volume,
                                   const volume::LabelStatistics& label, const MeshParams& params,
                                   const RunContext& context, std::vector<SurfaceResult>& surfaces,

@@ -121,10 +121,10 @@ TEST(VolumeMeshesRealData, LiverTetrahedraAreValid) {
   const MeshResult result = mesh_with_tets(testing::shared_data("liver.inr.gz"), {255});
   ASSERT_TRUE(result.volume.has_value());
   const VolumeResult& volume = *result.volume;
-  // Measured: 114,789 tetrahedra, 27,407 nodes; TetGen (with -o/140) gives
-  // Q min 0.161 and 4 questionable elements; the improvement pass (55 3-2
-  // flips, 286 moves, 6 inserted points, no sliver peeled on this surface)
-  // leaves Q min 0.211, none questionable, dihedral 12.0-161.7 degrees:
+  // Measured: 113,343 tetrahedra, 27,143 nodes; TetGen (with -o/140) gives
+  // Q min 0.092 and 5 questionable elements; the improvement pass (46 3-2
+  // flips, 344 moves, 12 inserted points, no sliver peeled on this surface)
+  // leaves Q min 0.227, none questionable, dihedral 11.6-157.7 degrees:
   // issue 4's targets (Q >= 0.2, dihedral >= 10).
   EXPECT_GT(volume.mesh.tetrahedra.size(), 80000u);
   expect_valid_elements(volume);

@@ -25,7 +25,9 @@ namespace {
 using volume::make_phantom;
 using volume::PhantomShape;
 
-// Writes a phantom where the pipeline can read it.
+// Writes a phantom where the pipeline can read it. `name` names the scratch
+// directory too, so each test needs its own: ctest runs tests side by side,
+// and a shared one was removed under another test's feet.
 std::string phantom_file(PhantomShape shape, const std::string& name) {
   const auto path = (testing::scratch_dir("poisson-" + name) / name).string();
   const auto phantom = make_phantom(shape);
@@ -97,7 +99,7 @@ TEST(PoissonSurface, SphereIsSmootherThanMarchingCubes) {
 }
 
 TEST(PoissonSurface, TorusKeepsGenusOne) {
-  const auto path = phantom_file(PhantomShape::kTorus, "torus.mha");
+  const auto path = phantom_file(PhantomShape::kTorus, "torus-genus.mha");
   const auto phantom = make_phantom(PhantomShape::kTorus);
   const MeshResult result = mesh_file(path);
   const SurfaceResult* smooth = find_stage(result, 1, "poisson");
@@ -110,7 +112,7 @@ TEST(PoissonSurface, TorusKeepsGenusOne) {
 }
 
 TEST(PoissonSurface, HierarchyClustersBoundThePointCount) {
-  const auto path = phantom_file(PhantomShape::kTorus, "torus.mha");
+  const auto path = phantom_file(PhantomShape::kTorus, "torus-hierarchy.mha");
   size_t previous_points = SIZE_MAX;
   for (uint32_t cluster : {2u, 3u, 5u}) {
     MeshParams params;
@@ -131,7 +133,7 @@ TEST(PoissonSurface, HierarchyClustersBoundThePointCount) {
 }
 
 TEST(PoissonSurface, PointBudgetCoarsensTheGridOfLargeSurfacesOnly) {
-  const auto path = phantom_file(PhantomShape::kTorus, "torus.mha");
+  const auto path = phantom_file(PhantomShape::kTorus, "torus-budget.mha");
   MeshParams unbounded;
   unbounded.poisson.max_points = 0;
   const MeshResult full_result = mesh_file(path, unbounded);
@@ -226,6 +228,45 @@ TEST(PoissonSurface, EveryComponentComesOutClosedAndSmallOnesAreCounted) {
   EXPECT_EQ(smooth->components->dropped_voxels, 8u);
   EXPECT_EQ(smooth->statistics.components, 3u);
   EXPECT_EQ(smooth->statistics.euler_characteristic, 6);
+}
+
+TEST(PoissonSurface, ALabelOfOnlySpecksIsReportedUnlessAskedFor) {
+  // A ball of radius 6 (label 1) and a 2x2x2 speck of label 2, as the
+  // liver's file has a label of 6 voxels beside its organs.
+  const auto v = testing::label_grid({24, 20, 20}, [](int i, int j, int k) -> uint8_t {
+    const double dx = i - 9.5, dy = j - 9.5, dz = k - 9.5;
+    if (dx * dx + dy * dy + dz * dz <= 36) return 1;
+    return (i >= 19 && i <= 20 && j >= 2 && j <= 3 && k >= 2 && k <= 3) ? 2 : 0;
+  });
+  const auto path = (testing::scratch_dir("poisson-speck-label") / "speck.nrrd").string();
+  ASSERT_TRUE(volume::write_label_volume(v, path).ok());
+
+  // Every label by default: the ball is meshed, the speck's label reported.
+  const MeshResult result = mesh_file(path);
+  const SurfaceResult* ball = find_stage(result, 1, "poisson");
+  ASSERT_NE(ball, nullptr);
+  EXPECT_TRUE(ball->is_output);
+  expect_quality_surface(*ball);
+  const SurfaceResult* speck = find_stage(result, 2, "repaired");
+  ASSERT_NE(speck, nullptr);
+  EXPECT_FALSE(speck->is_output);
+  ASSERT_TRUE(speck->components.has_value());
+  EXPECT_EQ(speck->components->kept, 0u);
+  EXPECT_EQ(speck->components->dropped, 1u);
+  EXPECT_EQ(speck->components->dropped_voxels, 8u);
+  EXPECT_EQ(speck->statistics.triangles, 0u);
+  EXPECT_EQ(find_stage(result, 2, "poisson"), nullptr);
+  // Its Marching Cubes figures are still there.
+  const SurfaceResult* speck_mc = find_stage(result, 2, "marching_cubes");
+  ASSERT_NE(speck_mc, nullptr);
+  EXPECT_GT(speck_mc->statistics.triangles, 0u);
+
+  // Asked for by name, it is an error that names it.
+  MeshParams only_speck;
+  only_speck.labels = {2};
+  const auto refused = run_pipeline(path, only_speck, RunContext{});
+  EXPECT_EQ(refused.status().code(), absl::StatusCode::kFailedPrecondition);
+  EXPECT_NE(std::string(refused.status().message()).find("label 2"), std::string::npos);
 }
 
 TEST(PoissonSurface, SameInputGivesTheSameSurfaceOnEveryRunAndThread) {
