@@ -37,6 +37,9 @@ struct ComponentCounts {
   uint64_t dropped_voxels = 0;
   // Voxels removed as strands one voxel thick before splitting.
   uint64_t pruned_voxels = 0;
+  // Cavities (enclosed background pockets) under the size threshold, filled.
+  uint32_t filled_cavities = 0;
+  uint64_t filled_voxels = 0;
 };
 
 // One label's surface after one stage. A run keeps every stage's figures (the

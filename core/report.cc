@@ -216,6 +216,8 @@ void add_quality_figures(const SurfaceResult& surface, v1::SurfaceSummary& entry
     entry.set_components_dropped(surface.components->dropped);
     entry.set_dropped_voxels(surface.components->dropped_voxels);
     entry.set_pruned_voxels(surface.components->pruned_voxels);
+    entry.set_cavities_filled(surface.components->filled_cavities);
+    entry.set_cavity_voxels_filled(surface.components->filled_voxels);
   }
   if (surface.repair) {
     const auto& r = *surface.repair;

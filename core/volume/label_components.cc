@@ -65,6 +65,89 @@ uint64_t prune_strands(const Box& box, std::vector<uint8_t>& mask) {
   return pruned;
 }
 
+// Fills the background pockets of `mask` that the label encloses and that
+// hold fewer than `below` voxels. Background is taken 6-connected because the
+// label is 26-connected: a pocket that touches the outside only at an edge or
+// a corner is enclosed, as its Marching Cubes surface is closed.
+//
+// Every voxel of an enclosed pocket has label voxels on both sides along each
+// axis (a straight line cannot leave the pocket except into the label), so
+// only such voxels are flooded, and a flood that reaches any other background
+// voxel, or `below` voxels, is an open or large pocket and stays as it is.
+// That keeps the work near one pass over the box.
+void fill_small_cavities(const Box& box, uint64_t below, std::vector<uint8_t>& mask,
+                         uint32_t& cavities, uint64_t& voxels) {
+  constexpr uint8_t kOpen = 2;
+  const int64_t nx = box.size[0], ny = box.size[1], nz = box.size[2];
+  // The first and last label voxel of every row along x, y and z.
+  constexpr int64_t kNone = -1;
+  std::vector<int64_t> x_first(ny * nz, kNone), x_last(ny * nz, kNone);
+  std::vector<int64_t> y_first(nx * nz, kNone), y_last(nx * nz, kNone);
+  std::vector<int64_t> z_first(nx * ny, kNone), z_last(nx * ny, kNone);
+  auto extend = [](int64_t& first, int64_t& last, int64_t at) {
+    if (first == kNone) first = at;
+    last = at;
+  };
+  for (int64_t k = 0; k < nz; ++k)
+    for (int64_t j = 0; j < ny; ++j)
+      for (int64_t i = 0; i < nx; ++i) {
+        if (!mask[static_cast<size_t>(box.index(i, j, k))]) continue;
+        extend(x_first[j + ny * k], x_last[j + ny * k], i);
+        extend(y_first[i + nx * k], y_last[i + nx * k], j);
+        extend(z_first[i + nx * j], z_last[i + nx * j], k);
+      }
+  auto between = [](int64_t first, int64_t last, int64_t at) {
+    return first != kNone && first < at && at < last;
+  };
+  for (int64_t k = 0; k < nz; ++k)
+    for (int64_t j = 0; j < ny; ++j)
+      for (int64_t i = 0; i < nx; ++i) {
+        auto& m = mask[static_cast<size_t>(box.index(i, j, k))];
+        if (m) continue;
+        const bool enclosed = between(x_first[j + ny * k], x_last[j + ny * k], i) &&
+                              between(y_first[i + nx * k], y_last[i + nx * k], j) &&
+                              between(z_first[i + nx * j], z_last[i + nx * j], k);
+        if (!enclosed) m = kOpen;
+      }
+
+  const int64_t steps[6] = {1, -1, nx, -nx, nx * ny, -nx * ny};
+  constexpr uint8_t kVisiting = 3;
+  std::vector<int64_t> stack, region;
+  for (int64_t n = 0; n < box.count(); ++n) {
+    if (mask[static_cast<size_t>(n)] != 0) continue;
+    // Enclosed voxels are inside the box's outer layer, so every step stays
+    // in the box.
+    region.clear();
+    bool open = false;
+    mask[static_cast<size_t>(n)] = kVisiting;
+    stack.push_back(n);
+    while (!stack.empty() && !open && region.size() < below) {
+      const int64_t at = stack.back();
+      stack.pop_back();
+      region.push_back(at);
+      for (int64_t step : steps) {
+        auto& m = mask[static_cast<size_t>(at + step)];
+        if (m == kOpen) {
+          open = true;
+        } else if (m == 0) {
+          m = kVisiting;
+          stack.push_back(at + step);
+        }
+      }
+    }
+    const bool fill = !open && stack.empty() && region.size() < below;
+    // What is left unvisited of an open or large pocket meets these marks
+    // later and is found open too.
+    for (int64_t at : region) mask[static_cast<size_t>(at)] = fill ? 1 : kOpen;
+    for (int64_t at : stack) mask[static_cast<size_t>(at)] = kOpen;
+    stack.clear();
+    if (!fill) continue;
+    ++cavities;
+    voxels += region.size();
+  }
+  for (auto& m : mask) m = m == 1 ? 1 : 0;
+}
+
 // Provisional set per voxel, united with the 13 neighbours already visited
 // (the half of the 26-neighbourhood that precedes it in memory order). When
 // the voxel before it in the row is set, that voxel was already united with
@@ -134,6 +217,10 @@ absl::StatusOr<LabelComponents> find_label_components(const LabelVolume& volume,
   if (!typed) return absl::InternalError("label components: unsupported voxel type in memory");
   LabelComponents result;
   if (options.prune_strands) result.pruned_voxels = prune_strands(box, mask);
+  if (options.fill_cavities_below > 0) {
+    fill_small_cavities(box, options.fill_cavities_below, mask, result.filled_cavities,
+                        result.filled_voxels);
+  }
 
   std::vector<uint32_t> sets_of_voxels(mask.size(), kBackground);
   geometry::DisjointSets sets;

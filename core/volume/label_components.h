@@ -29,6 +29,9 @@ struct ComponentOptions {
   // Remove strands one voxel thick (voxels with at most one face neighbour,
   // repeatedly) before labelling.
   bool prune_strands = true;
+  // Fill cavities (background pockets the label encloses, 6-connected) of
+  // fewer voxels than this before labelling; 0 fills none.
+  uint64_t fill_cavities_below = 0;
 };
 
 struct LabelComponents {
@@ -40,6 +43,9 @@ struct LabelComponents {
   std::vector<LabelComponent> components;
   // Voxels removed as one-voxel strands; in no component.
   uint64_t pruned_voxels = 0;
+  // Cavities filled (fill_cavities_below), and their voxels, now in the label.
+  uint32_t filled_cavities = 0;
+  uint64_t filled_voxels = 0;
 };
 
 // Labels the 26-connected components of `label`, after pruning one-voxel

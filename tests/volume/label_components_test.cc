@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <random>
 #include <vector>
 
@@ -118,6 +119,143 @@ TEST(LabelComponents, MatchAFloodFillOnRandomMasks) {
               << "density " << density << " at " << i << " " << j << " " << k;
         }
   }
+}
+
+TEST(LabelComponents, SmallCavitiesAreFilledLargeAndOpenOnesKept) {
+  // A 14^3 block holding a 1-voxel hole, a 2x2x2 hole, a 4x4x4 hole (64
+  // voxels: not under the threshold of 64) and a 1x1x3 notch open to the
+  // outside through a face.
+  const auto v = testing::label_grid({18, 18, 18}, [](int i, int j, int k) -> uint8_t {
+    if (!in_box(i, j, k, 2, 15)) return 0;
+    if (i == 4 && j == 4 && k == 4) return 0;                                   // 1 voxel
+    if (i >= 7 && i <= 8 && j >= 4 && j <= 5 && k >= 4 && k <= 5) return 0;     // 8 voxels
+    if (i >= 9 && i <= 12 && j >= 9 && j <= 12 && k >= 9 && k <= 12) return 0;  // 64 voxels
+    if (i == 6 && j == 13 && k >= 13) return 0;                                 // open notch
+    return 1;
+  });
+  ComponentOptions options;
+  options.prune_strands = false;
+  options.fill_cavities_below = 64;
+  const auto stats = compute_label_statistics(v);
+  const auto found = find_label_components(v, stats.labels[0], options, RunContext{});
+  ASSERT_TRUE(found.ok()) << found.status();
+  EXPECT_EQ(found->filled_cavities, 2u);
+  EXPECT_EQ(found->filled_voxels, 9u);
+  ASSERT_EQ(found->components.size(), 1u);
+  EXPECT_EQ(found->components[0].voxels, 14u * 14 * 14 - 64 - 3);
+  auto id_at = [&](int i, int j, int k) {
+    return *static_cast<int32_t*>(found->ids->GetScalarPointer(i, j, k));
+  };
+  EXPECT_EQ(id_at(4, 4, 4), 1);
+  EXPECT_EQ(id_at(8, 5, 5), 1);
+  EXPECT_EQ(id_at(10, 10, 10), 0);
+  EXPECT_EQ(id_at(6, 13, 14), 0);
+
+  // Off by default: nothing filled.
+  options.fill_cavities_below = 0;
+  const auto kept = find_label_components(v, stats.labels[0], options, RunContext{});
+  ASSERT_TRUE(kept.ok());
+  EXPECT_EQ(kept->filled_cavities, 0u);
+  EXPECT_EQ(kept->components[0].voxels, 14u * 14 * 14 - 64 - 3 - 9);
+}
+
+// Random dense masks, whose holes are many and of every size: the filled
+// voxels are exactly the background 6-components that a flood from the box's
+// border never reaches and that hold fewer than the threshold.
+TEST(LabelComponents, FilledCavitiesMatchAFloodFromOutside) {
+  constexpr int kSize = 16;
+  constexpr uint64_t kBelow = 6;
+  std::mt19937 random(9);
+  auto at = [](int i, int j, int k) { return i + kSize * (j + kSize * k); };
+  for (int round = 0; round < 20; ++round) {
+    std::bernoulli_distribution filled(0.6 + 0.015 * round);
+    std::vector<uint8_t> mask(kSize * kSize * kSize, 0);
+    for (int k = 1; k + 1 < kSize; ++k)
+      for (int j = 1; j + 1 < kSize; ++j)
+        for (int i = 1; i + 1 < kSize; ++i) mask[at(i, j, k)] = filled(random) ? 1 : 0;
+    const auto v = testing::label_grid(
+        {kSize, kSize, kSize}, [&](int i, int j, int k) -> uint8_t { return mask[at(i, j, k)]; });
+    // Background 6-components; those touching the border are outside.
+    std::vector<int> component(mask.size(), -1);
+    std::vector<size_t> sizes;
+    std::vector<bool> outside;
+    for (int start = 0; start < int(mask.size()); ++start) {
+      if (mask[start] || component[start] >= 0) continue;
+      const int id = int(sizes.size());
+      sizes.push_back(0);
+      outside.push_back(false);
+      std::vector<int> stack{start};
+      component[start] = id;
+      while (!stack.empty()) {
+        const int n = stack.back();
+        stack.pop_back();
+        ++sizes[id];
+        const int i = n % kSize, j = n / kSize % kSize, k = n / (kSize * kSize);
+        const std::array<int, 3> here{i, j, k};
+        for (int axis = 0; axis < 3; ++axis) {
+          for (int d : {-1, 1}) {
+            std::array<int, 3> next = here;
+            next[axis] += d;
+            if (next[axis] < 0 || next[axis] >= kSize) {
+              outside[id] = true;  // the box's border is open
+              continue;
+            }
+            const int m = at(next[0], next[1], next[2]);
+            if (!mask[m] && component[m] < 0) {
+              component[m] = id;
+              stack.push_back(m);
+            }
+          }
+        }
+      }
+    }
+    uint64_t expected_voxels = 0;
+    uint32_t expected_cavities = 0;
+    for (size_t id = 0; id < sizes.size(); ++id) {
+      if (outside[id] || sizes[id] >= kBelow) continue;
+      ++expected_cavities;
+      expected_voxels += sizes[id];
+    }
+    ComponentOptions options;
+    options.prune_strands = false;
+    options.fill_cavities_below = kBelow;
+    const auto stats = compute_label_statistics(v);
+    const auto found = find_label_components(v, stats.labels[0], options, RunContext{});
+    ASSERT_TRUE(found.ok());
+    EXPECT_EQ(found->filled_cavities, expected_cavities) << "round " << round;
+    EXPECT_EQ(found->filled_voxels, expected_voxels) << "round " << round;
+    int extent[6];
+    found->ids->GetExtent(extent);
+    for (int k = extent[4]; k <= extent[5]; ++k)
+      for (int j = extent[2]; j <= extent[3]; ++j)
+        for (int i = extent[0]; i <= extent[1]; ++i) {
+          const int n = at(i, j, k);
+          const bool labelled = *static_cast<int32_t*>(found->ids->GetScalarPointer(i, j, k)) != 0;
+          const bool should = mask[n] || (!outside[component[n]] && sizes[component[n]] < kBelow);
+          ASSERT_EQ(labelled, should) << "round " << round << " at " << i << " " << j << " " << k;
+        }
+  }
+}
+
+TEST(LabelComponents, APocketTouchingTheOutsideOnlyAtAnEdgeIsEnclosed) {
+  // A 6^3 block with a notch at its edge voxel (3, 3, 5), open to the
+  // outside, and a pocket at (4, 4, 5), which shares only an edge with the
+  // notch. The label is 26-connected, so background counts as 6-connected:
+  // the pocket is enclosed (its Marching Cubes surface is closed).
+  const auto v = testing::label_grid({10, 10, 10}, [](int i, int j, int k) -> uint8_t {
+    if (!in_box(i, j, k, 3, 8)) return 0;
+    if (k == 5 && ((i == 3 && j == 3) || (i == 4 && j == 4))) return 0;
+    return 1;
+  });
+  ComponentOptions options;
+  options.fill_cavities_below = 64;
+  const auto stats = compute_label_statistics(v);
+  const auto found = find_label_components(v, stats.labels[0], options, RunContext{});
+  ASSERT_TRUE(found.ok());
+  EXPECT_EQ(found->filled_cavities, 1u);
+  EXPECT_EQ(found->filled_voxels, 1u);
+  EXPECT_EQ(*static_cast<int32_t*>(found->ids->GetScalarPointer(4, 4, 5)), 1);
+  EXPECT_EQ(*static_cast<int32_t*>(found->ids->GetScalarPointer(3, 3, 5)), 0);
 }
 
 TEST(LabelComponents, CancelledRunStops) {
