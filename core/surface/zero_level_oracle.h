@@ -206,9 +206,6 @@ class ZeroLevelOracle {
 
   Intersect_3 intersect_3_object() const { return {}; }
   Construct_initial_points construct_initial_points_object() const { return {}; }
-  bool is_in_volume(const ZeroLevel& level, const Point& p) const {
-    return CGAL::sign(boost::get<0>(level.function->evaluate(p))) != CGAL::ZERO;
-  }
 };
 
 }  // namespace labelmesh::surface::poisson

@@ -318,13 +318,15 @@ bool smooth_vertex(WorkMesh& w, uint32_t v, ImproveFigures& figures) {
   for (int step = 0; step < 12; ++step) {
     p = best_point;
     uint32_t worst = w.star(v).front();
-    for (uint32_t t : w.star(v)) {
-      if (w.quality_of(w.tet(t)) < w.quality_of(w.tet(worst))) worst = t;
-    }
+    double worst_q = kNone;
     Vec3 together = {0, 0, 0};
     for (uint32_t t : w.star(v)) {
-      if (w.quality_of(w.tet(t)) < best + 0.01)
-        together = geometry::add(together, unit_gradient(t));
+      const double q = w.quality_of(w.tet(t));
+      if (q < worst_q) {
+        worst_q = q;
+        worst = t;
+      }
+      if (q < best + 0.01) together = geometry::add(together, unit_gradient(t));
     }
     if (!climb(together) && !climb(unit_gradient(worst))) break;
   }
