@@ -2,9 +2,14 @@
 
 #include <gtest/gtest.h>
 
+#include <CGAL/Polygon_mesh_processing/shape_predicates.h>
+
 #include <algorithm>
+#include <cmath>
+#include <functional>
 #include <set>
 
+#include "core/surface/cgal_mesh.h"
 #include "core/surface/extract_surfaces.h"
 #include "core/surface/surface_statistics.h"
 #include "core/volume/label_statistics.h"
@@ -149,6 +154,95 @@ TEST(SurfaceRepair, CapIsRemoved) {
   size_t unmoved = 0;
   for (const auto& p : repaired.points) unmoved += original.count(p);
   EXPECT_GE(unmoved, original.size() - 1);
+}
+
+// Needles and caps as CGAL's own predicates count them, face by face.
+uint32_t sharp_by_cgal(const TriangleMesh& triangles) {
+  namespace PMP = CGAL::Polygon_mesh_processing;
+  const auto mesh = cgal::to_surface_mesh(triangles);
+  EXPECT_TRUE(mesh.has_value());
+  if (!mesh) return 0;
+  const RepairParams params;
+  const double cap_cosine = std::cos(params.cap_angle_deg * M_PI / 180);
+  uint32_t sharp = 0;
+  for (auto f : mesh->faces()) {
+    sharp += PMP::is_needle_triangle_face(f, *mesh, params.needle_ratio) !=
+                 cgal::Mesh::null_halfedge() ||
+             PMP::is_cap_triangle_face(f, *mesh, cap_cosine) != cgal::Mesh::null_halfedge();
+  }
+  return sharp;
+}
+
+// The block with the first edge of triangle 0 split `fraction` of the way
+// along: needles for small fractions.
+TriangleMesh block_with_split_edge(double fraction) {
+  TriangleMesh mesh = block_surface();
+  const auto [t, u] = triangles_on_edge(mesh, 0);
+  const uint32_t a = mesh.triangles[t][0], b = mesh.triangles[t][1], c = mesh.triangles[t][2];
+  const uint32_t d = mesh.triangles[u][0] + mesh.triangles[u][1] + mesh.triangles[u][2] - a - b;
+  const auto m = static_cast<uint32_t>(mesh.points.size());
+  const auto &pa = mesh.points[a], &pb = mesh.points[b];
+  mesh.points.push_back({pa[0] + fraction * (pb[0] - pa[0]), pa[1] + fraction * (pb[1] - pa[1]),
+                         pa[2] + fraction * (pb[2] - pa[2])});
+  mesh.triangles[t] = {a, m, c};
+  mesh.triangles[u] = {b, m, d};
+  mesh.triangles.push_back({m, b, c});
+  mesh.triangles.push_back({m, a, d});
+  return mesh;
+}
+
+// The block with a point inside triangle 0, `depth` of the way from the
+// middle of its first edge to its third corner: a cap for small depths.
+TriangleMesh block_with_inner_point(double depth) {
+  TriangleMesh mesh = block_surface();
+  const uint32_t a = mesh.triangles[0][0], b = mesh.triangles[0][1], c = mesh.triangles[0][2];
+  const auto &pa = mesh.points[a], &pb = mesh.points[b], &pc = mesh.points[c];
+  Point m{};
+  for (int i = 0; i < 3; ++i) m[i] = (1 - depth) / 2 * (pa[i] + pb[i]) + depth * pc[i];
+  const auto mi = static_cast<uint32_t>(mesh.points.size());
+  mesh.points.push_back(m);
+  mesh.triangles[0] = {a, b, mi};
+  mesh.triangles.push_back({b, c, mi});
+  mesh.triangles.push_back({c, a, mi});
+  return mesh;
+}
+
+// Scans `shape` over [low, high], finds by bisection each parameter where
+// CGAL's count of sharp faces changes, and checks the repair's count at, and
+// a few units in the last place either side of, every such threshold (where
+// a fast inexact test could misjudge a face), and along the scan.
+void expect_sharp_counts_match_cgal(const std::function<TriangleMesh(double)>& shape, double low,
+                                    double high) {
+  auto repair_count = [&](double x) {
+    RepairCounts counts;
+    repair(shape(x), counts);
+    return counts.needles_before + counts.caps_before;
+  };
+  auto cgal_count = [&](double x) { return sharp_by_cgal(shape(x)); };
+  constexpr int kSteps = 60;
+  int thresholds = 0;
+  for (int i = 0; i < kSteps; ++i) {
+    double x0 = low + (high - low) * i / kSteps, x1 = low + (high - low) * (i + 1) / kSteps;
+    const uint32_t at_x0 = cgal_count(x0);
+    EXPECT_EQ(repair_count(x0), at_x0) << "at " << x0;
+    if (cgal_count(x1) == at_x0) continue;
+    ++thresholds;
+    while (std::nextafter(x0, x1) < x1) {
+      const double middle = x0 + (x1 - x0) / 2;
+      if (middle <= x0 || middle >= x1) break;
+      (cgal_count(middle) == at_x0 ? x0 : x1) = middle;
+    }
+    double x = x0;
+    for (int ulp = 0; ulp < 4; ++ulp) x = std::nextafter(x, low);
+    for (int ulp = 0; ulp < 9; ++ulp, x = std::nextafter(x, high))
+      EXPECT_EQ(repair_count(x), cgal_count(x)) << "at " << x;
+  }
+  EXPECT_GE(thresholds, 1) << "the scan must cross a threshold";
+}
+
+TEST(SurfaceRepair, SharpCountsMatchCgalAtTheThresholds) {
+  expect_sharp_counts_match_cgal(block_with_split_edge, 0.01, 0.5);
+  expect_sharp_counts_match_cgal(block_with_inner_point, 0.001, 0.2);
 }
 
 TEST(SurfaceRepair, DegenerateTrianglesAreRemoved) {
