@@ -178,15 +178,13 @@ absl::StatusOr<MeshResult> run_pipeline(const std::string& path, const MeshParam
     // at a time).
     RunContext quiet = context;
     quiet.progress = nullptr;
-    std::vector<StageTiming> distance_stage;
-    absl::Status distance_status, volume_status;
-    side_by_side(
-        [&] {
-          StageTimer timer(distance_stage, "surface_distance");
-          distance_status = measure_distances(result.surfaces, pending, quiet);
-        },
-        [&] { volume_status = add_volume_mesh(params, volume->geometry, context, result); });
-    if (quality) add_stage_time(result.stages, "surface_distance", distance_stage.front().seconds);
+    absl::Status volume_status;
+    double distance_seconds = 0;
+    const absl::Status distance_status = measure_distances_beside(
+        result.surfaces, pending, quiet,
+        [&] { volume_status = add_volume_mesh(params, volume->geometry, context, result); },
+        distance_seconds);
+    if (quality) add_stage_time(result.stages, "surface_distance", distance_seconds);
     if (!volume_status.ok()) return volume_status;
     if (!distance_status.ok()) return distance_status;
   }

@@ -1,6 +1,8 @@
 #include "core/quality_surfaces.h"
 
 #include <algorithm>
+#include <atomic>
+#include <chrono>
 #include <cmath>
 #include <memory>
 
@@ -260,6 +262,39 @@ absl::Status measure_distances(std::vector<SurfaceResult>& surfaces,
   }
   pending.clear();
   context.report("surface_distance", 1);
+  return absl::OkStatus();
+}
+
+absl::Status measure_distances_beside(std::vector<SurfaceResult>& surfaces,
+                                      std::vector<PendingDistance>& pending,
+                                      const RunContext& context,
+                                      const std::function<void()>& other_work,
+                                      double& distance_seconds) {
+  std::vector<std::unique_ptr<surface::DistanceMeasurement>> measurements;
+  // Set once `measurements` is complete; only then may this thread read it.
+  std::atomic<bool> ready{false};
+  side_by_side(
+      [&] {
+        const auto start = std::chrono::steady_clock::now();
+        for (const auto& measure : pending) {
+          measurements.push_back(std::make_unique<surface::DistanceMeasurement>(
+              surfaces[measure.surface].mesh, *measure.marching_cubes));
+        }
+        ready.store(true, std::memory_order_release);
+        for (auto& measurement : measurements) measurement->work(context);
+        distance_seconds =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      },
+      [&] {
+        other_work();
+        if (!ready.load(std::memory_order_acquire)) return;
+        for (auto& measurement : measurements) measurement->work(context);
+      });
+  if (auto s = context.check_stop(); !s.ok()) return s;
+  for (size_t i = 0; i < pending.size(); ++i) {
+    surfaces[pending[i].surface].distance_to_marching_cubes = measurements[i]->result();
+  }
+  pending.clear();
   return absl::OkStatus();
 }
 

@@ -3,6 +3,7 @@
 // with Poisson, then check the result against the Marching Cubes surface.
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -46,5 +47,15 @@ absl::Status add_quality_surfaces(const volume::LabelVolume& volume,
 // Errors: CANCELLED.
 absl::Status measure_distances(std::vector<SurfaceResult>& surfaces,
                                std::vector<PendingDistance>& pending, const RunContext& context);
+
+// measure_distances on a second thread while `other_work` runs on this one,
+// which then joins in with what is left of the measuring (TetGen runs on one
+// core, so the measuring gets the other, and both at the end). Sets
+// `distance_seconds` to the measuring's wall time. Errors: CANCELLED.
+absl::Status measure_distances_beside(std::vector<SurfaceResult>& surfaces,
+                                      std::vector<PendingDistance>& pending,
+                                      const RunContext& context,
+                                      const std::function<void()>& other_work,
+                                      double& distance_seconds);
 
 }  // namespace labelmesh

@@ -1,6 +1,7 @@
 #include "core/surface/surface_checks.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <iterator>
 #include <memory>
@@ -181,34 +182,66 @@ SurfaceDistance surface_distance(const TriangleMesh& a, const TriangleMesh& b,
 
 SurfaceDistance surface_distance(const TriangleMesh& a, const DistanceReference& b,
                                  const RunContext& context) {
-  const DistanceReference a_parts(a, b.sample_spacing_mm());
-  const Direction a_to_b{a_parts.parts().samples, b.parts().tree.get()};
-  const Direction b_to_a{b.parts().samples, a_parts.parts().tree.get()};
-  // Each thread's share is a fixed range and the partial sums are added in a
-  // fixed order, so the figures do not depend on scheduling.
-  // Each direction's samples are halved between the threads: per query, the
-  // direction into the denser mesh costs twice the other.
-  const size_t a_half = a_to_b.samples.size() / 2, b_half = b_to_a.samples.size() / 2;
-  OneSided first_forward, first_backward, second_forward, second_backward;
-  side_by_side(
-      [&] {
-        second_forward = distances(a_to_b, a_half, a_to_b.samples.size(), context);
-        second_backward = distances(b_to_a, b_half, b_to_a.samples.size(), context);
-      },
-      [&] {
-        first_forward = distances(a_to_b, 0, a_half, context);
-        first_backward = distances(b_to_a, 0, b_half, context);
-      });
-  first_forward.add(second_forward);
-  first_backward.add(second_backward);
+  DistanceMeasurement measurement(a, b);
+  side_by_side([&] { measurement.work(context); }, [&] { measurement.work(context); });
+  return measurement.result();
+}
 
+// Chunks small enough that a thread joining late still finds some (about
+// 30 ms of queries each), in a fixed order: all of one direction, then the
+// other.
+constexpr size_t kChunkSamples = 16384;
+
+struct DistanceMeasurement::State {
+  State(const TriangleMesh& a, const DistanceReference& b)
+      : a_parts(a, b.sample_spacing_mm()),
+        a_to_b{a_parts.parts().samples, b.parts().tree.get()},
+        b_to_a{b.parts().samples, a_parts.parts().tree.get()},
+        forward_chunks(chunks_of(a_to_b)),
+        chunks(forward_chunks + chunks_of(b_to_a)) {}
+
+  static size_t chunks_of(const Direction& direction) {
+    return (direction.samples.size() + kChunkSamples - 1) / kChunkSamples;
+  }
+
+  const DistanceReference a_parts;
+  const Direction a_to_b, b_to_a;
+  const size_t forward_chunks;
+  std::vector<OneSided> chunks;
+  std::atomic<size_t> next_chunk{0};
+};
+
+DistanceMeasurement::DistanceMeasurement(const TriangleMesh& a, const DistanceReference& b)
+    : state_(std::make_unique<State>(a, b)) {}
+
+DistanceMeasurement::~DistanceMeasurement() = default;
+
+void DistanceMeasurement::work(const RunContext& context) {
+  State& s = *state_;
+  const size_t forward = s.forward_chunks;
+  for (size_t chunk = s.next_chunk++; chunk < s.chunks.size(); chunk = s.next_chunk++) {
+    if (context.stop_requested()) return;
+    const bool is_forward = chunk < forward;
+    const Direction& direction = is_forward ? s.a_to_b : s.b_to_a;
+    const size_t begin = (is_forward ? chunk : chunk - forward) * kChunkSamples;
+    const size_t end = std::min(begin + kChunkSamples, direction.samples.size());
+    // Each chunk has its own slot: no two threads write the same one.
+    s.chunks[chunk] = distances(direction, begin, end, context);
+  }
+}
+
+SurfaceDistance DistanceMeasurement::result() const {
+  const State& s = *state_;
+  // Added in chunk order, so the sums do not depend on scheduling.
+  OneSided forward, backward;
+  for (size_t chunk = 0; chunk < s.chunks.size(); ++chunk)
+    (chunk < s.forward_chunks ? forward : backward).add(s.chunks[chunk]);
   SurfaceDistance distance;
-  const OneSided& worse =
-      first_forward.max_squared >= first_backward.max_squared ? first_forward : first_backward;
+  const OneSided& worse = forward.max_squared >= backward.max_squared ? forward : backward;
   distance.hausdorff_mm = std::sqrt(worse.max_squared);
   distance.hausdorff_at = {worse.farthest.x(), worse.farthest.y(), worse.farthest.z()};
-  const size_t count = first_forward.count + first_backward.count;
-  distance.mean_mm = count > 0 ? (first_forward.sum + first_backward.sum) / double(count) : 0;
+  const size_t count = forward.count + backward.count;
+  distance.mean_mm = count > 0 ? (forward.sum + backward.sum) / double(count) : 0;
   return distance;
 }
 

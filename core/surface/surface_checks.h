@@ -40,8 +40,7 @@ class DistanceReference {
   double sample_spacing_mm() const { return sample_spacing_mm_; }
 
  private:
-  friend SurfaceDistance surface_distance(const TriangleMesh&, const DistanceReference&,
-                                          const RunContext&);
+  friend class DistanceMeasurement;
   struct Parts;
   const Parts& parts() const { return *parts_; }
   std::unique_ptr<Parts> parts_;
@@ -61,5 +60,27 @@ SurfaceDistance surface_distance(const TriangleMesh& a, const TriangleMesh& b,
 // The same, with `b` prepared beforehand (at its own sample spacing).
 SurfaceDistance surface_distance(const TriangleMesh& a, const DistanceReference& b,
                                  const RunContext& context = {});
+
+// surface_distance as work that threads can share: each work() call measures
+// chunks of samples until none are left, so a thread done with other work
+// (TetGen, say) can join one already measuring. The figures do not depend on
+// which thread measured which chunk. `a` and `b` must outlive it.
+class DistanceMeasurement {
+ public:
+  DistanceMeasurement(const TriangleMesh& a, const DistanceReference& b);
+  ~DistanceMeasurement();
+  DistanceMeasurement(const DistanceMeasurement&) = delete;
+  DistanceMeasurement& operator=(const DistanceMeasurement&) = delete;
+
+  // Safe to call from several threads at once. Returns early on a stop
+  // request (the figures are then partial).
+  void work(const RunContext& context);
+  // Once every work() call has returned.
+  SurfaceDistance result() const;
+
+ private:
+  struct State;
+  std::unique_ptr<State> state_;
+};
 
 }  // namespace labelmesh::surface

@@ -6,6 +6,7 @@
 
 #include <atomic>
 #include <cmath>
+#include <thread>
 
 namespace labelmesh::surface {
 namespace {
@@ -48,11 +49,44 @@ TEST(SurfaceDistance, AStopRequestEndsTheQueriesEarly) {
   stopping.stop = &stop;
   const auto stopped = surface_distance(square(10, 0), tent, 0.04, stopping);
   // The whole run's mean is about the tent's mean height, 2/3 (a little less
-  // from the square's side, measured across the slope). A run stopped after
-  // its first 4,096 queries per range only measured the vertices and the
-  // edges, most of them on the base, where the surfaces touch.
+  // from the square's side, measured across the slope). A run stopped from
+  // the start measures no chunk of samples at all.
   EXPECT_NEAR(full.mean_mm, 0.64, 0.03);
   EXPECT_LT(stopped.mean_mm, full.mean_mm - 0.1);
+}
+
+TEST(SurfaceDistance, SharedMeasuringGivesTheSameFigures) {
+  TriangleMesh tent;
+  tent.points = {{0, 0, 0}, {10, 0, 0}, {10, 10, 0}, {0, 10, 0}, {5, 5, 2}};
+  tent.triangles = {{0, 1, 4}, {1, 2, 4}, {2, 3, 4}, {3, 0, 4}};
+  // About 125,000 samples a side: several chunks each.
+  const DistanceReference base(square(10, 0), 0.04);
+  const auto both = surface_distance(tent, base);
+
+  DistanceMeasurement alone(tent, base);
+  alone.work({});
+  alone.work({});  // nothing left: returns at once
+  const auto one_thread = alone.result();
+
+  // A second thread joining after the first has started.
+  DistanceMeasurement shared(tent, base);
+  std::atomic<bool> started{false};
+  std::thread late([&] {
+    while (!started.load()) std::this_thread::yield();
+    shared.work({});
+  });
+  started.store(true);
+  shared.work({});
+  late.join();
+  const auto joined = shared.result();
+
+  for (const auto& d : {one_thread, joined}) {
+    EXPECT_EQ(d.hausdorff_mm, both.hausdorff_mm);
+    EXPECT_EQ(d.mean_mm, both.mean_mm);
+    EXPECT_EQ(d.hausdorff_at, both.hausdorff_at);
+  }
+  EXPECT_NEAR(both.hausdorff_mm, 2.0, 1e-12);
+  EXPECT_NEAR(both.mean_mm, 0.64, 0.03);
 }
 
 // Three tiny upright triangles, one standing on each corner of `t`: a surface
