@@ -66,6 +66,8 @@ class PieceProgress {
                 const std::vector<TriangleMesh>& pieces)
       : context_(context), stage_(std::move(stage)) {
     for (const auto& piece : pieces) total_ += double(piece.points.size());
+    // The stage has begun: a watcher sees it long before its first piece is done.
+    context_.report(stage_, 0);
   }
   void done(const TriangleMesh& piece) {
     done_ += double(piece.points.size());

@@ -17,16 +17,14 @@
 
 #include "core/run_context.h"
 #include "core/surface/cgal_mesh.h"
+#include "core/surface/poisson_kernel.h"
 
 namespace labelmesh::surface::poisson {
 
 using cgal::Kernel;
 using cgal::Point;
 using Vector = Kernel::Vector_3;
-using PoissonFunction = CGAL::Poisson_reconstruction_function<Kernel>;
-
-// Thrown from inside CGAL's loops when a stop is requested.
-struct Cancelled {};
+using PoissonFunction = CGAL::Poisson_reconstruction_function<StopAwareKernel>;
 
 // Evaluates the solved implicit function for the surface mesher. Each value
 // means locating the point in the solve's triangulation, and CGAL walks there

@@ -41,10 +41,9 @@ using Vector = Kernel::Vector_3;
 using OrientedPoint = std::pair<Point, Vector>;
 using PointMap = CGAL::First_of_pair_property_map<OrientedPoint>;
 using NormalMap = CGAL::Second_of_pair_property_map<OrientedPoint>;
-using PoissonFunction = CGAL::Poisson_reconstruction_function<Kernel>;
-
 using poisson::Cancelled;
 using poisson::HintedEvaluator;
+using poisson::PoissonFunction;
 using poisson::SolvedFunction;
 using poisson::ZeroLevel;
 using poisson::ZeroLevelOracle;
@@ -73,11 +72,24 @@ class CancellablePreconditioner : public Eigen::DiagonalPreconditioner<double> {
   const RunContext* context_ = nullptr;
 };
 
+// CGAL's matrix, which the solve fills one coefficient at a time with no
+// callback between: each coefficient also polls for a stop (the assembly
+// took most of a second a half on the liver).
+class CancellableMatrix : public CGAL::Eigen_sparse_symmetric_matrix<double> {
+ public:
+  using CGAL::Eigen_sparse_symmetric_matrix<double>::Eigen_sparse_symmetric_matrix;
+
+  void set_coef(std::size_t i, std::size_t j, double value, bool new_coef = false) {
+    poisson::poll_for_stop();
+    CGAL::Eigen_sparse_symmetric_matrix<double>::set_coef(i, j, value, new_coef);
+  }
+};
+
 // Conjugate gradient to a relative residual, cancellable at every iteration;
 // a model of CGAL's SparseLinearAlgebraTraits_d.
 class CancellableSolver {
  public:
-  using Matrix = CGAL::Eigen_sparse_symmetric_matrix<double>;
+  using Matrix = CancellableMatrix;
   using Vector = CGAL::Eigen_vector<double>;
   using NT = double;
 
@@ -249,6 +261,8 @@ struct Solve {
 
 Solve solve(const std::vector<OrientedPoint>& points, const PoissonParams& params,
             const RunContext& context) {
+  // CGAL's refinement and assembly poll this thread's run for a stop.
+  const poisson::SolveScope scope(context);
   Solve result;
   result.function = std::make_unique<PoissonFunction>(points.begin(), points.end(), PointMap(),
                                                       NormalMap(), CancellableInsertion{&context});

@@ -4,7 +4,9 @@
 
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <cmath>
+#include <memory>
 #include <random>
 #include <vector>
 
@@ -93,6 +95,33 @@ TEST_F(HintedPoissonEvaluatorTest, StopsWhenAskedTo) {
   std::uniform_real_distribution<double> xy(-15, 15);
   EXPECT_THROW(for (int i = 0; i < 10000; ++i) evaluator.evaluate(Point(xy(random), xy(random), 0)),
                Cancelled);
+}
+
+// CGAL's refinement and assembly have no callback: a stop reaches them
+// through the kernel's squared-distance functor, while a SolveScope marks the
+// thread. Neither the visitor nor the solver here looks for a stop.
+TEST(StopAwareKernel, AStopEndsASolveWithNoCallbackOfItsOwn) {
+  const auto points = testing::torus_points();
+  using OrientedPoint = std::pair<Point, Vector>;
+  auto make_function = [&] {
+    return std::make_unique<PoissonFunction>(points.begin(), points.end(),
+                                             CGAL::First_of_pair_property_map<OrientedPoint>(),
+                                             CGAL::Second_of_pair_property_map<OrientedPoint>());
+  };
+  std::atomic<bool> stop{true};
+  RunContext stopping;
+  stopping.stop = &stop;
+  {
+    const auto function = make_function();
+    const SolveScope scope(stopping);
+    EXPECT_THROW(function->compute_implicit_function(), Cancelled);
+  }
+  // The scope is gone: the same stop no longer reaches CGAL.
+  EXPECT_EQ(solving_run, nullptr);
+  const auto function = make_function();
+  EXPECT_TRUE(function->compute_implicit_function());
+  EXPECT_LT(function->operator()(Point(10, 0, 0)), 0);  // inside the tube
+  EXPECT_GT(function->operator()(Point(0, 0, 0)), 0);   // in the ring's hole
 }
 
 }  // namespace
