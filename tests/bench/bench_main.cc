@@ -244,6 +244,23 @@ int bench_tetrahedra(const std::string& path, const std::vector<int32_t>& labels
       mesh3->seconds, mesh3->tetrahedra, mesh3->nodes, m.min, m.mean, m.min_dihedral_deg,
       m.max_dihedral_deg, static_cast<long long>(m.invalid + m.very_bad + m.questionable));
   std::printf("  ours / Mesh_3 time          %8.2f (target < 1)\n", ours / mesh3->seconds);
+
+  // Each once more, in turn: on this shared machine a slow spell can take
+  // 15 % off one side of a single pair of runs.
+  labelmesh::MeshParams whole;
+  whole.labels = labels;
+  whole.volume = labelmesh::VolumeMethod::kTetgen;
+  const auto again_start = Clock::now();
+  if (!labelmesh::run_pipeline(path, whole, labelmesh::RunContext{}).ok()) return 1;
+  const double ours_again = seconds_since(again_start);
+  auto mesh3_again = labelmesh::bench::mesh_label_with_mesh3(*volume_in, labels.front());
+  if (!mesh3_again.ok()) return 1;
+  const double ours_best = std::min(ours, ours_again);
+  const double mesh3_best = std::min(mesh3->seconds, mesh3_again->seconds);
+  std::printf("  second runs                 ours %.3f s, Mesh_3 %.3f s\n", ours_again,
+              mesh3_again->seconds);
+  std::printf("  best of two, ours / Mesh_3  %8.2f (%.3f s / %.3f s; target < 1)\n",
+              ours_best / mesh3_best, ours_best, mesh3_best);
   return 0;
 }
 
