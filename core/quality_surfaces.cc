@@ -180,47 +180,63 @@ absl::Status add_quality_surfaces(const volume::LabelVolume& volume,
   repaired.stage = "repaired";
   repaired.components = pieces->counts;
   repaired.repair.emplace();
-  // The Marching Cubes side of the distance check is built beside the
-  // repair, on the core the repair leaves idle.
+  // The Marching Cubes side of the distance check is built on one core while
+  // the other repairs, measures the repaired surface and smooths the pieces
+  // for Poisson (liver: 0.56 s beside 0.31 + 0.13 + 0.13 s).
+  const bool to_poisson = params.surface == SurfaceMethod::kPoisson;
   std::unique_ptr<surface::DistanceReference> marching_cubes_reference;
+  double reference_seconds = 0;
+  std::vector<TriangleMesh> smoothed;
   absl::Status repair_status;
-  {
-    StageTimer timer(stages, "repair");
-    side_by_side(
-        [&] {
-          marching_cubes_reference =
-              std::make_unique<surface::DistanceReference>(marching_cubes, voxel);
-        },
-        [&] { repair_status = repair_pieces(voxel, context, pieces->meshes, repaired); });
-  }
+  side_by_side(
+      [&] {
+        const auto start = std::chrono::steady_clock::now();
+        marching_cubes_reference =
+            std::make_unique<surface::DistanceReference>(marching_cubes, voxel);
+        reference_seconds =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      },
+      [&] {
+        // This thread is the caller's: only it adds to `stages`.
+        {
+          StageTimer timer(stages, "repair");
+          repair_status = repair_pieces(voxel, context, pieces->meshes, repaired);
+        }
+        if (!repair_status.ok()) return;
+        {
+          StageTimer timer(stages, "surface_statistics");
+          repaired.statistics = surface::compute_surface_statistics(repaired.mesh);
+        }
+        if (!to_poisson) return;
+        StageTimer timer(stages, "poisson_smoothing");
+        for (const auto& piece : pieces->meshes) {
+          auto samples = surface::smooth_surface(piece, params.poisson.smoothing, context);
+          if (!samples.ok()) {
+            repair_status = samples.status();
+            return;
+          }
+          smoothed.push_back(std::move(*samples));
+        }
+      });
   if (!repair_status.ok()) return repair_status;
   marching_cubes = {};
-  {
-    StageTimer timer(stages, "surface_statistics");
-    repaired.statistics = surface::compute_surface_statistics(repaired.mesh);
-  }
   // The repaired surface is only an intermediate when Poisson follows: its
   // figures stay in the report, its triangles need not stay in memory.
-  if (params.surface == SurfaceMethod::kPoisson) repaired.mesh = {};
+  if (to_poisson) repaired.mesh = {};
 
   SurfaceResult poisson;
-  if (params.surface == SurfaceMethod::kPoisson) {
+  if (to_poisson) {
     poisson.label = label.label;
     poisson.stage = "poisson";
     poisson.components = pieces->counts;
     poisson.poisson.emplace();
     const auto poisson_settings = poisson_params(params.poisson, voxel);
     PieceProgress progress(context, "poisson", pieces->meshes);
-    for (const auto& piece : pieces->meshes) {
-      absl::StatusOr<TriangleMesh> samples;
-      {
-        StageTimer timer(stages, "poisson_smoothing");
-        samples = surface::smooth_surface(piece, params.poisson.smoothing, context);
-      }
-      if (!samples.ok()) return samples.status();
+    for (size_t i = 0; i < pieces->meshes.size(); ++i) {
+      const TriangleMesh samples = std::move(smoothed[i]);
       surface::PoissonFigures figures;
       auto smooth = surface::reconstruct_poisson_surface(
-          samples->points, surface::vertex_normals(*samples, params.poisson.normals),
+          samples.points, surface::vertex_normals(samples, params.poisson.normals),
           poisson_settings, context, figures);
       add_stage_time(stages, "poisson_solve", figures.solve_seconds);
       add_stage_time(stages, "poisson_mesh", figures.mesh_seconds);
@@ -230,13 +246,13 @@ absl::Status add_quality_surfaces(const volume::LabelVolume& volume,
       }
       add_poisson_figures(*poisson.poisson, figures);
       poisson.mesh.append(*smooth);
-      progress.done(piece);
+      progress.done(pieces->meshes[i]);
     }
   }
 
-  SurfaceResult& output = params.surface == SurfaceMethod::kPoisson ? poisson : repaired;
+  SurfaceResult& output = to_poisson ? poisson : repaired;
   output.is_output = true;
-  if (params.surface == SurfaceMethod::kPoisson) {
+  if (to_poisson) {
     StageTimer timer(stages, "surface_statistics");
     poisson.statistics = surface::compute_surface_statistics(poisson.mesh);
   }
@@ -247,7 +263,9 @@ absl::Status add_quality_surfaces(const volume::LabelVolume& volume,
     context.report("self_intersections", 1);
   }
   surfaces.push_back(std::move(repaired));
-  if (params.surface == SurfaceMethod::kPoisson) surfaces.push_back(std::move(poisson));
+  if (to_poisson) surfaces.push_back(std::move(poisson));
+  // Part of the distance check, though it ran beside the repair.
+  add_stage_time(stages, "surface_distance", reference_seconds);
   pending.push_back({surfaces.size() - 1, std::move(marching_cubes_reference)});
   return absl::OkStatus();
 }
