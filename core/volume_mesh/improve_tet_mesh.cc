@@ -110,9 +110,31 @@ class WorkMesh {
       m.tetrahedra.push_back(tets_[t]);
       m.labels.push_back(labels_[t]);
     }
+    drop_unused_points();
   }
 
  private:
+  // An insertion whose cavity held a point's whole star leaves that point in
+  // no tetrahedron: it would be a node of no element in the written mesh.
+  void drop_unused_points() {
+    TetMesh& m = mesh_;
+    std::vector<uint8_t> used(m.points.size(), 0);
+    for (const Tet& t : m.tetrahedra) {
+      for (uint32_t v : t) used[v] = 1;
+    }
+    if (std::all_of(used.begin(), used.end(), [](uint8_t u) { return u != 0; })) return;
+    std::vector<uint32_t> renumbered(m.points.size());
+    uint32_t kept = 0;
+    for (uint32_t v = 0; v < m.points.size(); ++v) {
+      renumbered[v] = kept;
+      if (used[v]) m.points[kept++] = m.points[v];
+    }
+    m.points.resize(kept);
+    for (Tet& t : m.tetrahedra) {
+      for (uint32_t& v : t) v = renumbered[v];
+    }
+  }
+
   // The points of every label's boundary faces (its surface and its
   // interfaces with other labels) stay where they are.
   void mark_boundary_points() {

@@ -55,8 +55,9 @@ struct ImproveFigures {
 // other two faces, through the same points, and moves nowhere further than
 // that depth.
 //
-// Existing points keep their order (inserted points are appended);
-// tetrahedra are renumbered.
+// Existing points keep their order (inserted points are appended), except
+// that a point no tetrahedron uses any more (an insertion's cavity held its
+// whole star) is dropped; tetrahedra are renumbered.
 // Precondition: check_tet_mesh(mesh) is OK and every tetrahedron has positive
 // volume. Errors: CANCELLED when `context` asks to stop (the mesh is then
 // valid, partly improved).

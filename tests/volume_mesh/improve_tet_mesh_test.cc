@@ -225,5 +225,43 @@ TEST(ImproveTetMesh, AStopRequestEndsThePassWithAValidMesh) {
   for (size_t t = 0; t < m.tetrahedra.size(); ++t) EXPECT_GT(signed_volume(m, t), 0);
 }
 
+// An interior point inside a tetrahedron A,B,C,D that is symmetric across
+// the plane x = 0, at the centroid of A,B,C,D (so the move to its
+// neighbours' centroid goes nowhere). Its two worst tetrahedra, v,A,C,D and
+// v,B,C,D, are mirror images tied at Q 0.151: the gradient of either one
+// points mostly across the mirror, into the other, so climbing it lowers the
+// twin and the star's minimum never rises. The sum of their unit gradients
+// lies in the mirror plane and lifts both (with the worst one's gradient
+// alone, the pass leaves Q at 0.151).
+TEST(ImproveTetMesh, SmoothingClimbsBetweenTwoTiedWorstTetrahedra) {
+  const double a = 0.587, b = 1.67, b2 = 1.221, c1 = -0.512, c2 = -0.906;
+  TetMesh m;
+  m.points = {{-a, 0, 0}, {a, 0, 0}, {0, b, c1}, {0, -b2, c2}, {0, (b - b2) / 4, (c1 + c2) / 4}};
+  for (uint32_t corner = 0; corner < 4; ++corner) {
+    std::array<uint32_t, 4> t = {0, 1, 2, 3};
+    t[corner] = 4;
+    add_positive(m, t, 1);
+  }
+  const double volume = total_volume(m);
+  ASSERT_NEAR(lowest_quality(m), 0.151, 0.001);
+  ImproveFigures figures;
+  ASSERT_TRUE(improve_tet_mesh(m, {}, RunContext{}, figures).ok());
+  EXPECT_GE(figures.vertices_moved + figures.vertices_inserted, 1u);
+  EXPECT_GT(lowest_quality(m), 0.19);
+  EXPECT_TRUE(check_tet_mesh(m).ok());
+  EXPECT_EQ(m.tetrahedra.size(), 4u);
+  EXPECT_NEAR(total_volume(m), volume, 1e-12);
+  // One interior point, whichever operation placed it last: a point an
+  // insertion replaced is not left behind as a node of no element.
+  EXPECT_EQ(m.points.size(), 5u);
+  std::vector<int> uses(m.points.size(), 0);
+  for (const auto& t : m.tetrahedra)
+    for (uint32_t v : t) ++uses[v];
+  for (int count : uses) EXPECT_GT(count, 0);
+  // The outer points stay put.
+  EXPECT_EQ(m.points[0], (std::array<double, 3>{-a, 0, 0}));
+  EXPECT_EQ(m.points[3], (std::array<double, 3>{0, -b2, c2}));
+}
+
 }  // namespace
 }  // namespace labelmesh::volume_mesh
