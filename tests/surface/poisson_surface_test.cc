@@ -334,6 +334,7 @@ TEST(PoissonSurface, CancellingStopsWithinASecond) {
   const auto returned = std::chrono::steady_clock::now();
   canceller.join();
   EXPECT_EQ(result.status().code(), absl::StatusCode::kCancelled);
+  EXPECT_TRUE(in_poisson) << "the stop was meant to come during the Poisson stage";
   EXPECT_LT(std::chrono::duration<double>(returned - asked).count(), 1.0);
 }
 
