@@ -326,7 +326,11 @@ TEST(PoissonSurface, CancellingStopsWithinASecond) {
   params.poisson.max_distance_voxels = 0.05;
   std::chrono::steady_clock::time_point asked;
   std::thread canceller([&] {
-    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    // Into the Poisson stage (slow builds take longer to get there), then a
+    // little way in.
+    for (int wait = 0; wait < 6000 && !in_poisson; ++wait)
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    std::this_thread::sleep_for(std::chrono::milliseconds(200));
     asked = std::chrono::steady_clock::now();
     stop = true;
   });
