@@ -187,7 +187,8 @@ absl::Status add_quality_surfaces(const volume::LabelVolume& volume,
   std::unique_ptr<surface::DistanceReference> marching_cubes_reference;
   double reference_seconds = 0;
   std::vector<TriangleMesh> smoothed;
-  absl::Status repair_status;
+  // What the repairing core reports: its repair's or its smoothing's error.
+  absl::Status prepared;
   side_by_side(
       [&] {
         const auto start = std::chrono::steady_clock::now();
@@ -200,9 +201,9 @@ absl::Status add_quality_surfaces(const volume::LabelVolume& volume,
         // This thread is the caller's: only it adds to `stages`.
         {
           StageTimer timer(stages, "repair");
-          repair_status = repair_pieces(voxel, context, pieces->meshes, repaired);
+          prepared = repair_pieces(voxel, context, pieces->meshes, repaired);
         }
-        if (!repair_status.ok()) return;
+        if (!prepared.ok()) return;
         {
           StageTimer timer(stages, "surface_statistics");
           repaired.statistics = surface::compute_surface_statistics(repaired.mesh);
@@ -212,13 +213,13 @@ absl::Status add_quality_surfaces(const volume::LabelVolume& volume,
         for (const auto& piece : pieces->meshes) {
           auto samples = surface::smooth_surface(piece, params.poisson.smoothing, context);
           if (!samples.ok()) {
-            repair_status = samples.status();
+            prepared = samples.status();
             return;
           }
           smoothed.push_back(std::move(*samples));
         }
       });
-  if (!repair_status.ok()) return repair_status;
+  if (!prepared.ok()) return prepared;
   marching_cubes = {};
   // The repaired surface is only an intermediate when Poisson follows: its
   // figures stay in the report, its triangles need not stay in memory.

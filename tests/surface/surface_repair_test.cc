@@ -104,75 +104,6 @@ TEST(SurfaceRepair, NonManifoldVertexIsSplit) {
   EXPECT_EQ(point_set(repaired), point_set(mesh));
 }
 
-TEST(SurfaceRepair, NeedlesAreCollapsed) {
-  TriangleMesh mesh = block_surface();
-  const auto original = point_set(mesh);
-  // Split an edge (a, b) at a point 2 % of the way from a: two needles.
-  const auto [t, u] = triangles_on_edge(mesh, 0);
-  const uint32_t a = mesh.triangles[t][0], b = mesh.triangles[t][1], c = mesh.triangles[t][2];
-  const uint32_t d = mesh.triangles[u][0] + mesh.triangles[u][1] + mesh.triangles[u][2] - a - b;
-  const auto m = static_cast<uint32_t>(mesh.points.size());
-  const auto &pa = mesh.points[a], &pb = mesh.points[b];
-  mesh.points.push_back({pa[0] + 0.02 * (pb[0] - pa[0]), pa[1] + 0.02 * (pb[1] - pa[1]),
-                         pa[2] + 0.02 * (pb[2] - pa[2])});
-  mesh.triangles[t] = {a, m, c};
-  mesh.triangles[u] = {b, m, d};
-  mesh.triangles.push_back({m, b, c});
-  mesh.triangles.push_back({m, a, d});
-  ASSERT_TRUE(compute_surface_statistics(mesh).closed);
-  RepairCounts counts;
-  const TriangleMesh repaired = repair(mesh, counts);
-  EXPECT_EQ(counts.needles_before, 2u);
-  EXPECT_EQ(counts.needles_after, 0u);
-  expect_clean(repaired);
-  // The collapse keeps one end of the short edge: every other point is where it was.
-  EXPECT_EQ(repaired.points.size(), original.size());
-  size_t unmoved = 0;
-  for (const auto& p : repaired.points) unmoved += original.count(p);
-  EXPECT_GE(unmoved, original.size() - 1);
-}
-
-TEST(SurfaceRepair, CapIsRemoved) {
-  TriangleMesh mesh = block_surface();
-  const auto original = point_set(mesh);
-  // A point just inside triangle (a, b, c), by the midpoint of a-b: the
-  // triangle (a, b, m) has an angle of almost 180 degrees at m.
-  const uint32_t a = mesh.triangles[0][0], b = mesh.triangles[0][1], c = mesh.triangles[0][2];
-  const auto &pa = mesh.points[a], &pb = mesh.points[b], &pc = mesh.points[c];
-  Point m{};
-  for (int i = 0; i < 3; ++i) m[i] = 0.49 * pa[i] + 0.49 * pb[i] + 0.02 * pc[i];
-  const auto mi = static_cast<uint32_t>(mesh.points.size());
-  mesh.points.push_back(m);
-  mesh.triangles[0] = {a, b, mi};
-  mesh.triangles.push_back({b, c, mi});
-  mesh.triangles.push_back({c, a, mi});
-  RepairCounts counts;
-  const TriangleMesh repaired = repair(mesh, counts);
-  EXPECT_EQ(counts.caps_before, 1u);
-  EXPECT_EQ(counts.caps_after + counts.needles_after, 0u);
-  expect_clean(repaired);
-  size_t unmoved = 0;
-  for (const auto& p : repaired.points) unmoved += original.count(p);
-  EXPECT_GE(unmoved, original.size() - 1);
-}
-
-// Needles and caps as CGAL's own predicates count them, face by face.
-uint32_t sharp_by_cgal(const TriangleMesh& triangles) {
-  namespace PMP = CGAL::Polygon_mesh_processing;
-  const auto mesh = cgal::to_surface_mesh(triangles);
-  EXPECT_TRUE(mesh.has_value());
-  if (!mesh) return 0;
-  const RepairParams params;
-  const double cap_cosine = std::cos(params.cap_angle_deg * M_PI / 180);
-  uint32_t sharp = 0;
-  for (auto f : mesh->faces()) {
-    sharp += PMP::is_needle_triangle_face(f, *mesh, params.needle_ratio) !=
-                 cgal::Mesh::null_halfedge() ||
-             PMP::is_cap_triangle_face(f, *mesh, cap_cosine) != cgal::Mesh::null_halfedge();
-  }
-  return sharp;
-}
-
 // The block with the first edge of triangle 0 split `fraction` of the way
 // along: needles for small fractions.
 TriangleMesh block_with_split_edge(double fraction) {
@@ -205,6 +136,55 @@ TriangleMesh block_with_inner_point(double depth) {
   mesh.triangles.push_back({b, c, mi});
   mesh.triangles.push_back({c, a, mi});
   return mesh;
+}
+
+TEST(SurfaceRepair, NeedlesAreCollapsed) {
+  const auto original = point_set(block_surface());
+  // An edge split 2 % of the way along: two needles.
+  const TriangleMesh mesh = block_with_split_edge(0.02);
+  ASSERT_TRUE(compute_surface_statistics(mesh).closed);
+  RepairCounts counts;
+  const TriangleMesh repaired = repair(mesh, counts);
+  EXPECT_EQ(counts.needles_before, 2u);
+  EXPECT_EQ(counts.needles_after, 0u);
+  expect_clean(repaired);
+  // The collapse keeps one end of the short edge: every other point is where it was.
+  EXPECT_EQ(repaired.points.size(), original.size());
+  size_t unmoved = 0;
+  for (const auto& p : repaired.points) unmoved += original.count(p);
+  EXPECT_GE(unmoved, original.size() - 1);
+}
+
+TEST(SurfaceRepair, CapIsRemoved) {
+  const auto original = point_set(block_surface());
+  // A point just inside a triangle, by the middle of its first edge: an
+  // angle of almost 180 degrees there.
+  const TriangleMesh mesh = block_with_inner_point(0.02);
+  RepairCounts counts;
+  const TriangleMesh repaired = repair(mesh, counts);
+  EXPECT_EQ(counts.caps_before, 1u);
+  EXPECT_EQ(counts.caps_after + counts.needles_after, 0u);
+  expect_clean(repaired);
+  size_t unmoved = 0;
+  for (const auto& p : repaired.points) unmoved += original.count(p);
+  EXPECT_GE(unmoved, original.size() - 1);
+}
+
+// Needles and caps as CGAL's own predicates count them, face by face.
+uint32_t sharp_by_cgal(const TriangleMesh& triangles) {
+  namespace PMP = CGAL::Polygon_mesh_processing;
+  const auto mesh = cgal::to_surface_mesh(triangles);
+  EXPECT_TRUE(mesh.has_value());
+  if (!mesh) return 0;
+  const RepairParams params;
+  const double cap_cosine = std::cos(params.cap_angle_deg * M_PI / 180);
+  uint32_t sharp = 0;
+  for (auto f : mesh->faces()) {
+    sharp += PMP::is_needle_triangle_face(f, *mesh, params.needle_ratio) !=
+                 cgal::Mesh::null_halfedge() ||
+             PMP::is_cap_triangle_face(f, *mesh, cap_cosine) != cgal::Mesh::null_halfedge();
+  }
+  return sharp;
 }
 
 // Scans `shape` over [low, high], finds by bisection each parameter where
