@@ -1,15 +1,15 @@
 #include "core/volume/label_components.h"
 
 #include <algorithm>
+#include <cstddef>
 #include <limits>
+#include <vector>
 
 #include "core/geometry/disjoint_sets.h"
 #include "core/volume/voxel_access.h"
 
 namespace labelmesh::volume {
 namespace {
-
-constexpr uint32_t kBackground = std::numeric_limits<uint32_t>::max();
 
 // The label's bounding box padded by one voxel, so neighbour lookups of label
 // voxels never leave it.
@@ -148,52 +148,65 @@ void fill_small_cavities(const Box& box, uint64_t below, std::vector<uint8_t>& m
   for (auto& m : mask) m = m == 1 ? 1 : 0;
 }
 
-// Provisional set per voxel, united with the 13 neighbours already visited
-// (the half of the 26-neighbourhood that precedes it in memory order). When
-// the voxel before it in the row is set, that voxel was already united with
-// every such neighbour they share, so only the four in the next column
-// (i + 1) can bring another set: about a third of the lookups on a solid
-// organ.
-absl::Status label_mask(const Box& box, const std::vector<uint8_t>& mask,
-                        std::vector<uint32_t>& sets_of_voxels, geometry::DisjointSets& sets,
-                        const RunContext& context) {
-  struct Offset {
-    int64_t di, dj, dk;
-  };
-  static constexpr Offset kAllEarlier[13] = {
-      {-1, -1, -1}, {0, -1, -1}, {1, -1, -1}, {-1, 0, -1}, {0, 0, -1}, {1, 0, -1}, {-1, 1, -1},
-      {0, 1, -1},   {1, 1, -1},  {-1, -1, 0}, {0, -1, 0},  {1, -1, 0}, {-1, 0, 0}};
-  static constexpr Offset kNextColumn[4] = {{1, -1, -1}, {1, 0, -1}, {1, 1, -1}, {1, -1, 0}};
-  for (int64_t k = 1; k + 1 < box.size[2]; ++k) {
-    if (auto s = context.check_stop(); !s.ok()) return s;
-    for (int64_t j = 1; j + 1 < box.size[1]; ++j) {
-      for (int64_t i = 1; i + 1 < box.size[0]; ++i) {
-        const int64_t n = box.index(i, j, k);
-        if (!mask[static_cast<size_t>(n)]) continue;
-        const uint32_t left = sets_of_voxels[static_cast<size_t>(n - 1)];
-        uint32_t set = left;
-        auto unite_with = [&](const Offset& o) {
-          const uint32_t other =
-              sets_of_voxels[static_cast<size_t>(box.index(i + o.di, j + o.dj, k + o.dk))];
-          if (other == kBackground) return;
-          if (set == kBackground) {
-            set = other;
-          } else {
-            sets.unite(set, other);
-          }
-        };
-        if (left != kBackground) {
-          for (const auto& o : kNextColumn) unite_with(o);
-        } else {
-          for (const auto& o : kAllEarlier) unite_with(o);
-        }
-        if (set == kBackground) set = sets.add();
-        sets_of_voxels[static_cast<size_t>(n)] = set;
-      }
+// A row's stretch of label voxels, i in [begin, end), in row j + ny * k.
+struct Run {
+  int64_t row;
+  int64_t begin, end;
+};
+
+// The mask's runs in memory order, and where each row's runs start in them.
+struct Runs {
+  std::vector<Run> runs;
+  std::vector<size_t> row_start;  // one per row, and one past the last
+};
+
+absl::StatusOr<Runs> find_runs(const Box& box, const std::vector<uint8_t>& mask,
+                               const RunContext& context) {
+  Runs result;
+  const int64_t rows = box.size[1] * box.size[2];
+  result.row_start.reserve(static_cast<size_t>(rows) + 1);
+  for (int64_t row = 0; row < rows; ++row) {
+    if (row % box.size[1] == 0) {
+      if (auto s = context.check_stop(); !s.ok()) return s;
     }
-    context.report("components", 0.8 * double(k) / double(box.size[2]));
+    result.row_start.push_back(result.runs.size());
+    const uint8_t* voxels = mask.data() + row * box.size[0];
+    // The box's padding keeps the first and last voxel of a row empty.
+    for (int64_t i = 1; i + 1 < box.size[0]; ++i) {
+      if (!voxels[i]) continue;
+      const int64_t begin = i;
+      while (voxels[i]) ++i;
+      result.runs.push_back({row, begin, i});
+    }
   }
-  return absl::OkStatus();
+  result.row_start.push_back(result.runs.size());
+  return result;
+}
+
+// One set per run, united with the runs it touches (26-connected: overlapping
+// or meeting at a corner, i within one) in the four neighbouring rows that
+// come before it in memory order. Working on runs rather than voxels keeps
+// the union-find to about one entry per row of the organ.
+geometry::DisjointSets label_runs(const Box& box, const Runs& runs) {
+  geometry::DisjointSets sets(runs.runs.size());
+  const int64_t ny = box.size[1];
+  for (size_t r = 0; r < runs.runs.size(); ++r) {
+    const Run& run = runs.runs[r];
+    const int64_t j = run.row % ny, k = run.row / ny;
+    const int64_t earlier[4][2] = {{j - 1, k}, {j - 1, k - 1}, {j, k - 1}, {j + 1, k - 1}};
+    for (const auto& [nj, nk] : earlier) {
+      if (nj < 0 || nj >= ny || nk < 0) continue;
+      const size_t row = static_cast<size_t>(nj + ny * nk);
+      const auto first = runs.runs.begin() + static_cast<std::ptrdiff_t>(runs.row_start[row]);
+      const auto last = runs.runs.begin() + static_cast<std::ptrdiff_t>(runs.row_start[row + 1]);
+      // The first run in that row that ends at or past run.begin - 1.
+      auto other =
+          std::partition_point(first, last, [&](const Run& o) { return o.end < run.begin; });
+      for (; other != last && other->begin <= run.end; ++other)
+        sets.unite(static_cast<uint32_t>(r), static_cast<uint32_t>(other - runs.runs.begin()));
+    }
+  }
+  return sets;
 }
 
 }  // namespace
@@ -222,11 +235,12 @@ absl::StatusOr<LabelComponents> find_label_components(const LabelVolume& volume,
                         result.filled_voxels);
   }
 
-  std::vector<uint32_t> sets_of_voxels(mask.size(), kBackground);
-  geometry::DisjointSets sets;
-  if (auto s = label_mask(box, mask, sets_of_voxels, sets, context); !s.ok()) return s;
+  auto runs = find_runs(box, mask, context);
+  if (!runs.ok()) return runs.status();
+  context.report("components", 0.5);
+  geometry::DisjointSets sets = label_runs(box, *runs);
 
-  // Second pass: compact ids in order of first appearance, with counts and boxes.
+  // Ids in order of first appearance: runs are in memory order.
   result.ids = vtkSmartPointer<vtkImageData>::New();
   result.ids->SetExtent(
       static_cast<int>(box.origin[0]), static_cast<int>(box.origin[0] + box.size[0] - 1),
@@ -236,36 +250,31 @@ absl::StatusOr<LabelComponents> find_label_components(const LabelVolume& volume,
   result.ids->SetOrigin(volume.voxels->GetOrigin());
   result.ids->AllocateScalars(VTK_INT, 1);
   auto* ids = static_cast<int32_t*>(result.ids->GetScalarPointer());
+  std::fill(ids, ids + box.count(), 0);
   std::vector<int32_t> id_of_root(sets.size(), 0);
-  int64_t n = 0;
-  for (int64_t k = 0; k < box.size[2]; ++k) {
-    for (int64_t j = 0; j < box.size[1]; ++j) {
-      for (int64_t i = 0; i < box.size[0]; ++i, ++n) {
-        const uint32_t set = sets_of_voxels[static_cast<size_t>(n)];
-        if (set == kBackground) {
-          ids[n] = 0;
-          continue;
-        }
-        int32_t& id = id_of_root[sets.find(set)];
-        if (id == 0) {
-          LabelComponent component;
-          component.id = static_cast<int32_t>(result.components.size() + 1);
-          component.min_index = {std::numeric_limits<int64_t>::max(),
-                                 std::numeric_limits<int64_t>::max(),
-                                 std::numeric_limits<int64_t>::max()};
-          component.max_index = {-1, -1, -1};
-          result.components.push_back(component);
-          id = component.id;
-        }
-        ids[n] = id;
-        auto& component = result.components[static_cast<size_t>(id - 1)];
-        ++component.voxels;
-        const std::array<int64_t, 3> at{box.origin[0] + i, box.origin[1] + j, box.origin[2] + k};
-        for (int axis = 0; axis < 3; ++axis) {
-          component.min_index[axis] = std::min(component.min_index[axis], at[axis]);
-          component.max_index[axis] = std::max(component.max_index[axis], at[axis]);
-        }
-      }
+  for (size_t r = 0; r < runs->runs.size(); ++r) {
+    const Run& run = runs->runs[r];
+    int32_t& id = id_of_root[sets.find(static_cast<uint32_t>(r))];
+    if (id == 0) {
+      LabelComponent component;
+      component.id = static_cast<int32_t>(result.components.size() + 1);
+      component.min_index = {std::numeric_limits<int64_t>::max(),
+                             std::numeric_limits<int64_t>::max(),
+                             std::numeric_limits<int64_t>::max()};
+      component.max_index = {-1, -1, -1};
+      result.components.push_back(component);
+      id = component.id;
+    }
+    std::fill(ids + run.row * box.size[0] + run.begin, ids + run.row * box.size[0] + run.end, id);
+    auto& component = result.components[static_cast<size_t>(id - 1)];
+    component.voxels += static_cast<uint64_t>(run.end - run.begin);
+    const int64_t j = run.row % box.size[1], k = run.row / box.size[1];
+    const std::array<int64_t, 3> low{box.origin[0] + run.begin, box.origin[1] + j,
+                                     box.origin[2] + k};
+    const std::array<int64_t, 3> high{box.origin[0] + run.end - 1, low[1], low[2]};
+    for (int axis = 0; axis < 3; ++axis) {
+      component.min_index[axis] = std::min(component.min_index[axis], low[axis]);
+      component.max_index[axis] = std::max(component.max_index[axis], high[axis]);
     }
   }
   context.report("components", 1);
