@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <random>
 #include <vector>
@@ -75,14 +76,21 @@ TEST(LabelComponents, OneVoxelStrandsArePruned) {
 TEST(LabelComponents, MatchAFloodFillOnRandomMasks) {
   constexpr int kSize = 18;
   std::mt19937 random(5);
-  for (int round = 0; round < 20; ++round) {
-    const double density = 0.1 + 0.02 * round;  // from dust to one tangle
-    std::bernoulli_distribution filled(density);
+  for (int round = 0; round < 30; ++round) {
+    // Rounds 0-19: single voxels, from dust to one tangle. Rounds 20-29:
+    // stretches along rows, which meet the rows around them at their ends.
+    const bool stretches = round >= 20;
+    const double density = stretches ? 0.05 + 0.01 * (round - 20) : 0.1 + 0.02 * round;
+    std::bernoulli_distribution filled(density), goes_on(0.8);
     std::vector<uint8_t> mask(kSize * kSize * kSize, 0);
     auto at = [](int i, int j, int k) { return i + kSize * (j + kSize * k); };
     for (int k = 1; k + 1 < kSize; ++k)
       for (int j = 1; j + 1 < kSize; ++j)
-        for (int i = 1; i + 1 < kSize; ++i) mask[at(i, j, k)] = filled(random) ? 1 : 0;
+        for (int i = 1; i + 1 < kSize; ++i) {
+          if (!filled(random)) continue;
+          mask[at(i, j, k)] = 1;
+          while (stretches && i + 2 < kSize && goes_on(random)) mask[at(++i, j, k)] = 1;
+        }
     const auto v = testing::label_grid(
         {kSize, kSize, kSize}, [&](int i, int j, int k) -> uint8_t { return mask[at(i, j, k)]; });
     const auto found = components_of(v, 1, /*prune=*/false);
@@ -109,6 +117,24 @@ TEST(LabelComponents, MatchAFloodFillOnRandomMasks) {
       }
     }
     ASSERT_EQ(found.components.size(), size_t(next)) << "density " << density;
+    // Each component's voxel count and box, from the flood.
+    std::vector<uint64_t> voxels(size_t(next) + 1, 0);
+    std::vector<std::array<int64_t, 3>> low(size_t(next) + 1, {kSize, kSize, kSize}),
+        high(size_t(next) + 1, {-1, -1, -1});
+    for (int n = 0; n < int(mask.size()); ++n) {
+      if (flood[n] == 0) continue;
+      const std::array<int64_t, 3> ijk{n % kSize, n / kSize % kSize, n / (kSize * kSize)};
+      ++voxels[flood[n]];
+      for (int axis = 0; axis < 3; ++axis) {
+        low[flood[n]][axis] = std::min(low[flood[n]][axis], ijk[axis]);
+        high[flood[n]][axis] = std::max(high[flood[n]][axis], ijk[axis]);
+      }
+    }
+    for (const auto& component : found.components) {
+      EXPECT_EQ(component.voxels, voxels[component.id]) << "density " << density;
+      EXPECT_EQ(component.min_index, low[component.id]) << "density " << density;
+      EXPECT_EQ(component.max_index, high[component.id]) << "density " << density;
+    }
     int extent[6];
     found.ids->GetExtent(extent);
     for (int k = extent[4]; k <= extent[5]; ++k)
