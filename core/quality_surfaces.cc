@@ -124,6 +124,8 @@ surface::PoissonParams poisson_params(const PoissonOptions& options, double voxe
   params.min_angle_deg = options.min_angle_deg;
   params.max_edge_mm = options.max_edge_voxels * voxel;
   params.max_distance_mm = options.max_distance_voxels * voxel;
+  // Half the longest edge: about the liver's mean edge at the defaults.
+  params.seed_spacing_mm = params.max_edge_mm / 2;
   params.reduction = options.point_reduction;
   params.reduction_cell_mm = options.point_cell_voxels * voxel;
   params.cluster_size = options.point_cluster_size;

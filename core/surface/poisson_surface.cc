@@ -29,6 +29,7 @@
 #include "core/side_by_side.h"
 #include "core/surface/cgal_mesh.h"
 #include "core/surface/hinted_poisson_evaluator.h"
+#include "core/surface/mesher_seeds.h"
 #include "core/surface/zero_level_oracle.h"
 #include "core/text.h"
 
@@ -331,17 +332,27 @@ double own_side_median(const PoissonFunction& function, const Halves& halves, bo
   return values[values.size() / 2];
 }
 
+// Fewer seeds than CGAL's own 20 starting points: use those instead.
+constexpr size_t kMinSeeds = 20;
+
 // Delaunay refinement of the zero level of `function` inside a ball around
-// `inner` (a point where the function is negative) of `radius`.
+// `inner` (a point where the function is negative) of `radius`, from seeds
+// spread over the level (mesher_seeds) near `points`.
 absl::StatusOr<TriangleMesh> mesh_zero_level(const SolvedFunction& function, const Point& inner,
-                                             double radius, const PoissonParams& params) {
+                                             double radius, const PoissonParams& params,
+                                             const std::vector<OrientedPoint>& points) {
   // As in CGAL's examples, a ball well beyond the points. A crossing is
   // exact where a tetrahedron's linear piece holds it, and otherwise found
   // to a twentieth of the distance bound.
   const double ball_radius = 5 * radius;
   const double bisection_error = params.max_distance_mm / 20;
-  const ZeroLevel level{&function, Kernel::Sphere_3(inner, ball_radius * ball_radius),
-                        bisection_error * bisection_error};
+  ZeroLevel level{&function, Kernel::Sphere_3(inner, ball_radius * ball_radius),
+                  bisection_error * bisection_error};
+  // Seeds two voxels either side of the points (the surface is within about
+  // one); too few for a start (a tiny piece) leave the mesher its own.
+  const std::vector<Point> seeds =
+      mesher_seeds(level, points, params.seed_spacing_mm, 4 * params.max_distance_mm);
+  if (seeds.size() >= kMinSeeds) level.seeds = &seeds;
   CGAL::Surface_mesh_default_criteria_3<Triangulation> criteria(
       params.min_angle_deg, params.max_edge_mm / 2, params.max_distance_mm);
   Triangulation triangulation;
@@ -365,9 +376,9 @@ absl::StatusOr<TriangleMesh> reconstruct_whole(const std::vector<OrientedPoint>&
   start = std::chrono::steady_clock::now();
   HintedEvaluator evaluator(*whole.function, context);
   const SolvedFunction function(&evaluator);
-  auto mesh =
-      mesh_zero_level(function, whole.function->get_inner_point(),
-                      std::sqrt(whole.function->bounding_sphere().squared_radius()), params);
+  auto mesh = mesh_zero_level(function, whole.function->get_inner_point(),
+                              std::sqrt(whole.function->bounding_sphere().squared_radius()), params,
+                              points);
   figures.mesh_seconds = seconds_since(start);
   return mesh;
 }
@@ -407,8 +418,9 @@ absl::StatusOr<TriangleMesh> reconstruct_in_halves(const std::vector<OrientedPoi
   const Point centre((lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, (lo[2] + hi[2]) / 2);
   const double half_diagonal =
       std::sqrt(CGAL::squared_distance(centre, Point(hi[0], hi[1], hi[2])));
-  auto mesh = mesh_zero_level(
-      function, inner, half_diagonal + std::sqrt(CGAL::squared_distance(centre, inner)), params);
+  auto mesh = mesh_zero_level(function, inner,
+                              half_diagonal + std::sqrt(CGAL::squared_distance(centre, inner)),
+                              params, points);
   figures.mesh_seconds = seconds_since(start);
   return mesh;
 }

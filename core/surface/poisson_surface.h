@@ -52,6 +52,9 @@ struct PoissonParams {
   // its surface Delaunay ball: how far the mesh may stray from the function's
   // zero level.
   double max_distance_mm = 0;
+  // The mesher starts from points of the surface this far apart (about a
+  // final edge) rather than from a few along rays; 0: CGAL's 20 ray points.
+  double seed_spacing_mm = 0;
   PointReduction reduction = PointReduction::kGrid;
   double reduction_cell_mm = 0;
   uint32_t cluster_size = 3;

@@ -4,7 +4,9 @@
 // CGAL's Poisson and surface mesher headers are slow to compile.
 #pragma once
 
+#include <algorithm>
 #include <optional>
+#include <vector>
 
 #include <CGAL/Object.h>
 #include <CGAL/Random.h>
@@ -88,10 +90,13 @@ class SolvedFunction {
 
 // What the surface mesher meshes: the zero level of `function` inside
 // `sphere`, with crossings found to within `squared_error` (squared length).
+// With `seeds`, the mesher starts from those points of the level instead of
+// a few found along rays from the sphere's centre.
 struct ZeroLevel {
   const SolvedFunction* function;
   Kernel::Sphere_3 sphere;
   double squared_error;
+  const std::vector<Point>* seeds = nullptr;
 };
 
 // The surface mesher's oracle (CGAL's SurfaceMeshTraits_3) for a ZeroLevel.
@@ -185,6 +190,8 @@ class ZeroLevelOracle {
    public:
     template <typename Out>
     Out operator()(const ZeroLevel& level, Out out, int count = 20) const {
+      if (level.seeds != nullptr && !level.seeds->empty())
+        return std::copy(level.seeds->begin(), level.seeds->end(), out);
       CGAL::Random random(0);
       CGAL::Random_points_on_sphere_3<Point> on_sphere(std::sqrt(level.sphere.squared_radius()),
                                                        random);
