@@ -35,10 +35,15 @@ inline std::vector<Point> mesher_seeds(const ZeroLevel& level,
   CGAL::Bbox_3 box;
   for (const auto& point : points) box += point.first.bbox();
   // Cubes at least `spacing` across, so a kept point nearer than that lies
-  // in one of the 27 cubes around; no more than about 16 M of them.
-  const double volume =
-      (box.xmax() - box.xmin()) * (box.ymax() - box.ymin()) * (box.zmax() - box.zmin());
-  const double cube = std::max(spacing, std::cbrt(volume / double(1 << 24)));
+  // in one of the 27 cubes around; larger when that would make more than
+  // 16 M of them (a long thin box, say).
+  double cube = spacing;
+  auto cubes_of = [&box](double side) {
+    double count = 1;
+    for (int axis = 0; axis < 3; ++axis) count *= (box.max(axis) - box.min(axis)) / side + 1;
+    return count;
+  };
+  while (cubes_of(cube) > double(1 << 24)) cube *= 2;
   std::array<int64_t, 3> size;
   for (int axis = 0; axis < 3; ++axis)
     size[axis] = int64_t((box.max(axis) - box.min(axis)) / cube) + 1;

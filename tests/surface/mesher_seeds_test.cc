@@ -67,6 +67,20 @@ TEST_F(MesherSeedsTest, PointsFartherThanTheReachFromTheLevelGiveNone) {
   for (const Point& seed : seeds) EXPECT_LT(std::abs(function_(seed)), 1e-9 * scale_);
 }
 
+TEST_F(MesherSeedsTest, AFarPointWidensTheCubesInsteadOfAllocatingBillions) {
+  HintedEvaluator evaluator(function_, context_);
+  const SolvedFunction function(&evaluator);
+  // One point 10 km away in x and y makes the box 10 km wide and 8 mm thin:
+  // at 0.01 mm cubes that would be 10^18 of them, and cubes sized by the
+  // box's volume alone 7 * 10^8 (3 GB of them).
+  auto points = points_;
+  points.emplace_back(Point(1e7, 1e7, 0), Vector(1, 0, 0));
+  const auto seeds = mesher_seeds(level_of(function), points, 0.01, kReach);
+  // Thinned to 0.01 mm, every torus point near the level is its own seed.
+  EXPECT_GT(seeds.size(), points_.size() / 2);
+  for (const Point& seed : seeds) EXPECT_LT(std::abs(function_(seed)), 1e-9 * scale_);
+}
+
 TEST_F(MesherSeedsTest, TheOracleStartsTheMesherFromTheSeeds) {
   HintedEvaluator evaluator(function_, context_);
   const SolvedFunction function(&evaluator);
