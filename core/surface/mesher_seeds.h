@@ -38,15 +38,12 @@ inline std::vector<Point> mesher_seeds(const ZeroLevel& level,
   // in one of the 27 cubes around; larger when that would make more than
   // 16 M of them (a long thin box, say).
   double cube = spacing;
-  auto cubes_of = [&box](double side) {
-    double count = 1;
-    for (int axis = 0; axis < 3; ++axis) count *= (box.max(axis) - box.min(axis)) / side + 1;
-    return count;
-  };
-  while (cubes_of(cube) > double(1 << 24)) cube *= 2;
   std::array<int64_t, 3> size;
-  for (int axis = 0; axis < 3; ++axis)
-    size[axis] = int64_t((box.max(axis) - box.min(axis)) / cube) + 1;
+  for (;; cube *= 2) {
+    for (int axis = 0; axis < 3; ++axis)
+      size[axis] = int64_t((box.max(axis) - box.min(axis)) / cube) + 1;
+    if (double(size[0]) * double(size[1]) * double(size[2]) <= double(1 << 24)) break;
+  }
   // Each cube's last kept point, and each kept point's previous one in its
   // cube (-1: none).
   std::vector<int32_t> last_in_cube(size_t(size[0] * size[1] * size[2]), -1);

@@ -265,10 +265,10 @@ absl::StatusOr<LabelComponents> find_label_components(const LabelVolume& volume,
       result.components.push_back(component);
       id = component.id;
     }
-    std::fill(ids + run.row * box.size[0] + run.begin, ids + run.row * box.size[0] + run.end, id);
+    const int64_t j = run.row % box.size[1], k = run.row / box.size[1];
+    std::fill(ids + box.index(run.begin, j, k), ids + box.index(run.end, j, k), id);
     auto& component = result.components[static_cast<size_t>(id - 1)];
     component.voxels += static_cast<uint64_t>(run.end - run.begin);
-    const int64_t j = run.row % box.size[1], k = run.row / box.size[1];
     const std::array<int64_t, 3> low{box.origin[0] + run.begin, box.origin[1] + j,
                                      box.origin[2] + k};
     const std::array<int64_t, 3> high{box.origin[0] + run.end - 1, low[1], low[2]};
