@@ -6,6 +6,7 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <functional>
 #include <memory>
 #include <unordered_map>
 #include <utility>
@@ -340,7 +341,8 @@ constexpr size_t kMinSeeds = 20;
 // spread over the level (mesher_seeds) near `points`.
 absl::StatusOr<TriangleMesh> mesh_zero_level(const SolvedFunction& function, const Point& inner,
                                              double radius, const PoissonParams& params,
-                                             const std::vector<OrientedPoint>& points) {
+                                             const std::vector<OrientedPoint>& points,
+                                             const std::function<void()>& beside_meshing) {
   // As in CGAL's examples, a ball well beyond the points. A crossing is
   // exact where a tetrahedron's linear piece holds it, and otherwise found
   // to a twentieth of the distance bound.
@@ -357,7 +359,14 @@ absl::StatusOr<TriangleMesh> mesh_zero_level(const SolvedFunction& function, con
       params.min_angle_deg, params.max_edge_mm / 2, params.max_distance_mm);
   Triangulation triangulation;
   Complex complex(triangulation);
-  CGAL::make_surface_mesh(complex, level, ZeroLevelOracle(), criteria, CGAL::Manifold_tag());
+  auto mesh_level = [&] {
+    CGAL::make_surface_mesh(complex, level, ZeroLevelOracle(), criteria, CGAL::Manifold_tag());
+  };
+  if (beside_meshing) {
+    side_by_side(beside_meshing, mesh_level);
+  } else {
+    mesh_level();
+  }
   auto mesh = complex_to_mesh(complex, triangulation);
   if (mesh.ok() && mesh->triangles.empty())
     return absl::InternalError("poisson: meshing found no surface in the implicit function");
@@ -366,7 +375,8 @@ absl::StatusOr<TriangleMesh> mesh_zero_level(const SolvedFunction& function, con
 
 absl::StatusOr<TriangleMesh> reconstruct_whole(const std::vector<OrientedPoint>& points,
                                                const PoissonParams& params,
-                                               const RunContext& context, PoissonFigures& figures) {
+                                               const RunContext& context, PoissonFigures& figures,
+                                               const std::function<void()>& beside_meshing) {
   auto start = std::chrono::steady_clock::now();
   Solve whole = solve(points, params, context);
   figures.solver_iterations = whole.iterations;
@@ -378,7 +388,7 @@ absl::StatusOr<TriangleMesh> reconstruct_whole(const std::vector<OrientedPoint>&
   const SolvedFunction function(&evaluator);
   auto mesh = mesh_zero_level(function, whole.function->get_inner_point(),
                               std::sqrt(whole.function->bounding_sphere().squared_radius()), params,
-                              points);
+                              points, beside_meshing);
   figures.mesh_seconds = seconds_since(start);
   return mesh;
 }
@@ -386,12 +396,14 @@ absl::StatusOr<TriangleMesh> reconstruct_whole(const std::vector<OrientedPoint>&
 absl::StatusOr<TriangleMesh> reconstruct_in_halves(const std::vector<OrientedPoint>& points,
                                                    const PoissonParams& params,
                                                    const RunContext& context,
-                                                   PoissonFigures& figures) {
+                                                   PoissonFigures& figures,
+                                                   const std::function<void()>& beside_meshing) {
   auto start = std::chrono::steady_clock::now();
   const Halves halves = split_points(points, params.split_overlap_mm);
   // Many points on one plane across the split axis can leave the low side
   // (below the median) nearly empty: then one solve.
-  if (halves.below < points.size() / 4) return reconstruct_whole(points, params, context, figures);
+  if (halves.below < points.size() / 4)
+    return reconstruct_whole(points, params, context, figures, beside_meshing);
   Solve low, high;
   side_by_side([&] { high = solve(halves.high, params, context); },
                [&] { low = solve(halves.low, params, context); });
@@ -420,7 +432,7 @@ absl::StatusOr<TriangleMesh> reconstruct_in_halves(const std::vector<OrientedPoi
       std::sqrt(CGAL::squared_distance(centre, Point(hi[0], hi[1], hi[2])));
   auto mesh = mesh_zero_level(function, inner,
                               half_diagonal + std::sqrt(CGAL::squared_distance(centre, inner)),
-                              params, points);
+                              params, points, beside_meshing);
   figures.mesh_seconds = seconds_since(start);
   return mesh;
 }
@@ -433,11 +445,10 @@ absl::Status check_point_count(std::string_view field, uint64_t value) {
       cat(field, ": ", value, " is neither 0 (off) nor at least ", kMinPointBudget));
 }
 
-absl::StatusOr<TriangleMesh> reconstruct_poisson_surface(const std::vector<geometry::Vec3>& points,
-                                                         const std::vector<geometry::Vec3>& normals,
-                                                         const PoissonParams& params,
-                                                         const RunContext& context,
-                                                         PoissonFigures& figures) {
+absl::StatusOr<TriangleMesh> reconstruct_poisson_surface(
+    const std::vector<geometry::Vec3>& points, const std::vector<geometry::Vec3>& normals,
+    const PoissonParams& params, const RunContext& context, PoissonFigures& figures,
+    const std::function<void()>& beside_meshing) {
   if (auto s = check_params(params); !s.ok()) return s;
   if (points.size() != normals.size())
     return absl::InternalError("poisson: one normal per point is needed");
@@ -460,8 +471,8 @@ absl::StatusOr<TriangleMesh> reconstruct_poisson_surface(const std::vector<geome
 
   try {
     if (params.split_points != 0 && oriented.size() > params.split_points)
-      return reconstruct_in_halves(oriented, params, context, figures);
-    return reconstruct_whole(oriented, params, context, figures);
+      return reconstruct_in_halves(oriented, params, context, figures, beside_meshing);
+    return reconstruct_whole(oriented, params, context, figures, beside_meshing);
   } catch (const Cancelled&) {
     return absl::CancelledError("the run was cancelled");
   }

@@ -4,6 +4,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <string_view>
 #include <vector>
 
@@ -91,10 +92,11 @@ struct PoissonFigures {
 // Manifold_tag); the same input always gives the same mesh.
 // Errors: INVALID_ARGUMENT for bad parameters or too few points, INTERNAL when
 // the solve fails or meshing finds no surface, CANCELLED.
-absl::StatusOr<TriangleMesh> reconstruct_poisson_surface(const std::vector<geometry::Vec3>& points,
-                                                         const std::vector<geometry::Vec3>& normals,
-                                                         const PoissonParams& params,
-                                                         const RunContext& context,
-                                                         PoissonFigures& figures);
+// The surface mesher uses one core: `beside_meshing`, if given, runs on a
+// second thread meanwhile (and not at all when the run ends before meshing).
+absl::StatusOr<TriangleMesh> reconstruct_poisson_surface(
+    const std::vector<geometry::Vec3>& points, const std::vector<geometry::Vec3>& normals,
+    const PoissonParams& params, const RunContext& context, PoissonFigures& figures,
+    const std::function<void()>& beside_meshing = {});
 
 }  // namespace labelmesh::surface

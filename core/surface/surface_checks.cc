@@ -120,16 +120,30 @@ struct DistanceReference::Parts {
   std::unique_ptr<Tree> tree;
 };
 
-DistanceReference::DistanceReference(const TriangleMesh& mesh, double sample_spacing_mm)
+DistanceReference::DistanceReference(const TriangleMesh& mesh, double sample_spacing_mm,
+                                     const RunContext& context)
     : parts_(std::make_unique<Parts>()), sample_spacing_mm_(sample_spacing_mm) {
+  // A stop leaves no samples and no tree: nothing to measure, not a part.
+  auto stopped = [this, &context] {
+    if (!context.stop_requested()) return false;
+    parts_->tree.reset();  // before the triangles it points into
+    parts_->triangles = {};
+    parts_->samples = {};
+    return true;
+  };
   parts_->samples = sample_points(mesh, sample_spacing_mm);
+  if (stopped()) return;
   // Queries in Hilbert order find the tree's nodes still in cache (liver:
-  // 1.2 s of queries down to 1.0 s).
-  CGAL::hilbert_sort(parts_->samples.begin(), parts_->samples.end());
+  // 1.2 s of queries down to 1.0 s). Cutting cells at their middle rather
+  // than at the median point sorts the liver's samples in 0.19 s, not 0.25.
+  CGAL::hilbert_sort(parts_->samples.begin(), parts_->samples.end(),
+                     CGAL::Hilbert_sort_middle_policy());
+  if (stopped()) return;
   parts_->triangles = to_triangles(mesh);
   if (!parts_->triangles.empty()) {
     parts_->tree = std::make_unique<Tree>(parts_->triangles.begin(), parts_->triangles.end());
     parts_->tree->build();
+    if (stopped()) return;
     // The first corner of every fourth triangle seeds each query's search:
     // a quarter of CGAL's default memory, about as near a start.
     std::vector<std::pair<Point, Primitive::Id>> seeds;

@@ -55,6 +55,22 @@ TEST(SurfaceDistance, AStopRequestEndsTheQueriesEarly) {
   EXPECT_LT(stopped.mean_mm, full.mean_mm - 0.1);
 }
 
+TEST(SurfaceDistance, AReferenceBuiltAfterAStopIsEmpty) {
+  TriangleMesh tent;
+  tent.points = {{0, 0, 0}, {10, 0, 0}, {10, 10, 0}, {0, 10, 0}, {5, 5, 2}};
+  tent.triangles = {{0, 1, 4}, {1, 2, 4}, {2, 3, 4}, {3, 0, 4}};
+  std::atomic<bool> stop{true};
+  RunContext stopping;
+  stopping.stop = &stop;
+  const DistanceReference built(square(10, 0), 0.5);
+  const DistanceReference stopped(square(10, 0), 0.5, stopping);
+  EXPECT_NEAR(surface_distance(tent, built).hausdorff_mm, 2.0, 1e-12);
+  // Neither the tent's samples (no tree) nor the square's (none) are measured.
+  const auto nothing = surface_distance(tent, stopped);
+  EXPECT_EQ(nothing.hausdorff_mm, 0);
+  EXPECT_EQ(nothing.mean_mm, 0);
+}
+
 TEST(SurfaceDistance, SharedMeasuringGivesTheSameFigures) {
   TriangleMesh tent;
   tent.points = {{0, 0, 0}, {10, 0, 0}, {10, 10, 0}, {0, 10, 0}, {5, 5, 2}};
