@@ -30,6 +30,11 @@ void print_text(const std::string& path, const v1::InputSummary& s) {
       s.direction(5), s.direction(6), s.direction(7), s.direction(8));
   std::printf("convention   %s\n", s.convention().c_str());
   std::printf("voxel type   %s\n", s.voxel_type().c_str());
+  if (s.repeated_planes_size() == 3) {
+    std::printf("drawn at     %.6g x %.6g x %.6g mm (planes repeated %u x %u x %u)\n",
+                s.drawn_spacing(0), s.drawn_spacing(1), s.drawn_spacing(2), s.repeated_planes(0),
+                s.repeated_planes(1), s.repeated_planes(2));
+  }
   std::printf("background   %llu voxels\n", static_cast<unsigned long long>(s.background_voxels()));
   std::printf("labels       %d\n", s.labels_size());
   std::printf("  %10s %14s %16s\n", "label", "voxels", "volume (mm3)");

@@ -11,6 +11,7 @@
 #include "core/surface/write_surface.h"
 #include "core/text.h"
 #include "core/volume/read_label_volume.h"
+#include "core/volume/repeated_planes.h"
 #include "core/volume_mesh/write_volume_mesh.h"
 
 namespace labelmesh {
@@ -72,8 +73,10 @@ absl::StatusOr<VolumeSummary> summarise_volume(const std::string& path,
                                                const RunContext& context) {
   auto volume = volume::read_label_volume(path, limits, context);
   if (!volume.ok()) return volume.status();
-  return VolumeSummary{volume->format, volume->file_voxel_type, volume->geometry,
-                       volume::compute_label_statistics(*volume)};
+  VolumeSummary summary{volume->format, volume->file_voxel_type, volume->geometry,
+                        volume::compute_label_statistics(*volume)};
+  summary.repeated_planes = volume::find_repeated_planes(*volume, summary.statistics);
+  return summary;
 }
 
 volume_mesh::ImproveParams improve_params_for(const MeshParams& params,
@@ -102,6 +105,7 @@ absl::StatusOr<MeshResult> run_pipeline(const std::string& path, const MeshParam
     StageTimer timer(result.stages, "label_statistics");
     result.input = {volume->format, volume->file_voxel_type, volume->geometry,
                     volume::compute_label_statistics(*volume)};
+    result.input.repeated_planes = volume::find_repeated_planes(*volume, result.input.statistics);
   }
   auto labels = choose_labels(path, result.input.statistics, params.labels);
   if (!labels.ok()) return labels.status();

@@ -27,6 +27,9 @@ struct VolumeSummary {
   std::string file_voxel_type;
   volume::ImageGeometry geometry;
   volume::VolumeStatistics statistics;
+  // Runs of equal planes per voxel axis (find_repeated_planes): 3 along z
+  // means the segmentation was drawn on every third slice.
+  std::array<int, 3> repeated_planes{1, 1, 1};
 };
 
 // Which connected pieces of a label a surface covers.

@@ -265,6 +265,10 @@ v1::InputSummary make_input_summary(const VolumeSummary& summary) {
     entry->set_volume_mm3(static_cast<double>(label.voxels) * voxel_volume);
   }
   input.set_background_voxels(summary.statistics.background_voxels);
+  for (int axis = 0; axis < 3; ++axis) {
+    input.add_repeated_planes(static_cast<uint32_t>(summary.repeated_planes[axis]));
+    input.add_drawn_spacing(g.spacing[axis] * summary.repeated_planes[axis]);
+  }
   return input;
 }
 

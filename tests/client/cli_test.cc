@@ -53,6 +53,13 @@ TEST(Cli, MeshWritesSurfacesAndReport) {
           .ok());
   EXPECT_EQ(report.input().convention(), "LPS");
   EXPECT_EQ(report.input().format(), "nrrd");
+  // The phantom is drawn on every voxel plane: none repeats.
+  ASSERT_EQ(report.input().repeated_planes_size(), 3);
+  ASSERT_EQ(report.input().drawn_spacing_size(), 3);
+  for (int axis = 0; axis < 3; ++axis) {
+    EXPECT_EQ(report.input().repeated_planes(axis), 1u);
+    EXPECT_EQ(report.input().drawn_spacing(axis), report.input().spacing(axis));
+  }
   ASSERT_EQ(report.input().labels_size(), 3);
   ASSERT_EQ(report.surfaces_size(), 2);
   EXPECT_EQ(report.surfaces(0).label(), 1);
