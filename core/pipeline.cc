@@ -17,6 +17,14 @@
 namespace labelmesh {
 namespace {
 
+// The input's format, placement, label counts and repeated planes.
+VolumeSummary summary_of(const volume::LabelVolume& volume) {
+  VolumeSummary summary{volume.format, volume.file_voxel_type, volume.geometry,
+                        volume::compute_label_statistics(volume)};
+  summary.repeated_planes = volume::find_repeated_planes(volume, summary.statistics);
+  return summary;
+}
+
 // The labels to mesh: those asked for (each must be present), or all.
 absl::StatusOr<std::vector<int32_t>> choose_labels(const std::string& path,
                                                    const volume::VolumeStatistics& statistics,
@@ -73,10 +81,7 @@ absl::StatusOr<VolumeSummary> summarise_volume(const std::string& path,
                                                const RunContext& context) {
   auto volume = volume::read_label_volume(path, limits, context);
   if (!volume.ok()) return volume.status();
-  VolumeSummary summary{volume->format, volume->file_voxel_type, volume->geometry,
-                        volume::compute_label_statistics(*volume)};
-  summary.repeated_planes = volume::find_repeated_planes(*volume, summary.statistics);
-  return summary;
+  return summary_of(*volume);
 }
 
 volume_mesh::ImproveParams improve_params_for(const MeshParams& params,
@@ -103,9 +108,7 @@ absl::StatusOr<MeshResult> run_pipeline(const std::string& path, const MeshParam
   if (!volume.ok()) return volume.status();
   {
     StageTimer timer(result.stages, "label_statistics");
-    result.input = {volume->format, volume->file_voxel_type, volume->geometry,
-                    volume::compute_label_statistics(*volume)};
-    result.input.repeated_planes = volume::find_repeated_planes(*volume, result.input.statistics);
+    result.input = summary_of(*volume);
   }
   auto labels = choose_labels(path, result.input.statistics, params.labels);
   if (!labels.ok()) return labels.status();

@@ -194,8 +194,7 @@ absl::Status add_quality_surfaces(const volume::LabelVolume& volume,
     marching_cubes_reference =
         std::make_unique<surface::DistanceReference>(marching_cubes, voxel, context);
     marching_cubes = {};
-    reference_seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    reference_seconds = seconds_since(start);
   };
   absl::Status prepared;
   std::vector<TriangleMesh> smoothed;
@@ -219,8 +218,7 @@ absl::Status add_quality_surfaces(const volume::LabelVolume& volume,
   auto measure_repaired = [&] {
     const auto start = std::chrono::steady_clock::now();
     repaired.statistics = surface::compute_surface_statistics(repaired.mesh);
-    statistics_seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    statistics_seconds = seconds_since(start);
   };
   if (to_poisson) {
     repair();
@@ -318,8 +316,7 @@ absl::Status measure_distances_beside(std::vector<SurfaceResult>& surfaces,
         }
         ready.store(true, std::memory_order_release);
         for (auto& measurement : measurements) measurement->work(context);
-        distance_seconds =
-            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        distance_seconds = seconds_since(start);
       },
       [&] {
         other_work();

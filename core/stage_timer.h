@@ -24,6 +24,11 @@ inline void add_stage_time(std::vector<StageTiming>& stages, const std::string& 
   stages.push_back({name, seconds});
 }
 
+// Seconds from `start` until now.
+inline double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
 // Times a scope and adds it to `stages`.
 class StageTimer {
  public:

@@ -28,6 +28,7 @@
 #include <Eigen/IterativeLinearSolvers>
 
 #include "core/side_by_side.h"
+#include "core/stage_timer.h"
 #include "core/surface/cgal_mesh.h"
 #include "core/surface/hinted_poisson_evaluator.h"
 #include "core/surface/mesher_seeds.h"
@@ -188,10 +189,6 @@ absl::StatusOr<TriangleMesh> complex_to_mesh(const Complex& complex, const Trian
     std::rotate(t.begin(), std::min_element(t.begin(), t.end()), t.end());
   std::sort(result.triangles.begin(), result.triangles.end());
   return result;
-}
-
-double seconds_since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
 absl::Status check_params(const PoissonParams& params) {
