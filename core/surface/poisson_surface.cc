@@ -25,13 +25,13 @@
 #include <CGAL/hierarchy_simplify_point_set.h>
 #include <CGAL/make_surface_mesh.h>
 #include <CGAL/property_map.h>
-#include <Eigen/IterativeLinearSolvers>
 
 #include "core/side_by_side.h"
 #include "core/stage_timer.h"
 #include "core/surface/cgal_mesh.h"
 #include "core/surface/hinted_poisson_evaluator.h"
 #include "core/surface/mesher_seeds.h"
+#include "core/surface/poisson_linear_system.h"
 #include "core/surface/zero_level_oracle.h"
 #include "core/text.h"
 
@@ -44,6 +44,7 @@ using Vector = Kernel::Vector_3;
 using OrientedPoint = std::pair<Point, Vector>;
 using PointMap = CGAL::First_of_pair_property_map<OrientedPoint>;
 using NormalMap = CGAL::Second_of_pair_property_map<OrientedPoint>;
+using poisson::CancellableSolver;
 using poisson::Cancelled;
 using poisson::HintedEvaluator;
 using poisson::PoissonFunction;
@@ -57,65 +58,6 @@ struct CancellableInsertion {
   void before_insertion() const {
     if (context->stop_requested()) throw Cancelled{};
   }
-};
-
-// Eigen's Jacobi preconditioner, which conjugate gradient applies once per
-// iteration: the one hook inside the solve where a stop request can be seen.
-class CancellablePreconditioner : public Eigen::DiagonalPreconditioner<double> {
- public:
-  void set_context(const RunContext* context) { context_ = context; }
-
-  template <typename Rhs>
-  auto solve(const Eigen::MatrixBase<Rhs>& b) const {
-    if (context_ != nullptr && context_->stop_requested()) throw Cancelled{};
-    return Eigen::DiagonalPreconditioner<double>::solve(b);
-  }
-
- private:
-  const RunContext* context_ = nullptr;
-};
-
-// CGAL's matrix, which the solve fills one coefficient at a time with no
-// callback between: each coefficient also polls for a stop (the assembly
-// took most of a second a half on the liver).
-class CancellableMatrix : public CGAL::Eigen_sparse_symmetric_matrix<double> {
- public:
-  using CGAL::Eigen_sparse_symmetric_matrix<double>::Eigen_sparse_symmetric_matrix;
-
-  void set_coef(std::size_t i, std::size_t j, double value, bool new_coef = false) {
-    poisson::poll_for_stop();
-    CGAL::Eigen_sparse_symmetric_matrix<double>::set_coef(i, j, value, new_coef);
-  }
-};
-
-// Conjugate gradient to a relative residual, cancellable at every iteration;
-// a model of CGAL's SparseLinearAlgebraTraits_d.
-class CancellableSolver {
- public:
-  using Matrix = CancellableMatrix;
-  using Vector = CGAL::Eigen_vector<double>;
-  using NT = double;
-
-  CancellableSolver(const RunContext* context, double tolerance, int* iterations)
-      : context_(context), tolerance_(tolerance), iterations_(iterations) {}
-
-  bool linear_solver(const Matrix& a, const Vector& b, Vector& x, NT& d) {
-    d = 1;
-    // CGAL stores the lower triangle of the symmetric matrix.
-    Eigen::ConjugateGradient<Matrix::EigenType, Eigen::Lower, CancellablePreconditioner> solver;
-    solver.preconditioner().set_context(context_);
-    solver.setTolerance(tolerance_);
-    solver.compute(a.eigen_object());
-    if (solver.info() != Eigen::Success) return false;
-    x = solver.solve(b);
-    *iterations_ += static_cast<int>(solver.iterations());
-    return solver.info() == Eigen::Success;
-  }
-
- private:
-  const RunContext* context_;
-  double tolerance_;
-  int* iterations_;
 };
 
 // Adds CGAL's creation-order time stamp to a vertex or cell base. CGAL then
