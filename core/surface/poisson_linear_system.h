@@ -10,7 +10,6 @@
 #include <utility>
 #include <vector>
 
-#include <CGAL/Eigen_matrix.h>
 #include <CGAL/Eigen_sparse_matrix.h>
 #include <CGAL/Eigen_vector.h>
 #include <CGAL/Poisson_reconstruction_function.h>

@@ -22,12 +22,18 @@ namespace {
 
 using surface::poisson::CancellableSolver;
 
+// A function of `points` with its triangulation built, not yet solved.
+PoissonFunction unsolved(const std::vector<std::pair<Point, Vector>>& points) {
+  using OrientedPoint = std::pair<Point, Vector>;
+  return PoissonFunction(points.begin(), points.end(),
+                         CGAL::First_of_pair_property_map<OrientedPoint>(),
+                         CGAL::Second_of_pair_property_map<OrientedPoint>());
+}
+
 // Solved by labelmesh's assembly; the fixture's function_ by CGAL's.
 class PoissonLinearSystemTest : public SolvedTorusTest {
  protected:
-  PoissonFunction ours_{points_.begin(), points_.end(),
-                        CGAL::First_of_pair_property_map<OrientedPoint>(),
-                        CGAL::Second_of_pair_property_map<OrientedPoint>()};
+  PoissonFunction ours_ = unsolved(points_);
 };
 
 // The torus's points moved by up to 0.1 in each coordinate: no longer
@@ -44,12 +50,7 @@ std::vector<std::pair<Point, Vector>> jittered_torus_points() {
 
 TEST_F(PoissonLinearSystemTest, GivesCgalsFunctionWhereItsWeightsAreDefined) {
   const auto points = jittered_torus_points();
-  auto function = [&] {
-    return PoissonFunction(points.begin(), points.end(),
-                           CGAL::First_of_pair_property_map<OrientedPoint>(),
-                           CGAL::Second_of_pair_property_map<OrientedPoint>());
-  };
-  PoissonFunction cgal = function(), mine = function();
+  PoissonFunction cgal = unsolved(points), mine = unsolved(points);
   // CGAL's own solve_poisson, with its default Eigen solver.
   ASSERT_TRUE(cgal.compute_implicit_function());
   int iterations = 0;
@@ -81,9 +82,9 @@ TEST_F(PoissonLinearSystemTest, KeepsTheSurfaceOfCocircularPoints) {
   int iterations = 0;
   ASSERT_TRUE(ours_.compute_implicit_function(CancellableSolver(&context_, 1e-12, &iterations)));
   auto value = [](const PoissonFunction& f, const Point& p) {
-    // The value of the cell's first vertex is enough to tell the sides
-    // apart this far from the level; CGAL's evaluator is not used on a
-    // function labelmesh solved (its cache is not filled).
+    // The mean of the cell's finite vertices' values is enough to tell the
+    // sides apart this far from the level; CGAL's evaluator is not used on
+    // a function labelmesh solved (its cache is not filled).
     const auto cell = f.tr().locate(p);
     double sum = 0;
     int finite = 0;
@@ -111,9 +112,7 @@ TEST_F(PoissonLinearSystemTest, ALooseToleranceStopsEarlierNearTheSameFunction) 
   for (auto v = ours_.tr().finite_vertices_begin(); v != ours_.tr().finite_vertices_end(); ++v)
     tight_values.push_back(v->f());
 
-  PoissonFunction again(points_.begin(), points_.end(),
-                        CGAL::First_of_pair_property_map<OrientedPoint>(),
-                        CGAL::Second_of_pair_property_map<OrientedPoint>());
+  PoissonFunction again = unsolved(points_);
   ASSERT_TRUE(again.compute_implicit_function(CancellableSolver(&context_, 1e-3, &loose)));
   EXPECT_LT(loose, tight);
   double largest_difference = 0;
