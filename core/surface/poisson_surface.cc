@@ -60,6 +60,29 @@ struct CancellableInsertion {
   }
 };
 
+}  // namespace
+}  // namespace labelmesh::surface
+
+// CGAL's constructor from oriented points, as solve() below calls it, but
+// without the points' average spacing, which CGAL computes (a search for each
+// point's 6 nearest neighbours: about 0.2 s a half on the liver) only for an
+// extra refinement pass that compute_implicit_function makes when given an
+// approximation ratio, and solve() gives none.
+template <>
+template <>
+CGAL::Poisson_reconstruction_function<labelmesh::surface::poisson::StopAwareKernel>::
+    Poisson_reconstruction_function(
+        std::vector<labelmesh::surface::OrientedPoint>::const_iterator first,
+        std::vector<labelmesh::surface::OrientedPoint>::const_iterator beyond,
+        labelmesh::surface::PointMap point_map, labelmesh::surface::NormalMap normal_map,
+        labelmesh::surface::CancellableInsertion visitor)
+    : m_tr(new Triangulation), m_bary(new std::vector<Cached_bary_coord>), average_spacing(0) {
+  forward_constructor(first, beyond, point_map, normal_map, visitor);
+}
+
+namespace labelmesh::surface {
+namespace {
+
 // Adds CGAL's creation-order time stamp to a vertex or cell base. CGAL then
 // orders and hashes handles by that stamp instead of by address, so the
 // surface mesher's sets of bad vertices and edges are walked in the same order

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <numbers>
 #include <random>
 #include <utility>
@@ -121,6 +122,40 @@ TEST_F(PoissonLinearSystemTest, ALooseToleranceStopsEarlierNearTheSameFunction) 
     largest_difference = std::max(largest_difference, std::abs(v->f() - tight_values[i++]));
   EXPECT_GT(largest_difference, 0);
   EXPECT_LT(largest_difference, 0.05 * scale_);
+}
+
+// The unknowns are numbered along a Hilbert curve: every vertex but the
+// constrained one, once each, in that order, so that the ends of an edge (a
+// matrix entry) are numbered far closer together than in the
+// triangulation's memory order.
+TEST_F(PoissonLinearSystemTest, NumbersTheUnknownsAlongAHilbertCurve) {
+  int iterations = 0;
+  ASSERT_TRUE(ours_.compute_implicit_function(CancellableSolver(&context_, 1e-6, &iterations)));
+  const auto& tr = ours_.tr();
+  const auto curve = surface::poisson::along_hilbert_curve(tr);
+  ASSERT_EQ(curve.size(), tr.number_of_vertices() - 1);
+  for (size_t i = 0; i < curve.size(); ++i) {
+    ASSERT_FALSE(tr.is_constrained(curve[i]));
+    ASSERT_EQ(curve[i]->index(), int(i));  // the assembly's rows, in this order
+  }
+  std::map<PoissonFunction::Triangulation::Vertex_handle, int> in_memory;
+  for (auto v = tr.finite_vertices_begin(); v != tr.finite_vertices_end(); ++v) {
+    if (!tr.is_constrained(v)) in_memory.emplace(v, int(in_memory.size()));
+  }
+  // The median gap between the numbers of an edge's ends.
+  auto median_gap = [&](auto number) {
+    std::vector<int> gaps;
+    for (auto e = tr.finite_edges_begin(); e != tr.finite_edges_end(); ++e) {
+      const auto v = e->first->vertex(e->second), w = e->first->vertex(e->third);
+      if (tr.is_constrained(v) || tr.is_constrained(w)) continue;
+      gaps.push_back(std::abs(number(v) - number(w)));
+    }
+    std::nth_element(gaps.begin(), gaps.begin() + gaps.size() / 2, gaps.end());
+    return gaps[gaps.size() / 2];
+  };
+  const int along_curve = median_gap([](auto v) { return int(v->index()); });
+  const int by_memory = median_gap([&](auto v) { return in_memory.at(v); });
+  EXPECT_LT(along_curve, by_memory / 4);
 }
 
 }  // namespace
