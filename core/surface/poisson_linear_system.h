@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstddef>
 #include <iterator>
+#include <numeric>
 #include <utility>
 #include <vector>
 
@@ -83,7 +84,7 @@ std::vector<typename Triangulation::Vertex_handle> along_hilbert_curve(const Tri
     points.emplace_back(v->point().x(), v->point().y(), v->point().z());
   }
   std::vector<std::size_t> order(vertices.size());
-  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::iota(order.begin(), order.end(), std::size_t{0});
   using Traits =
       CGAL::Spatial_sort_traits_adapter_3<CGAL::Epick,
                                           CGAL::Pointer_property_map<CGAL::Epick::Point_3>::type>;
@@ -131,7 +132,8 @@ inline bool CGAL::Poisson_reconstruction_function<labelmesh::surface::poisson::S
   constrain_one_vertex_on_convex_hull();
   const std::vector<Vertex_handle> unknown =
       labelmesh::surface::poisson::along_hilbert_curve(*m_tr);
-  for (std::size_t i = 0; i < unknown.size(); ++i) unknown[i]->index() = static_cast<int>(i);
+  for (std::size_t i = 0; i < unknown.size(); ++i)
+    unknown[i]->index() = static_cast<unsigned int>(i);
   const auto unknowns = static_cast<unsigned int>(unknown.size());
   Solver::Matrix a(unknowns);
   Solver::Vector x(unknowns), b(unknowns);
@@ -152,11 +154,6 @@ inline bool CGAL::Poisson_reconstruction_function<labelmesh::surface::poisson::S
     labelmesh::surface::poisson::poll_for_stop();
     cells.clear();
     m_tr->incident_cells(v, std::back_inserter(cells));
-    for (Cell_handle cell : cells) {
-      if (cell->info() >= 0 || m_tr->is_infinite(cell)) continue;
-      cell->info() = static_cast<int>(Dual.size());
-      Dual.push_back(m_tr->dual(cell));
-    }
 
     // Divergence (CGAL's default, unnormalised form): through the face
     // opposite v of each finite cell, that face's area vector against the
@@ -164,6 +161,10 @@ inline bool CGAL::Poisson_reconstruction_function<labelmesh::surface::poisson::S
     FT divergence = 0;
     for (Cell_handle cell : cells) {
       if (m_tr->is_infinite(cell)) continue;
+      if (cell->info() < 0) {
+        cell->info() = static_cast<int>(Dual.size());
+        Dual.push_back(m_tr->dual(cell));
+      }
       const int at = cell->index(v);
       const Vertex_handle q0 = cell->vertex(m_tr->vertex_triple_index(at, 0));
       const Vertex_handle q1 = cell->vertex(m_tr->vertex_triple_index(at, 1));
@@ -237,8 +238,6 @@ inline bool CGAL::Poisson_reconstruction_function<labelmesh::surface::poisson::S
 
   double denominator = 1;
   if (!solver.linear_solver(a, b, x, denominator)) return false;
-  for (auto v = m_tr->finite_vertices_begin(); v != m_tr->finite_vertices_end(); ++v) {
-    if (!m_tr->is_constrained(v)) v->f() = x[static_cast<std::size_t>(v->index())];
-  }
+  for (std::size_t row = 0; row < unknown.size(); ++row) unknown[row]->f() = x[row];
   return true;
 }
