@@ -35,6 +35,10 @@ void print_summary(const MeshResult& result, const std::string& out_dir) {
               "triangles", "min_ang", "max_ang", "closed", "manifold", "volume (mm3)", "self_int",
               "hausdorff");
   for (const auto& s : result.surfaces) {
+    if (s.error) {
+      std::printf("%8d %-15s not delivered: %s\n", s.label, s.stage.c_str(), s.error->c_str());
+      continue;
+    }
     if (s.components && s.components->kept == 0) {
       std::printf(
           "%8d %-15s every component under --min-component-voxels: %u dropped, no surface\n",
@@ -65,6 +69,16 @@ void print_summary(const MeshResult& result, const std::string& out_dir) {
   std::printf("meshes and report.json written to %s\n", out_dir.c_str());
 }
 
+// The labels delivered outside tolerance or not at all, on stderr, so they
+// are seen even when stdout goes elsewhere.
+void print_warnings(const MeshResult& result) {
+  if (result.warnings.empty()) return;
+  std::fprintf(stderr, "labelmesh mesh: %zu label(s) outside tolerance or not delivered:\n",
+               result.warnings.size());
+  for (const auto& warning : result.warnings)
+    std::fprintf(stderr, "  label %d: %s\n", warning.label, warning.reason.c_str());
+}
+
 }  // namespace
 
 CommandRunner add_mesh_command(CLI::App& app) {
@@ -79,8 +93,9 @@ CommandRunner add_mesh_command(CLI::App& app) {
                  "Print report.json to stdout instead of progress and a table");
   mesh->footer(kExitCodeHelp);
   return [options] {
-    const v1::MeshOptions proto = to_mesh_options(options->pipeline);
-    auto params = params_from_options(proto);
+    const auto proto = to_mesh_options(options->pipeline);
+    auto params =
+        proto.ok() ? params_from_options(*proto) : absl::StatusOr<MeshParams>(proto.status());
     if (!params.ok()) {
       std::fprintf(stderr, "labelmesh mesh: %s\n", std::string(params.status().message()).c_str());
       return int{kExitUsage};
@@ -103,6 +118,7 @@ CommandRunner add_mesh_command(CLI::App& app) {
     } else {
       print_summary(*result, options->out_dir);
     }
+    print_warnings(*result);
     return int{kExitSuccess};
   };
 }

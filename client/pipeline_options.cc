@@ -2,6 +2,8 @@
 
 #include <CLI/CLI.hpp>
 
+#include <cstdio>
+
 namespace labelmesh::client {
 
 void add_pipeline_flags(CLI::App& command, PipelineFlags& flags) {
@@ -33,6 +35,38 @@ void add_pipeline_flags(CLI::App& command, PipelineFlags& flags) {
       // CLI11 reads "-1" into an unsigned option as its largest value.
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
+  command
+      .add_option("--max-edge-mm", poisson.max_edge_mm,
+                  "Longest triangle edge, mm; replaces --max-edge when set")
+      ->check(CLI::NonNegativeNumber);
+  command
+      .add_option("--max-distance-mm", poisson.max_distance_mm,
+                  "Surface mesher distance bound, mm; replaces --max-distance when set")
+      ->check(CLI::NonNegativeNumber);
+  command.add_flag("--no-adapt-to-thickness", flags.no_adapt_to_thickness,
+                   "Keep the same sizing for thin components (by default each component's edges "
+                   "are no longer than its thickness, 3 x volume / area)");
+  command.add_option("--label-sizing", flags.label_sizing,
+                     "Per-label sizing LABEL:EDGE_MM[:DISTANCE_MM], e.g. 114:2:0.2; repeatable");
+  auto& guard = flags.guard;
+  command
+      .add_option("--volume-tolerance", guard.volume_percent,
+                  "Delivery guard: largest volume change against Marching Cubes, percent")
+      ->capture_default_str();
+  command
+      .add_option("--small-volume-tolerance", guard.small_volume_percent,
+                  "Delivery guard: the same for labels under 1,000 voxels, percent")
+      ->capture_default_str();
+  command
+      .add_option("--hausdorff-tolerance", guard.hausdorff_mm,
+                  "Delivery guard: largest Hausdorff distance to Marching Cubes, mm (0: the "
+                  "largest spacing the segmentation was drawn at)")
+      ->capture_default_str();
+  command.add_flag("--no-fall-back", flags.no_fall_back,
+                   "Delivery guard: only measure and warn; never rebuild a surface outside "
+                   "tolerance");
+  command.add_flag("--strict", guard.strict,
+                   "Fail (exit 4) when any label is delivered outside tolerance or not at all");
   command.add_flag("--keep-strands", flags.keep_strands,
                    "Keep strands one voxel thick (repaired, poisson); by default they are pruned");
   command
@@ -117,8 +151,29 @@ void add_pipeline_flags(CLI::App& command, PipelineFlags& flags) {
       ->capture_default_str();
 }
 
-v1::MeshOptions to_mesh_options(const PipelineFlags& flags) {
+absl::StatusOr<v1::MeshOptions> to_mesh_options(const PipelineFlags& flags) {
   v1::MeshOptions proto;
+  for (const auto& text : flags.label_sizing) {
+    int label = 0;
+    double edge = 0, distance = 0;
+    char extra = 0;
+    const int read = std::sscanf(text.c_str(), "%d:%lf:%lf%c", &label, &edge, &distance, &extra);
+    if (read != 2 && read != 3)
+      return absl::InvalidArgumentError("--label-sizing: '" + text +
+                                        "' is not LABEL:EDGE_MM[:DISTANCE_MM]");
+    auto* entry = proto.add_label_sizing();
+    entry->set_label(label);
+    entry->set_max_edge_mm(edge);
+    entry->set_max_distance_mm(distance);
+  }
+  if (flags.poisson.max_edge_mm > 0) proto.set_max_edge_mm(flags.poisson.max_edge_mm);
+  if (flags.poisson.max_distance_mm > 0) proto.set_max_distance_mm(flags.poisson.max_distance_mm);
+  proto.set_adapt_to_thickness(!flags.no_adapt_to_thickness);
+  proto.set_volume_tolerance_percent(flags.guard.volume_percent);
+  proto.set_small_volume_tolerance_percent(flags.guard.small_volume_percent);
+  proto.set_hausdorff_tolerance_mm(flags.guard.hausdorff_mm);
+  proto.set_fall_back(!flags.no_fall_back);
+  proto.set_strict(flags.guard.strict);
   for (int32_t label : flags.labels) proto.add_labels(label);
   proto.set_surface(flags.surface == "mc"         ? v1::SURFACE_METHOD_MARCHING_CUBES
                     : flags.surface == "repaired" ? v1::SURFACE_METHOD_REPAIRED

@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "absl/status/statusor.h"
 #include "core/mesh_params.h"
 #include "labelmesh/v1/options.pb.h"
 
@@ -25,12 +26,18 @@ struct PipelineFlags {
   volume_mesh::TetgenParams tetgen;
   volume_mesh::ImproveParams improve;
   bool tet_split_boundary = false;
+  bool no_adapt_to_thickness = false;
+  // LABEL:EDGE_MM[:DISTANCE_MM], one per label.
+  std::vector<std::string> label_sizing;
+  GuardOptions guard;
+  bool no_fall_back = false;
   std::vector<std::string> formats{"stl", "vtp"};
   uint64_t max_voxels = volume::ReadLimits{}.max_voxels;
 };
 
 void add_pipeline_flags(CLI::App& command, PipelineFlags& flags);
 
-v1::MeshOptions to_mesh_options(const PipelineFlags& flags);
+// Errors: INVALID_ARGUMENT for a malformed --label-sizing entry.
+absl::StatusOr<v1::MeshOptions> to_mesh_options(const PipelineFlags& flags);
 
 }  // namespace labelmesh::client

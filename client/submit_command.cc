@@ -55,7 +55,9 @@ absl::StatusOr<v1::SubmitReply> upload(const ServerConnection& connection,
   auto writer = stub->Submit(context.get(), &reply);
   v1::SubmitRequest request;
   v1::JobSpec& spec = *request.mutable_spec();
-  *spec.mutable_options() = to_mesh_options(flags.pipeline);
+  auto options = to_mesh_options(flags.pipeline);
+  if (!options.ok()) return options.status();
+  *spec.mutable_options() = *options;
   spec.set_file_name(std::filesystem::path(flags.path).filename().string());
   spec.set_size_bytes(size);
   spec.set_sha256(*digest);
@@ -81,7 +83,9 @@ absl::StatusOr<v1::SubmitReply> upload(const ServerConnection& connection,
 }
 
 int run_submit(const SubmitFlags& flags) {
-  auto params = params_from_options(to_mesh_options(flags.pipeline));
+  auto options = to_mesh_options(flags.pipeline);
+  auto params =
+      options.ok() ? params_from_options(*options) : absl::StatusOr<MeshParams>(options.status());
   if (!params.ok()) {
     std::fprintf(stderr, "labelmesh submit: %s\n", std::string(params.status().message()).c_str());
     return kExitUsage;

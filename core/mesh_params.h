@@ -24,12 +24,28 @@ enum class SurfaceMethod {
 
 // Poisson surface settings. Lengths are in voxels (multiples of the cube root
 // of the voxel volume), so the same defaults work at any resolution.
+// Surface sizing for one label, mm, overriding the defaults (0: keep them).
+struct LabelSizing {
+  int32_t label = 0;
+  double max_edge_mm = 0;
+  double max_distance_mm = 0;
+};
+
 struct PoissonOptions {
   double min_angle_deg = 30;
   // 8 voxels and half a voxel give the liver about 26,000 triangles in about
   // 3 s of meshing; halving both doubles fidelity to curvature, triples time.
   double max_edge_voxels = 8;
   double max_distance_voxels = 0.5;
+  // The same in mm; when set (> 0) they replace the voxel figures.
+  double max_edge_mm = 0;
+  double max_distance_mm = 0;
+  // Each component's sizing shrinks to its thickness (3 x volume / area),
+  // so a rib or vessel gets edges as short as it is thin while a large organ
+  // keeps the defaults.
+  bool adapt_to_thickness = true;
+  // Per-label sizing; it also overrides the adaptation.
+  std::vector<LabelSizing> label_sizing;
   // Islands smaller than 4^3 voxels are segmentation noise in practice, and too
   // small for Poisson to reconstruct as anything but a blob.
   uint64_t min_component_voxels = 64;
@@ -69,11 +85,31 @@ enum class VolumeMethod {
   kTetgen,
 };
 
+// The guard on what is delivered: each label's output surface is compared
+// with its Marching Cubes surface; outside the tolerance it is rebuilt finer,
+// then replaced by a remeshed Marching Cubes surface, and what is delivered
+// outside it anyway is listed in the report's warnings.
+struct GuardOptions {
+  // Largest |volume change|, percent of the Marching Cubes volume, for labels
+  // of at least kSmallLabelVoxels voxels, and for smaller ones.
+  double volume_percent = 3;
+  double small_volume_percent = 10;
+  // Largest Hausdorff distance, mm; 0: the largest spacing the segmentation
+  // was drawn at (input.drawn_spacing).
+  double hausdorff_mm = 0;
+  // Rebuild and fall back when outside the tolerance (false: only measure
+  // and warn).
+  bool fall_back = true;
+  // Any label delivered outside the tolerance, or not at all, fails the run.
+  bool strict = false;
+};
+
 struct MeshParams {
   // Labels to mesh; empty means every non-zero label in the volume.
   std::vector<int32_t> labels;
   SurfaceMethod surface = SurfaceMethod::kPoisson;
   PoissonOptions poisson;
+  GuardOptions guard;
   // Surface files to write per label.
   std::vector<surface::SurfaceFormat> formats{surface::SurfaceFormat::kStl,
                                               surface::SurfaceFormat::kVtp};

@@ -49,6 +49,41 @@ absl::StatusOr<std::vector<int32_t>> choose_labels(const std::string& path,
   return labels;
 }
 
+// One warning per label delivered outside its tolerance, not at all, or with
+// much of it left out as small components and strands.
+std::vector<LabelWarning> collect_warnings(const std::vector<SurfaceResult>& surfaces,
+                                           const MeshParams& params) {
+  std::vector<LabelWarning> warnings;
+  for (const auto& s : surfaces) {
+    if (s.stage == "marching_cubes") continue;
+    if (s.error) {
+      warnings.push_back({s.label, cat("not delivered: ", *s.error)});
+      continue;
+    }
+    if (s.components && s.components->kept == 0) {
+      warnings.push_back(
+          {s.label, cat("too small to mesh: no component of ", params.poisson.min_component_voxels,
+                        " voxels or more (min_component_voxels) once one-voxel strands are "
+                        "pruned; ",
+                        s.components->dropped, " smaller component(s), ",
+                        s.components->pruned_voxels, " voxels in strands")});
+      continue;
+    }
+    if (!s.is_output || !s.fidelity) continue;
+    const auto& f = *s.fidelity;
+    const auto& a = f.attempts[f.delivered];
+    if (!f.within_tolerance()) {
+      warnings.push_back(
+          {s.label, cat("outside tolerance: ", a.method, " surface, volume ",
+                        format_fixed(100 * a.volume_change, 1), " % (tolerance ",
+                        format_fixed(100 * f.tolerance.volume_fraction, 1), " %), Hausdorff ",
+                        format_fixed(a.hausdorff_mm, 2), " mm (tolerance ",
+                        format_fixed(f.tolerance.hausdorff_mm, 2), " mm)")});
+    }
+  }
+  return warnings;
+}
+
 // TetGen on each label's output surface, then the improvement pass.
 absl::Status add_volume_mesh(const MeshParams& params, const volume::ImageGeometry& geometry,
                              const RunContext& context, MeshResult& result) {
@@ -145,23 +180,32 @@ absl::StatusOr<MeshResult> run_pipeline(const std::string& path, const MeshParam
   // Listed where it runs first, whatever finishes first.
   result.stages.push_back({"surface_statistics", 0});
   std::vector<SurfaceResult> quality_surfaces;
-  // The distances to Marching Cubes are measured after each label, so one
-  // label's Marching Cubes side is in memory at a time; or, when TetGen
-  // follows, beside it (below).
-  std::vector<PendingDistance> pending;
   absl::Status quality_status;
+  std::array<double, 3> drawn_spacing;
+  for (int axis = 0; axis < 3; ++axis)
+    drawn_spacing[axis] = volume->geometry.spacing[axis] * result.input.repeated_planes[axis];
   if (!quality) {
     measure_marching_cubes();
   } else {
     side_by_side(measure_marching_cubes, [&] {
       for (int32_t label : *labels) {
         const auto* statistics = result.input.statistics.find(label);
-        quality_status = add_quality_surfaces(*volume, *statistics, params, context,
-                                              quality_surfaces, pending, result.stages);
-        if (!quality_status.ok()) return;
-        if (tetrahedra) continue;
-        StageTimer timer(result.stages, "surface_distance");
-        quality_status = measure_distances(quality_surfaces, pending, context);
+        const auto& guard = params.guard;
+        const SurfaceTolerance tolerance =
+            tolerance_for(statistics->voxels, drawn_spacing, guard.volume_percent,
+                          guard.small_volume_percent, guard.hausdorff_mm);
+        quality_status = add_quality_surfaces(*volume, *statistics, params, tolerance, context,
+                                              quality_surfaces, result.stages);
+        // One label's failure is that label's error; the others go on.
+        if (!quality_status.ok() && quality_status.code() != absl::StatusCode::kCancelled &&
+            quality_status.code() != absl::StatusCode::kInvalidArgument && params.labels.empty()) {
+          SurfaceResult failed;
+          failed.label = label;
+          failed.stage = params.surface == SurfaceMethod::kPoisson ? "poisson" : "repaired";
+          failed.error = std::string(quality_status.message());
+          quality_surfaces.push_back(std::move(failed));
+          quality_status = absl::OkStatus();
+        }
         if (!quality_status.ok()) return;
       }
     });
@@ -172,28 +216,23 @@ absl::StatusOr<MeshResult> run_pipeline(const std::string& path, const MeshParam
   if (quality && std::none_of(quality_surfaces.begin(), quality_surfaces.end(),
                               [](const SurfaceResult& s) { return s.is_output; })) {
     return absl::FailedPreconditionError(
-        cat(path, ": every label's components are smaller than min-component-voxels (",
-            params.poisson.min_component_voxels, "); nothing to mesh"));
+        cat(path,
+            ": no label left a surface: every label's components are smaller than "
+            "min-component-voxels (",
+            params.poisson.min_component_voxels, ") or its stages failed; nothing to mesh"));
   }
-  const size_t first_quality = result.surfaces.size();
   for (auto& surface : quality_surfaces) result.surfaces.push_back(std::move(surface));
-  for (auto& measure : pending) measure.surface += first_quality;
+  result.warnings = collect_warnings(result.surfaces, params);
+  if (params.guard.strict && !result.warnings.empty()) {
+    const auto& first = result.warnings.front();
+    return absl::FailedPreconditionError(
+        cat(path, ": strict: ", result.warnings.size(),
+            " label(s) delivered outside tolerance or not at all; first, label ", first.label, ": ",
+            first.reason));
+  }
 
   if (tetrahedra) {
-    // TetGen needs only the surfaces and their self-intersection counts.
-    // Progress then comes from TetGen alone (the callback expects one stage
-    // at a time).
-    RunContext quiet = context;
-    quiet.progress = nullptr;
-    absl::Status volume_status;
-    double distance_seconds = 0;
-    const absl::Status distance_status = measure_distances_beside(
-        result.surfaces, pending, quiet,
-        [&] { volume_status = add_volume_mesh(params, volume->geometry, context, result); },
-        distance_seconds);
-    if (quality) add_stage_time(result.stages, "surface_distance", distance_seconds);
-    if (!volume_status.ok()) return volume_status;
-    if (!distance_status.ok()) return distance_status;
+    if (auto s = add_volume_mesh(params, volume->geometry, context, result); !s.ok()) return s;
   }
   return result;
 }

@@ -15,6 +15,7 @@
 #include "core/surface/surface_repair.h"
 #include "core/surface/surface_statistics.h"
 #include "core/surface/triangle_mesh.h"
+#include "core/surface_fidelity.h"
 #include "core/volume/label_statistics.h"
 #include "core/volume/label_volume.h"
 #include "core/volume_meshes.h"
@@ -49,7 +50,9 @@ struct ComponentCounts {
 // paper's Table 2 columns) but writes files only for the final stage.
 struct SurfaceResult {
   int32_t label = 0;
-  // Stage that produced the surface: "marching_cubes", "repaired" or "poisson".
+  // Stage that produced the surface: "marching_cubes", "repaired", or the
+  // delivery guard's method ("poisson", "poisson_refined", "remeshed_smoothed",
+  // "remeshed").
   std::string stage;
   // True for the stage whose surface is the run's output.
   bool is_output = false;
@@ -63,8 +66,19 @@ struct SurfaceResult {
   std::optional<uint64_t> self_intersections;
   // To the Marching Cubes surface of the kept components.
   std::optional<surface::SurfaceDistance> distance_to_marching_cubes;
+  // Output stage of the quality surfaces: what the delivery guard tried and
+  // measured, and which attempt was delivered.
+  std::optional<SurfaceFidelity> fidelity;
+  // Why the label has no surface when its stages failed (the run goes on).
+  std::optional<std::string> error;
   // Files written for it, relative to the output directory.
   std::vector<std::string> files;
+};
+
+// A label delivered outside its tolerance, or not at all, and why.
+struct LabelWarning {
+  int32_t label = 0;
+  std::string reason;
 };
 
 struct MeshResult {
@@ -73,6 +87,8 @@ struct MeshResult {
   // When a volume method was asked for.
   std::optional<VolumeResult> volume;
   std::vector<StageTiming> stages;
+  // Every label delivered outside its tolerance or not at all.
+  std::vector<LabelWarning> warnings;
 };
 
 // Reads `path` and counts its labels (what `labelmesh info` shows).

@@ -3,8 +3,6 @@
 // with Poisson, then check the result against the Marching Cubes surface.
 #pragma once
 
-#include <functional>
-#include <memory>
 #include <vector>
 
 #include "absl/status/status.h"
@@ -21,41 +19,23 @@ namespace labelmesh {
 // voxel volume.
 double voxel_size_mm(const volume::ImageGeometry& geometry);
 
-// A surface whose distance to Marching Cubes is still to be measured: its
-// index in the surfaces vector and the Marching Cubes side of the distance.
-struct PendingDistance {
-  size_t surface;
-  std::unique_ptr<surface::DistanceReference> marching_cubes;
-};
-
 // Appends the "repaired" surface of `label` and, for SurfaceMethod::kPoisson,
-// the "poisson" one; the last appended is marked as the output, and its
-// distance to Marching Cubes is left in `pending` for measure_distances. When
-// every component is under the size threshold, only a "repaired" entry with
-// the dropped counts (and no surface) is appended, unless the label was asked
-// for by name (params.labels): then FAILED_PRECONDITION. Adds stage times to
-// `stages`. Errors: INVALID_ARGUMENT for bad options, INTERNAL for a failed
-// stage, CANCELLED.
+// the delivered one; the last appended is marked as the output. The delivery
+// guard measures each surface it builds against the label's Marching Cubes
+// surface (volume, distances) and, outside `tolerance`, tries a finer Poisson
+// surface, then the smoothed and the plain repaired surface remeshed, and
+// delivers the first within it or else the one least outside it; what it
+// tried is in the output's `fidelity`. When no attempt could be built, the
+// output carries the `error` and no surface. When every component is under
+// the size threshold, only a "repaired" entry with the dropped counts (and no
+// surface) is appended, unless the label was asked for by name
+// (params.labels): then FAILED_PRECONDITION. Adds stage times to `stages`.
+// Errors: INVALID_ARGUMENT for bad options, INTERNAL for a failed stage before
+// the surfaces, CANCELLED.
 absl::Status add_quality_surfaces(const volume::LabelVolume& volume,
                                   const volume::LabelStatistics& label, const MeshParams& params,
-                                  const RunContext& context, std::vector<SurfaceResult>& surfaces,
-                                  std::vector<PendingDistance>& pending,
+                                  const SurfaceTolerance& tolerance, const RunContext& context,
+                                  std::vector<SurfaceResult>& surfaces,
                                   std::vector<StageTiming>& stages);
-
-// Measures each pending surface of `surfaces` against its Marching Cubes
-// reference (distance_to_marching_cubes; two threads) and empties `pending`.
-// Errors: CANCELLED.
-absl::Status measure_distances(std::vector<SurfaceResult>& surfaces,
-                               std::vector<PendingDistance>& pending, const RunContext& context);
-
-// measure_distances on a second thread while `other_work` runs on this one,
-// which then joins in with what is left of the measuring (TetGen runs on one
-// core, so the measuring gets the other, and both at the end). Sets
-// `distance_seconds` to the measuring's wall time. Errors: CANCELLED.
-absl::Status measure_distances_beside(std::vector<SurfaceResult>& surfaces,
-                                      std::vector<PendingDistance>& pending,
-                                      const RunContext& context,
-                                      const std::function<void()>& other_work,
-                                      double& distance_seconds);
 
 }  // namespace labelmesh

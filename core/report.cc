@@ -39,6 +39,44 @@ absl::Status check_voxels(std::string_view field, double value) {
   return absl::InvalidArgumentError(cat(field, ": ", value, " is not a positive number of voxels"));
 }
 
+// Lengths in mm beyond a metre are mistakes.
+constexpr double kMaxLengthMm = 1000;
+// One entry per label is plenty; the bound keeps a job record small.
+constexpr int kMaxLabelSizings = 1000;
+
+absl::Status check_millimetres(std::string_view field, double value) {
+  if (std::isfinite(value) && value > 0 && value <= kMaxLengthMm) return absl::OkStatus();
+  return absl::InvalidArgumentError(
+      cat(field, ": ", value, " is not a length in (0, ", kMaxLengthMm, "] mm"));
+}
+
+absl::Status read_guard_options(const v1::MeshOptions& options, GuardOptions& guard) {
+  auto percent = [](std::string_view field, double value) {
+    if (std::isfinite(value) && value > 0 && value <= 100) return absl::OkStatus();
+    return absl::InvalidArgumentError(cat(field, ": ", value, " is outside (0, 100] percent"));
+  };
+  if (options.has_volume_tolerance_percent()) {
+    guard.volume_percent = options.volume_tolerance_percent();
+    if (auto s = percent("volume_tolerance_percent", guard.volume_percent); !s.ok()) return s;
+  }
+  if (options.has_small_volume_tolerance_percent()) {
+    guard.small_volume_percent = options.small_volume_tolerance_percent();
+    if (auto s = percent("small_volume_tolerance_percent", guard.small_volume_percent); !s.ok())
+      return s;
+  }
+  if (options.has_hausdorff_tolerance_mm()) {
+    guard.hausdorff_mm = options.hausdorff_tolerance_mm();
+    // 0 asks for the default (the drawn spacing).
+    if (guard.hausdorff_mm != 0) {
+      if (auto s = check_millimetres("hausdorff_tolerance_mm", guard.hausdorff_mm); !s.ok())
+        return s;
+    }
+  }
+  if (options.has_fall_back()) guard.fall_back = options.fall_back();
+  if (options.has_strict()) guard.strict = options.strict();
+  return absl::OkStatus();
+}
+
 absl::Status read_poisson_options(const v1::MeshOptions& options, PoissonOptions& poisson) {
   if (options.has_min_angle_deg()) {
     poisson.min_angle_deg = options.min_angle_deg();
@@ -56,6 +94,27 @@ absl::Status read_poisson_options(const v1::MeshOptions& options, PoissonOptions
     poisson.max_distance_voxels = options.max_distance_voxels();
     if (auto s = check_voxels("max_distance_voxels", poisson.max_distance_voxels); !s.ok())
       return s;
+  }
+  if (options.has_max_edge_mm()) {
+    poisson.max_edge_mm = options.max_edge_mm();
+    if (auto s = check_millimetres("max_edge_mm", poisson.max_edge_mm); !s.ok()) return s;
+  }
+  if (options.has_max_distance_mm()) {
+    poisson.max_distance_mm = options.max_distance_mm();
+    if (auto s = check_millimetres("max_distance_mm", poisson.max_distance_mm); !s.ok()) return s;
+  }
+  if (options.has_adapt_to_thickness()) poisson.adapt_to_thickness = options.adapt_to_thickness();
+  if (options.label_sizing_size() > kMaxLabelSizings)
+    return absl::InvalidArgumentError(
+        cat("label_sizing: ", options.label_sizing_size(), " entries; at most ", kMaxLabelSizings));
+  for (const auto& entry : options.label_sizing()) {
+    if (entry.label() == 0)
+      return absl::InvalidArgumentError("label_sizing: label 0 is the background");
+    if (!(entry.max_edge_mm() >= 0 && entry.max_edge_mm() <= kMaxLengthMm) ||
+        !(entry.max_distance_mm() >= 0 && entry.max_distance_mm() <= kMaxLengthMm))
+      return absl::InvalidArgumentError(cat("label_sizing: label ", entry.label(),
+                                            ": lengths must be in [0, ", kMaxLengthMm, "] mm"));
+    poisson.label_sizing.push_back({entry.label(), entry.max_edge_mm(), entry.max_distance_mm()});
   }
   if (options.has_prune_strands()) poisson.prune_strands = options.prune_strands();
   if (options.has_smoothing_iterations()) {
@@ -230,6 +289,29 @@ void add_quality_figures(const SurfaceResult& surface, v1::SurfaceSummary& entry
     repair->set_non_manifold_vertices_split(r.non_manifold_vertices_split);
     repair->set_holes_filled(r.holes_filled);
   }
+  if (surface.error) entry.set_error(*surface.error);
+  if (surface.fidelity) {
+    const auto& f = *surface.fidelity;
+    auto* fidelity = entry.mutable_fidelity();
+    fidelity->set_volume_tolerance_percent(100 * f.tolerance.volume_fraction);
+    fidelity->set_hausdorff_tolerance_mm(f.tolerance.hausdorff_mm);
+    fidelity->set_marching_cubes_volume_mm3(f.marching_cubes_volume_mm3);
+    fidelity->set_within_tolerance(f.within_tolerance());
+    if (f.delivered < f.attempts.size()) fidelity->set_delivered(f.attempts[f.delivered].method);
+    for (const auto& a : f.attempts) {
+      auto* attempt = fidelity->add_attempts();
+      attempt->set_method(a.method);
+      attempt->set_max_edge_mm(a.max_edge_mm);
+      attempt->set_max_distance_mm(a.max_distance_mm);
+      attempt->set_error(a.error);
+      attempt->set_volume_change_percent(100 * a.volume_change);
+      attempt->set_hausdorff_mm(a.hausdorff_mm);
+      attempt->set_mean_distance_mm(a.mean_distance_mm);
+      attempt->set_min_angle_deg(a.min_angle_deg);
+      attempt->set_max_angle_deg(a.max_angle_deg);
+      attempt->set_within_tolerance(a.within_tolerance);
+    }
+  }
   if (surface.poisson) {
     const auto& p = *surface.poisson;
     auto* poisson = entry.mutable_poisson();
@@ -292,6 +374,21 @@ v1::MeshOptions make_options(const MeshParams& params) {
   options.set_prune_strands(poisson.prune_strands);
   options.set_smoothing_iterations(poisson.smoothing.iterations);
   options.set_smoothing_pass_band(poisson.smoothing.pass_band);
+  if (poisson.max_edge_mm > 0) options.set_max_edge_mm(poisson.max_edge_mm);
+  if (poisson.max_distance_mm > 0) options.set_max_distance_mm(poisson.max_distance_mm);
+  options.set_adapt_to_thickness(poisson.adapt_to_thickness);
+  for (const auto& sizing : poisson.label_sizing) {
+    auto* entry = options.add_label_sizing();
+    entry->set_label(sizing.label);
+    entry->set_max_edge_mm(sizing.max_edge_mm);
+    entry->set_max_distance_mm(sizing.max_distance_mm);
+  }
+  const GuardOptions& guard = params.guard;
+  options.set_volume_tolerance_percent(guard.volume_percent);
+  options.set_small_volume_tolerance_percent(guard.small_volume_percent);
+  options.set_hausdorff_tolerance_mm(guard.hausdorff_mm);
+  options.set_fall_back(guard.fall_back);
+  options.set_strict(guard.strict);
 
   for (auto format : params.formats)
     options.add_formats(std::string(surface::surface_format_name(format)));
@@ -330,6 +427,7 @@ absl::StatusOr<MeshParams> params_from_options(const v1::MeshOptions& options) {
       return absl::InvalidArgumentError("surface: unknown surface method");
   }
   if (auto s = read_poisson_options(options, params.poisson); !s.ok()) return s;
+  if (auto s = read_guard_options(options, params.guard); !s.ok()) return s;
   if (auto s = read_volume_options(options, params); !s.ok()) return s;
   if (!options.formats().empty()) {
     // One list for both kinds: each name is either a surface or a volume format.
@@ -387,6 +485,11 @@ v1::Report make_report(const MeshResult& result, const MeshParams& params) {
     add_quality_figures(surface, *entry);
   }
   if (result.volume) *report.mutable_volume() = make_volume_summary(*result.volume);
+  for (const auto& warning : result.warnings) {
+    auto* entry = report.add_warnings();
+    entry->set_label(warning.label);
+    entry->set_reason(warning.reason);
+  }
   for (const auto& stage : result.stages) {
     auto* entry = report.add_stages();
     entry->set_name(stage.name);

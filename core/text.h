@@ -40,6 +40,13 @@ std::string cat(const Pieces&... pieces) {
   return out;
 }
 
+// `value` with `decimals` digits after the point ("-8.4").
+inline std::string format_fixed(double value, int decimals) {
+  char text[64];
+  std::snprintf(text, sizeof text, "%.*f", decimals, value);
+  return text;
+}
+
 inline bool contains(std::string_view text, std::string_view part) {
   return text.find(part) != std::string_view::npos;
 }

@@ -8,19 +8,10 @@
 #include <cmath>
 #include <functional>
 #include <memory>
-#include <unordered_map>
 #include <utility>
 
-#include <CGAL/Delaunay_triangulation_3.h>
-#include <CGAL/Delaunay_triangulation_cell_base_with_circumcenter_3.h>
 #include <CGAL/Poisson_reconstruction_function.h>
-#include <CGAL/Polygon_mesh_processing/orient_polygon_soup.h>
-#include <CGAL/Polygon_mesh_processing/orientation.h>
-#include <CGAL/Robust_circumcenter_traits_3.h>
-#include <CGAL/Surface_mesh_cell_base_3.h>
-#include <CGAL/Surface_mesh_complex_2_in_triangulation_3.h>
 #include <CGAL/Surface_mesh_default_criteria_3.h>
-#include <CGAL/Surface_mesh_vertex_base_3.h>
 #include <CGAL/grid_simplify_point_set.h>
 #include <CGAL/hierarchy_simplify_point_set.h>
 #include <CGAL/make_surface_mesh.h>
@@ -32,6 +23,7 @@
 #include "core/surface/hinted_poisson_evaluator.h"
 #include "core/surface/mesher_seeds.h"
 #include "core/surface/poisson_linear_system.h"
+#include "core/surface/restricted_delaunay.h"
 #include "core/surface/zero_level_oracle.h"
 #include "core/text.h"
 
@@ -51,6 +43,9 @@ using poisson::PoissonFunction;
 using poisson::SolvedFunction;
 using poisson::ZeroLevel;
 using poisson::ZeroLevelOracle;
+using restricted_delaunay::Complex;
+using restricted_delaunay::complex_to_mesh;
+using restricted_delaunay::Triangulation;
 
 // CGAL calls this before inserting each input point into its triangulation.
 struct CancellableInsertion {
@@ -82,82 +77,6 @@ CGAL::Poisson_reconstruction_function<labelmesh::surface::poisson::StopAwareKern
 
 namespace labelmesh::surface {
 namespace {
-
-// Adds CGAL's creation-order time stamp to a vertex or cell base. CGAL then
-// orders and hashes handles by that stamp instead of by address, so the
-// surface mesher's sets of bad vertices and edges are walked in the same order
-// in every process (the default triangulation gave the liver 15,798 nodes in
-// the CLI and 15,890 in the server's worker).
-template <class Base>
-class TimeStamped : public Base {
- public:
-  using Has_timestamp = CGAL::Tag_true;
-  template <class Tds>
-  struct Rebind_TDS {
-    using Other = TimeStamped<typename Base::template Rebind_TDS<Tds>::Other>;
-  };
-  using Base::Base;
-
-  std::size_t time_stamp() const { return time_stamp_; }
-  void set_time_stamp(std::size_t stamp) { time_stamp_ = stamp; }
-
- private:
-  std::size_t time_stamp_ = std::size_t(-1);
-};
-
-// CGAL's Surface_mesh_default_triangulation_3 with time-stamped bases.
-using MesherTraits = CGAL::Robust_circumcenter_traits_3<Kernel>;
-using MesherVertexBase = TimeStamped<CGAL::Surface_mesh_vertex_base_3<MesherTraits>>;
-using MesherCellBase = TimeStamped<CGAL::Delaunay_triangulation_cell_base_with_circumcenter_3<
-    MesherTraits, CGAL::Surface_mesh_cell_base_3<MesherTraits>>>;
-using Triangulation = CGAL::Delaunay_triangulation_3<
-    MesherTraits, CGAL::Triangulation_data_structure_3<MesherVertexBase, MesherCellBase>>;
-using Complex = CGAL::Surface_mesh_complex_2_in_triangulation_3<Triangulation>;
-using OutputMesh = cgal::Mesh;
-
-// The triangles of the restricted Delaunay surface, in the triangulation's
-// own (deterministic) vertex order, oriented outward by CGAL (which handles
-// nested components), and sorted so the order never depends on addresses.
-absl::StatusOr<TriangleMesh> complex_to_mesh(const Complex& complex, const Triangulation& tr) {
-  namespace PMP = CGAL::Polygon_mesh_processing;
-  std::vector<std::array<Triangulation::Vertex_handle, 3>> facets;
-  for (auto f = tr.finite_facets_begin(); f != tr.finite_facets_end(); ++f) {
-    if (!complex.is_in_complex(*f)) continue;
-    const auto cell = f->first;
-    const int i = f->second;
-    facets.push_back({cell->vertex(tr.vertex_triple_index(i, 0)),
-                      cell->vertex(tr.vertex_triple_index(i, 1)),
-                      cell->vertex(tr.vertex_triple_index(i, 2))});
-  }
-  std::unordered_map<Triangulation::Vertex_handle, size_t> index;
-  for (const auto& facet : facets) {
-    for (auto v : facet) index.emplace(v, 0);
-  }
-  std::vector<Point> points;
-  for (auto v = tr.finite_vertices_begin(); v != tr.finite_vertices_end(); ++v) {
-    auto found = index.find(v);
-    if (found == index.end()) continue;
-    found->second = points.size();
-    points.push_back(v->point());
-  }
-  std::vector<std::array<size_t, 3>> triangles;
-  triangles.reserve(facets.size());
-  for (const auto& f : facets) triangles.push_back({index[f[0]], index[f[1]], index[f[2]]});
-  // CGAL duplicates a point only where the soup is not a manifold: with
-  // none duplicated it is a polygon mesh, and the second look at every
-  // polygon (0.1 s on the liver) is only needed when some were.
-  const bool manifold = PMP::orient_polygon_soup(points, triangles);
-  if (!manifold && !PMP::is_polygon_soup_a_polygon_mesh(triangles))
-    return absl::InternalError("poisson: the meshed surface is not a manifold");
-  OutputMesh mesh;
-  PMP::polygon_soup_to_polygon_mesh(points, triangles, mesh);
-  PMP::orient_to_bound_a_volume(mesh);
-  TriangleMesh result = cgal::from_surface_mesh(mesh);
-  for (auto& t : result.triangles)
-    std::rotate(t.begin(), std::min_element(t.begin(), t.end()), t.end());
-  std::sort(result.triangles.begin(), result.triangles.end());
-  return result;
-}
 
 absl::Status check_params(const PoissonParams& params) {
   if (!(params.min_angle_deg > 0 && params.min_angle_deg <= 30)) {
@@ -315,6 +234,13 @@ absl::StatusOr<TriangleMesh> mesh_zero_level(const SolvedFunction& function, con
   const double bisection_error = params.max_distance_mm / 20;
   ZeroLevel level{&function, Kernel::Sphere_3(inner, ball_radius * ball_radius),
                   bisection_error * bisection_error};
+  // The liver asks about one crossing search per input point, small thin
+  // shapes up to 25 (against a floor of 10,000); ten per point and 10,000
+  // more leave a sound function room and stop a runaway one within a second
+  // or two.
+  uint64_t crossings = 0;
+  level.crossings = &crossings;
+  level.max_crossings = 10 * (points.size() + 1000);
   // Seeds two voxels either side of the points (the surface is within about
   // one); too few for a start (a tiny piece) leave the mesher its own.
   const std::vector<Point> seeds =
@@ -327,13 +253,26 @@ absl::StatusOr<TriangleMesh> mesh_zero_level(const SolvedFunction& function, con
   auto mesh_level = [&] {
     CGAL::make_surface_mesh(complex, level, ZeroLevelOracle(), criteria, CGAL::Manifold_tag());
   };
+  bool budget_spent = false;
+  auto bounded_mesh_level = [&] {
+    try {
+      mesh_level();
+    } catch (const poisson::CrossingBudgetSpent&) {
+      budget_spent = true;
+    }
+  };
   if (beside_meshing) {
-    side_by_side(beside_meshing, mesh_level);
+    side_by_side(beside_meshing, bounded_mesh_level);
   } else {
-    mesh_level();
+    bounded_mesh_level();
   }
+  if (budget_spent)
+    return absl::InternalError(cat("poisson: the zero level needed more than ", level.max_crossings,
+                                   " crossing searches: far more detail than the sizing"));
   auto mesh = complex_to_mesh(complex, triangulation);
-  if (mesh.ok() && mesh->triangles.empty())
+  if (!mesh.ok())
+    return absl::InternalError(cat("poisson: ", std::string(mesh.status().message())));
+  if (mesh->triangles.empty())
     return absl::InternalError("poisson: meshing found no surface in the implicit function");
   return mesh;
 }
@@ -440,6 +379,9 @@ absl::StatusOr<TriangleMesh> reconstruct_poisson_surface(
     return reconstruct_whole(oriented, params, context, figures, beside_meshing);
   } catch (const Cancelled&) {
     return absl::CancelledError("the run was cancelled");
+  } catch (const std::exception& e) {
+    // CGAL's failed preconditions and assertions, bad_alloc.
+    return absl::InternalError(cat("poisson: ", e.what()));
   }
 }
 

@@ -114,6 +114,15 @@ double signed_volume(const TriangleMesh& mesh) {
   return six_volume / 6.0;
 }
 
+double surface_area(const TriangleMesh& mesh) {
+  double area = 0;
+  for (const auto& t : mesh.triangles) {
+    const auto &p0 = mesh.points[t[0]], &p1 = mesh.points[t[1]], &p2 = mesh.points[t[2]];
+    area += 0.5 * norm(cross(sub(p1, p0), sub(p2, p0)));
+  }
+  return area;
+}
+
 SurfaceStatistics compute_surface_statistics(const TriangleMesh& mesh) {
   SurfaceStatistics s;
   s.nodes = static_cast<uint32_t>(mesh.points.size());

@@ -44,4 +44,7 @@ bool is_oriented_manifold(const TriangleMesh& mesh);
 // Signed volume enclosed by the surface (divergence theorem), mm^3.
 double signed_volume(const TriangleMesh& mesh);
 
+// Sum of the triangles' areas, mm^2.
+double surface_area(const TriangleMesh& mesh);
+
 }  // namespace labelmesh::surface

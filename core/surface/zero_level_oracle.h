@@ -97,7 +97,16 @@ struct ZeroLevel {
   Kernel::Sphere_3 sphere;
   double squared_error;
   const std::vector<Point>* seeds = nullptr;
+  // Crossings searched so far, and the most allowed (0: no bound). A
+  // function whose zero level holds far more detail than the sizing (specks
+  // of a thin shape's function, say) would otherwise keep the mesher going
+  // for minutes.
+  uint64_t* crossings = nullptr;
+  uint64_t max_crossings = 0;
 };
+
+// Thrown by the oracle when a ZeroLevel's crossing budget is spent.
+struct CrossingBudgetSpent {};
 
 // The surface mesher's oracle (CGAL's SurfaceMeshTraits_3) for a ZeroLevel.
 // CGAL's Poisson oracle bisects each crossing segment until both ends share a
@@ -147,6 +156,9 @@ class ZeroLevelOracle {
     }
 
     static CGAL::Object crossing(const ZeroLevel& level, Point p1, Point p2) {
+      if (level.crossings != nullptr && ++*level.crossings > level.max_crossings &&
+          level.max_crossings != 0)
+        throw CrossingBudgetSpent{};
       const SolvedFunction& function = *level.function;
       double v1, v2;
       SolvedFunction::Cell_handle c1, c2;

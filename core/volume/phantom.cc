@@ -3,55 +3,13 @@
 #include <cmath>
 #include <numbers>
 
-#include <vtkImageData.h>
-#include <vtkPointData.h>
-#include <vtkUnsignedCharArray.h>
+#include "core/volume/phantom_grid.h"
+#include "core/volume/thin_shapes.h"
 
 namespace labelmesh::volume {
 namespace {
 
 using std::numbers::pi;
-
-// A grid of `dims` voxels whose centre sits at `centre`.
-ImageGeometry centred_grid(const std::array<int64_t, 3>& dims, const std::array<double, 3>& spacing,
-                           const std::array<double, 9>& direction,
-                           const std::array<double, 3>& centre) {
-  ImageGeometry g;
-  g.dims = dims;
-  g.spacing = spacing;
-  g.direction = direction;
-  g.origin = {0, 0, 0};
-  const auto middle =
-      g.to_physical({(dims[0] - 1) / 2.0, (dims[1] - 1) / 2.0, (dims[2] - 1) / 2.0});
-  for (int row = 0; row < 3; ++row) g.origin[row] = centre[row] - middle[row];
-  return g;
-}
-
-// Labels every voxel by `label_at(LPS point of its centre)`.
-template <typename F>
-LabelVolume rasterise(const ImageGeometry& geometry, F&& label_at) {
-  LabelVolume volume;
-  volume.format = ImageFormat::kNifti;
-  volume.file_voxel_type = "uint8";
-  volume.geometry = geometry;
-  auto labels = vtkSmartPointer<vtkUnsignedCharArray>::New();
-  labels->SetNumberOfTuples(geometry.voxel_count());
-  uint8_t* out = labels->GetPointer(0);
-  const auto& d = geometry.dims;
-  for (int64_t k = 0; k < d[2]; ++k) {
-    for (int64_t j = 0; j < d[1]; ++j) {
-      for (int64_t i = 0; i < d[0]; ++i) {
-        const auto p = geometry.to_physical({double(i), double(j), double(k)});
-        *out++ = static_cast<uint8_t>(label_at(p));
-      }
-    }
-  }
-  volume.voxels = vtkSmartPointer<vtkImageData>::New();
-  volume.voxels->SetDimensions(static_cast<int>(d[0]), static_cast<int>(d[1]),
-                               static_cast<int>(d[2]));
-  volume.voxels->GetPointData()->SetScalars(labels);
-  return volume;
-}
 
 constexpr std::array<double, 9> kIdentity{1, 0, 0, 0, 1, 0, 0, 0, 1};
 
@@ -82,16 +40,23 @@ std::optional<PhantomShape> phantom_shape_from_name(std::string_view name) {
   if (name == "torus") return PhantomShape::kTorus;
   if (name == "boxes") return PhantomShape::kTouchingBoxes;
   if (name == "oblique-ellipsoid") return PhantomShape::kObliqueEllipsoid;
+  if (name == "thin-shapes") return PhantomShape::kThinShapes;
+  if (name == "thin-shapes-anisotropic") return PhantomShape::kThinShapesAnisotropic;
   return std::nullopt;
 }
 
 const std::vector<std::string_view>& phantom_shape_names() {
-  static const std::vector<std::string_view> kNames{"sphere", "nested-spheres", "torus", "boxes",
-                                                    "oblique-ellipsoid"};
+  static const std::vector<std::string_view> kNames{
+      "sphere",      "nested-spheres",         "torus", "boxes", "oblique-ellipsoid",
+      "thin-shapes", "thin-shapes-anisotropic"};
   return kNames;
 }
 
 Phantom make_phantom(PhantomShape shape, double scale) {
+  if (shape == PhantomShape::kThinShapes)
+    return make_thin_shapes({3 * scale, 3 * scale, 3 * scale});
+  if (shape == PhantomShape::kThinShapesAnisotropic)
+    return make_thin_shapes({0.75 * scale, 0.75 * scale, 3 * scale});
   Phantom phantom;
   phantom.centre = kCentre;
   const auto& c = phantom.centre;
@@ -170,6 +135,9 @@ Phantom make_phantom(PhantomShape shape, double scale) {
       phantom.truth = {{1, 4.0 / 3.0 * pi * ax * ay * az, area}};
       break;
     }
+    case PhantomShape::kThinShapes:
+    case PhantomShape::kThinShapesAnisotropic:
+      break;
   }
   return phantom;
 }
