@@ -20,6 +20,7 @@ struct MeshCommandOptions {
   std::string out_dir;
   PipelineFlags pipeline;
   bool json = false;
+  unsigned threads = 0;
 };
 
 // "-" for a figure the stage does not measure.
@@ -89,6 +90,9 @@ CommandRunner add_mesh_command(CLI::App& app) {
       ->required();
   mesh->add_option("--out", options->out_dir, "Output directory (created if missing)")->required();
   add_pipeline_flags(*mesh, options->pipeline);
+  mesh->add_option("--threads", options->threads,
+                   "Labels meshed at once (0: one per core); the output is the same for any")
+      ->capture_default_str();
   mesh->add_flag("--json", options->json,
                  "Print report.json to stdout instead of progress and a table");
   mesh->footer(kExitCodeHelp);
@@ -100,6 +104,7 @@ CommandRunner add_mesh_command(CLI::App& app) {
       std::fprintf(stderr, "labelmesh mesh: %s\n", std::string(params.status().message()).c_str());
       return int{kExitUsage};
     }
+    params->threads = options->threads;
     TerminalProgress progress(!options->json);
     RunContext context;
     context.progress = [&progress](std::string_view stage, double fraction) {

@@ -118,6 +118,9 @@ struct MeshParams {
   volume_mesh::ImproveParams improve;
   // Volume mesh files (when `volume` is not kNone).
   std::vector<volume_mesh::VolumeFormat> volume_formats{volume_mesh::VolumeFormat::kVtu};
+  // Labels meshed at once (each label's own stages use up to two threads);
+  // 0: one per core. The output does not depend on it.
+  unsigned threads = 0;
   // Size limits applied to the input before anything is allocated.
   volume::ReadLimits limits;
 };

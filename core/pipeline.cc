@@ -1,8 +1,11 @@
 #include "core/pipeline.h"
 
 #include <algorithm>
+#include <atomic>
 #include <filesystem>
 #include <fstream>
+#include <mutex>
+#include <thread>
 
 #include "core/quality_surfaces.h"
 #include "core/report.h"
@@ -82,6 +85,82 @@ std::vector<LabelWarning> collect_warnings(const std::vector<SurfaceResult>& sur
     }
   }
   return warnings;
+}
+
+// How many labels are meshed at once: the params' budget, else every core.
+unsigned label_threads(const MeshParams& params, size_t labels) {
+  unsigned threads = params.threads > 0 ? params.threads : std::thread::hardware_concurrency();
+  return static_cast<unsigned>(std::clamp<size_t>(threads, 1, std::max<size_t>(labels, 1)));
+}
+
+// The quality surfaces of every label in `labels`, several labels at once
+// (label_threads). Each label's surfaces and stage times are kept apart and
+// joined in label order, so the result does not depend on the thread count.
+// A label whose stages fail gets that error and the others go on; a stop, a
+// bad option, or a failure of a label asked for by name ends the run.
+absl::Status add_label_surfaces(const volume::LabelVolume& volume, const VolumeSummary& input,
+                                const std::vector<int32_t>& labels, const MeshParams& params,
+                                const RunContext& context, std::vector<SurfaceResult>& surfaces,
+                                std::vector<StageTiming>& stages) {
+  std::array<double, 3> drawn_spacing;
+  for (int axis = 0; axis < 3; ++axis)
+    drawn_spacing[axis] = volume.geometry.spacing[axis] * input.repeated_planes[axis];
+  const size_t count = labels.size();
+  std::vector<std::vector<SurfaceResult>> label_surfaces(count);
+  std::vector<std::vector<StageTiming>> label_stages(count);
+  std::vector<absl::Status> label_status(count);
+  // Progress callbacks expect one caller at a time.
+  std::mutex progress_mutex;
+  RunContext shared = context;
+  if (context.progress) {
+    shared.progress = [&](std::string_view stage, double fraction) {
+      std::lock_guard<std::mutex> lock(progress_mutex);
+      context.progress(stage, fraction);
+    };
+  }
+  std::atomic<size_t> next{0};
+  std::atomic<bool> ended{false};
+  auto work = [&] {
+    for (size_t i; !ended.load() && (i = next.fetch_add(1)) < count;) {
+      const auto* statistics = input.statistics.find(labels[i]);
+      const auto& guard = params.guard;
+      const SurfaceTolerance tolerance =
+          tolerance_for(statistics->voxels, drawn_spacing, guard.volume_percent,
+                        guard.small_volume_percent, guard.hausdorff_mm);
+      absl::Status status;
+      try {
+        status = add_quality_surfaces(volume, *statistics, params, tolerance, shared,
+                                      label_surfaces[i], label_stages[i]);
+      } catch (const std::bad_alloc&) {
+        status = absl::ResourceExhaustedError(cat("label ", labels[i], ": out of memory"));
+      }
+      const bool label_error = !status.ok() && status.code() != absl::StatusCode::kCancelled &&
+                               status.code() != absl::StatusCode::kInvalidArgument &&
+                               params.labels.empty();
+      if (label_error) {
+        SurfaceResult failed;
+        failed.label = labels[i];
+        failed.stage = params.surface == SurfaceMethod::kPoisson ? "poisson" : "repaired";
+        failed.error = std::string(status.message());
+        label_surfaces[i] = {};
+        label_surfaces[i].push_back(std::move(failed));
+        status = absl::OkStatus();
+      }
+      label_status[i] = status;
+      if (!status.ok()) ended = true;
+    }
+  };
+  const unsigned threads = label_threads(params, count);
+  std::vector<std::thread> helpers;
+  for (unsigned t = 1; t < threads; ++t) helpers.emplace_back(work);
+  work();
+  for (auto& helper : helpers) helper.join();
+  for (size_t i = 0; i < count; ++i) {
+    if (!label_status[i].ok()) return label_status[i];
+    for (auto& surface : label_surfaces[i]) surfaces.push_back(std::move(surface));
+    for (const auto& stage : label_stages[i]) add_stage_time(stages, stage.name, stage.seconds);
+  }
+  return absl::OkStatus();
 }
 
 // TetGen on each label's output surface, then the improvement pass.
@@ -181,33 +260,12 @@ absl::StatusOr<MeshResult> run_pipeline(const std::string& path, const MeshParam
   result.stages.push_back({"surface_statistics", 0});
   std::vector<SurfaceResult> quality_surfaces;
   absl::Status quality_status;
-  std::array<double, 3> drawn_spacing;
-  for (int axis = 0; axis < 3; ++axis)
-    drawn_spacing[axis] = volume->geometry.spacing[axis] * result.input.repeated_planes[axis];
   if (!quality) {
     measure_marching_cubes();
   } else {
     side_by_side(measure_marching_cubes, [&] {
-      for (int32_t label : *labels) {
-        const auto* statistics = result.input.statistics.find(label);
-        const auto& guard = params.guard;
-        const SurfaceTolerance tolerance =
-            tolerance_for(statistics->voxels, drawn_spacing, guard.volume_percent,
-                          guard.small_volume_percent, guard.hausdorff_mm);
-        quality_status = add_quality_surfaces(*volume, *statistics, params, tolerance, context,
-                                              quality_surfaces, result.stages);
-        // One label's failure is that label's error; the others go on.
-        if (!quality_status.ok() && quality_status.code() != absl::StatusCode::kCancelled &&
-            quality_status.code() != absl::StatusCode::kInvalidArgument && params.labels.empty()) {
-          SurfaceResult failed;
-          failed.label = label;
-          failed.stage = params.surface == SurfaceMethod::kPoisson ? "poisson" : "repaired";
-          failed.error = std::string(quality_status.message());
-          quality_surfaces.push_back(std::move(failed));
-          quality_status = absl::OkStatus();
-        }
-        if (!quality_status.ok()) return;
-      }
+      quality_status = add_label_surfaces(*volume, result.input, *labels, params, context,
+                                          quality_surfaces, result.stages);
     });
   }
   add_stage_time(result.stages, "surface_statistics", statistics_stage.front().seconds);

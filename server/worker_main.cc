@@ -1,8 +1,10 @@
 // `labelmeshd --worker JOB_DIR`: one job, run with the core library, its
 // events sent to the parent labelmeshd over file descriptor 3. The server
 // kills it to stop it.
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <new>
 
@@ -84,6 +86,10 @@ absl::Status run_job(const std::string& job_dir, int fd) {
   }
   auto params = params_from_options(record.spec().options());
   if (!params.ok()) return params.status();
+  // The server's share of the cores for each worker (kJobThreadsVariable).
+  if (const char* threads = std::getenv(kJobThreadsVariable)) {
+    params->threads = static_cast<unsigned>(std::clamp(std::atoi(threads), 1, 256));
+  }
   StageEvents events(fd);
   RunContext context;
   context.progress = [&events](std::string_view stage, double fraction) {

@@ -1,5 +1,8 @@
 #include "server/worker_pool.h"
 
+#include <algorithm>
+#include <thread>
+
 #include <unistd.h>
 
 #include "absl/strings/str_cat.h"
@@ -46,6 +49,9 @@ void WorkerPool::run_job(const v1::JobRecord& record) {
   run.job_dir = spool_.job_dir(id);
   run.log_path = spool_.worker_log(id);
   run.limits.memory_bytes = config_.worker_memory_bytes;
+  // Each worker meshes its labels on its share of the cores.
+  run.limits.threads = std::max(1u, std::thread::hardware_concurrency() /
+                                        static_cast<unsigned>(std::max(config_.workers, 1)));
   run.limits.cpu_seconds =
       config_.worker_cpu_seconds > 0
           ? config_.worker_cpu_seconds

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "absl/status/status.h"
+#include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 #include "server/event_pipe.h"
 
@@ -26,6 +27,8 @@ struct ChildSetup {
   int log_fd;
   int null_fd;
   WorkerLimits limits;
+  // The server's environment, plus the worker's thread budget.
+  char* const* environment;
 };
 
 // Between fork and exec only async-signal-safe calls are allowed.
@@ -51,7 +54,7 @@ struct ChildSetup {
   dup2(setup.event_write_fd, kChildEventFd);
   // Nothing of the server's (sockets, other jobs' pipes) reaches the child.
   close_range(kChildEventFd + 1, ~0U, 0);
-  execv(argv[0], argv);
+  execve(argv[0], argv, setup.environment);
   _exit(127);
 }
 
@@ -114,7 +117,18 @@ WorkerOutcome run_worker_process(const WorkerRun& run) {
   std::string executable = run.executable, job_dir = run.job_dir;
   std::string mode = kWorkerMode;
   std::vector<char*> argv{executable.data(), mode.data(), job_dir.data(), nullptr};
-  const ChildSetup setup{pipe_fds[1], log_fd >= 0 ? log_fd : null_fd, null_fd, run.limits};
+  // Built before fork: the child may only make async-signal-safe calls.
+  std::vector<std::string> variables;
+  for (char** v = environ; *v != nullptr; ++v) {
+    if (!absl::StartsWith(*v, absl::StrCat(kJobThreadsVariable, "="))) variables.emplace_back(*v);
+  }
+  if (run.limits.threads > 0)
+    variables.push_back(absl::StrCat(kJobThreadsVariable, "=", run.limits.threads));
+  std::vector<char*> environment;
+  for (auto& variable : variables) environment.push_back(variable.data());
+  environment.push_back(nullptr);
+  const ChildSetup setup{pipe_fds[1], log_fd >= 0 ? log_fd : null_fd, null_fd, run.limits,
+                         environment.data()};
 
   const pid_t pid = fork();
   if (pid == 0) exec_child(setup, argv.data());

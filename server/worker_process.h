@@ -13,7 +13,13 @@
 
 namespace labelmesh::server {
 
+// The environment variable that tells a worker how many labels to mesh at
+// once: the server's cores divided among its workers.
+inline constexpr char kJobThreadsVariable[] = "LABELMESH_JOB_THREADS";
+
 struct WorkerLimits {
+  // Labels meshed at once; 0: the worker's default (every core).
+  unsigned threads = 0;
   // Address space, bytes; 0 for none.
   uint64_t memory_bytes = 0;
   // CPU time, seconds; 0 for none.

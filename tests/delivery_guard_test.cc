@@ -143,6 +143,28 @@ TEST(DeliveryGuard, WithoutFallBackASurfaceOutsideToleranceIsWarnedNotHidden) {
   EXPECT_NE(warning->reason.find("outside tolerance"), std::string::npos) << warning->reason;
 }
 
+TEST(DeliveryGuard, LabelsInParallelGiveTheSameSurfacesAsOneAtATime) {
+  const auto path = phantom_file(PhantomShape::kThinShapes, "thin-threads.nii.gz");
+  MeshParams one, four;
+  one.threads = 1;
+  four.threads = 4;
+  auto serial = run_pipeline(path, one, RunContext{});
+  auto parallel = run_pipeline(path, four, RunContext{});
+  ASSERT_TRUE(serial.ok() && parallel.ok());
+  ASSERT_EQ(serial->surfaces.size(), parallel->surfaces.size());
+  for (size_t i = 0; i < serial->surfaces.size(); ++i) {
+    const auto& a = serial->surfaces[i];
+    const auto& b = parallel->surfaces[i];
+    EXPECT_EQ(a.label, b.label);
+    EXPECT_EQ(a.stage, b.stage);
+    EXPECT_EQ(a.mesh.points, b.mesh.points) << "label " << a.label;
+    EXPECT_EQ(a.mesh.triangles, b.mesh.triangles) << "label " << a.label;
+  }
+  ASSERT_EQ(serial->warnings.size(), parallel->warnings.size());
+  for (size_t i = 0; i < serial->warnings.size(); ++i)
+    EXPECT_EQ(serial->warnings[i].reason, parallel->warnings[i].reason);
+}
+
 TEST(DeliveryGuard, TolerancesFollowLabelSizeAndDrawnSpacing) {
   const auto small = tolerance_for(999, {0.6, 0.6, 2.0}, 3, 10, 0);
   EXPECT_DOUBLE_EQ(small.volume_fraction, 0.10);
