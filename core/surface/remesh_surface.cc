@@ -5,6 +5,8 @@
 
 #include <cmath>
 #include <cstdint>
+#include <memory>
+#include <unordered_map>
 #include <vector>
 
 #include <CGAL/Implicit_surface_3.h>
@@ -32,26 +34,43 @@ struct Stopped {};
 // Thrown when the mesher has asked more inside tests than its budget.
 struct BudgetSpent {};
 
+// Hash of a point's exact coordinates.
+struct PointHash {
+  size_t operator()(const Point& p) const {
+    size_t h = 0;
+    for (int i = 0; i < 3; ++i) h = h * 0x9E3779B97F4A7C15ull ^ std::hash<double>()(p[i]);
+    return h;
+  }
+};
+
 // -1 inside (or on) the surface, +1 outside; polls for a stop every 4,096
-// calls. A thin sheet can keep the mesher refining without end, so the calls
-// are bounded.
+// tests. The mesher asks about the same Voronoi vertices again and again (an
+// end of every dual edge it tests), so answers are remembered. A thin sheet
+// can keep the mesher refining without end, so the tests are bounded.
 class InsideFunction {
  public:
-  InsideFunction(const Inside* inside, const RunContext* context, uint64_t max_calls)
-      : inside_(inside), context_(context), max_calls_(max_calls) {}
+  InsideFunction(const Inside* inside, const RunContext* context, uint64_t max_tests)
+      : inside_(inside), context_(context), max_tests_(max_tests) {}
   double operator()(const Point& p) const {
-    const uint64_t calls = ++*calls_;
-    if ((calls & 4095) == 0 && context_->stop_requested()) throw Stopped{};
-    if (calls > max_calls_) throw BudgetSpent{};
-    return (*inside_)(p) == CGAL::ON_UNBOUNDED_SIDE ? 1.0 : -1.0;
+    auto [at, added] = state_->answers.try_emplace(p, 0.0);
+    if (!added) return at->second;
+    const uint64_t tests = ++state_->tests;
+    if ((tests & 4095) == 0 && context_->stop_requested()) throw Stopped{};
+    if (tests > max_tests_) throw BudgetSpent{};
+    at->second = (*inside_)(p) == CGAL::ON_UNBOUNDED_SIDE ? 1.0 : -1.0;
+    return at->second;
   }
 
  private:
+  struct State {
+    uint64_t tests = 0;
+    std::unordered_map<Point, double, PointHash> answers;
+  };
   const Inside* inside_;
   const RunContext* context_;
-  uint64_t max_calls_;
-  // std::function copies the functor; the count is shared.
-  std::shared_ptr<uint64_t> calls_ = std::make_shared<uint64_t>(0);
+  uint64_t max_tests_;
+  // std::function copies the functor; the answers are shared.
+  std::shared_ptr<State> state_ = std::make_shared<State>();
 };
 
 absl::Status check_params(const RemeshParams& params) {
