@@ -129,9 +129,10 @@ absl::StatusOr<TriangleMesh> remesh_surface(const TriangleMesh& surface, const R
     // to the radius).
     const double relative_error = params.max_distance_mm / 20 / radius;
     CGAL::Implicit_surface_3<MesherTraits, InsideFunction> implicit(
-        // About 20 tests a bisected crossing, a few crossings a vertex: 400
-        // tests per input point (and 400,000 more) leave a closed organ room.
-        InsideFunction(&inside, &context, 400 * (surface.points.size() + 1000)),
+        // TotalSegmentator's organs and bones take up to 40 tests per input
+        // point; 150 (and 150,000 more) leave them room and stop a mesher
+        // that does not settle within seconds.
+        InsideFunction(&inside, &context, 150 * (surface.points.size() + 1000)),
         MesherTraits::Sphere_3(*inner, radius * radius), relative_error);
     // The mesher starts from the surface's own points, thinned to half an
     // edge apart, so every component is found however small.
