@@ -348,6 +348,33 @@ TEST_F(MeshingServiceTest, JobOverTheDeadlineFailsWithDeadlineExceeded) {
   EXPECT_LT(job.finished_at() - job.started_at(), 2.5);
 }
 
+// A strict job on a volume with labels too small to mesh fails with the
+// reason; without strict the same job succeeds and its report lists them.
+TEST_F(MeshingServiceTest, StrictJobWithALabelNotDeliveredFails) {
+  ServiceHarness service(config_);
+  const fs::path input = write_phantom(dir_, volume::PhantomShape::kThinShapes);
+  v1::MeshOptions options = repaired_options();
+  options.set_strict(true);
+  v1::SubmitReply reply;
+  ASSERT_TRUE(service.submit(input, options, &reply).ok());
+  auto events = service.watch(reply.job_id());
+  ASSERT_TRUE(events.back().has_failed()) << events.back().DebugString();
+  EXPECT_EQ(events.back().failed().code(), int(grpc::StatusCode::FAILED_PRECONDITION));
+  EXPECT_NE(events.back().failed().message().find("strict"), std::string::npos)
+      << events.back().failed().message();
+
+  options.set_strict(false);
+  ASSERT_TRUE(service.submit(input, options, &reply).ok());
+  events = service.watch(reply.job_id());
+  ASSERT_TRUE(events.back().has_finished()) << events.back().DebugString();
+  const auto& report = events.back().finished().report();
+  ASSERT_GE(report.warnings_size(), 2);
+  bool single_voxel_warned = false;
+  for (const auto& warning : report.warnings())
+    single_voxel_warned = single_voxel_warned || warning.label() == 9;
+  EXPECT_TRUE(single_voxel_warned);
+}
+
 // A worker that sends its result and then lingers past the deadline (a
 // scripted stand-in for one slow to exit): the result it sent stands.
 TEST_F(MeshingServiceTest, AResultSentBeforeTheDeadlineStands) {
