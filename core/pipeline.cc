@@ -5,6 +5,8 @@
 #include <filesystem>
 #include <fstream>
 #include <mutex>
+#include <numeric>
+#include <shared_mutex>
 #include <thread>
 
 #include "core/quality_surfaces.h"
@@ -87,6 +89,9 @@ std::vector<LabelWarning> collect_warnings(const std::vector<SurfaceResult>& sur
   return warnings;
 }
 
+// Labels with at least this many voxels are meshed one at a time.
+constexpr uint64_t kLargeLabelVoxels = 100'000;
+
 // How many labels are meshed at once: the params' budget, else every core.
 unsigned label_threads(const MeshParams& params, size_t labels) {
   unsigned threads = params.threads > 0 ? params.threads : std::thread::hardware_concurrency();
@@ -118,10 +123,28 @@ absl::Status add_label_surfaces(const volume::LabelVolume& volume, const VolumeS
       context.progress(stage, fraction);
     };
   }
+  // Large labels first, each alone (their Poisson solve already uses both
+  // cores, and two at once would double the peak memory), then the rest side
+  // by side.
+  std::vector<size_t> order(count);
+  std::iota(order.begin(), order.end(), 0);
+  auto is_large = [&](size_t i) {
+    return input.statistics.find(labels[i])->voxels >= kLargeLabelVoxels;
+  };
+  std::stable_partition(order.begin(), order.end(), is_large);
+  std::shared_mutex room;
   std::atomic<size_t> next{0};
   std::atomic<bool> ended{false};
   auto work = [&] {
-    for (size_t i; !ended.load() && (i = next.fetch_add(1)) < count;) {
+    for (size_t n; !ended.load() && (n = next.fetch_add(1)) < count;) {
+      const size_t i = order[n];
+      std::unique_lock<std::shared_mutex> alone(room, std::defer_lock);
+      std::shared_lock<std::shared_mutex> together(room, std::defer_lock);
+      if (is_large(i)) {
+        alone.lock();
+      } else {
+        together.lock();
+      }
       const auto* statistics = input.statistics.find(labels[i]);
       const auto& guard = params.guard;
       const SurfaceTolerance tolerance =
