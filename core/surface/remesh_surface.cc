@@ -3,6 +3,7 @@
 // bisection. Its own translation unit: the mesher's headers are slow to compile.
 #include "core/surface/remesh_surface.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <memory>
@@ -28,6 +29,13 @@ using restricted_delaunay::MesherTraits;
 using restricted_delaunay::Triangulation;
 using Point = cgal::Point;
 using Inside = CGAL::Side_of_triangle_mesh<cgal::Mesh, cgal::Kernel>;
+
+// The most inside tests one remeshing may make, and the largest surface it
+// takes: ray parity costs 2-3 us a test on an organ of a few thousand
+// triangles but 30 us on the brain's folded white matter (2 M tests took a
+// minute there), so large surfaces are left to the other attempts.
+constexpr uint64_t kMaxTests = 1'000'000;
+constexpr size_t kMaxPoints = 60'000;
 
 // Thrown from the inside test when the run is asked to stop.
 struct Stopped {};
@@ -111,6 +119,10 @@ std::optional<Point> inner_point(const TriangleMesh& surface, const Inside& insi
 absl::StatusOr<TriangleMesh> remesh_surface(const TriangleMesh& surface, const RemeshParams& params,
                                             const RunContext& context) {
   if (auto s = check_params(params); !s.ok()) return s;
+  if (surface.points.size() > kMaxPoints)
+    return absl::FailedPreconditionError(cat("remesh: the surface has ", surface.points.size(),
+                                             " points, more than the ", kMaxPoints,
+                                             " remeshing takes"));
   auto mesh = cgal::to_surface_mesh(surface);
   if (!mesh || mesh->is_empty() || !CGAL::is_closed(*mesh))
     return absl::InvalidArgumentError("remesh: the surface is not a closed 2-manifold");
@@ -131,8 +143,11 @@ absl::StatusOr<TriangleMesh> remesh_surface(const TriangleMesh& surface, const R
     CGAL::Implicit_surface_3<MesherTraits, InsideFunction> implicit(
         // TotalSegmentator's organs and bones take up to 40 tests per input
         // point; 150 (and 150,000 more) leave them room and stop a mesher
-        // that does not settle within seconds.
-        InsideFunction(&inside, &context, 150 * (surface.points.size() + 1000)),
+        // that does not settle within seconds. Never more than kMaxTests: a
+        // large folded surface (the brain's white matter) would otherwise
+        // take minutes and gigabytes of remembered answers.
+        InsideFunction(&inside, &context,
+                       std::min<uint64_t>(150 * (surface.points.size() + 1000), kMaxTests)),
         MesherTraits::Sphere_3(*inner, radius * radius), relative_error);
     // The mesher starts from the surface's own points, thinned to half an
     // edge apart, so every component is found however small.

@@ -24,8 +24,10 @@ struct RemeshParams {
 // The remeshed surface: closed, 2-manifold, outward; the same input always
 // gives the same mesh. `surface` must be closed and oriented (each component
 // bounds a volume, nested ones allowed). Errors: INVALID_ARGUMENT for bad
-// parameters or a surface that is not closed, INTERNAL when the mesher's
-// result is not a manifold, CANCELLED.
+// parameters or a surface that is not closed, FAILED_PRECONDITION for a
+// surface of more than 60,000 points, INTERNAL when the mesher's result is not
+// a manifold or it does not settle within a bounded number of inside tests,
+// CANCELLED.
 absl::StatusOr<TriangleMesh> remesh_surface(const TriangleMesh& surface, const RemeshParams& params,
                                             const RunContext& context);
 
