@@ -45,7 +45,7 @@ void add_pipeline_flags(CLI::App& command, PipelineFlags& flags) {
       ->check(CLI::NonNegativeNumber);
   command.add_flag("--no-adapt-to-thickness", flags.no_adapt_to_thickness,
                    "Keep the same sizing for thin components (by default each component's edges "
-                   "are no longer than its thickness, 3 x volume / area)");
+                   "are at most half its thickness, 3 x volume / area)");
   command.add_option("--label-sizing", flags.label_sizing,
                      "Per-label sizing LABEL:EDGE_MM[:DISTANCE_MM], e.g. 114:2:0.2; repeatable");
   auto& guard = flags.guard;

@@ -54,8 +54,9 @@ absl::StatusOr<std::vector<int32_t>> choose_labels(const std::string& path,
   return labels;
 }
 
-// One warning per label delivered outside its tolerance, not at all, or with
-// much of it left out as small components and strands.
+// One warning per label delivered outside its tolerance or not at all (its
+// stages failed, or nothing was left once small components and strands were
+// dropped).
 std::vector<LabelWarning> collect_warnings(const std::vector<SurfaceResult>& surfaces,
                                            const MeshParams& params) {
   std::vector<LabelWarning> warnings;

@@ -1,7 +1,6 @@
 #include "core/quality_surfaces.h"
 
 #include <algorithm>
-#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <memory>
@@ -183,11 +182,14 @@ surface::PoissonParams poisson_params(const PoissonOptions& options, double voxe
   return params;
 }
 
-// The figures of `mesh` against the label's Marching Cubes surface.
-void measure_attempt(const TriangleMesh& mesh, const surface::DistanceReference& reference,
-                     double marching_cubes_volume, const SurfaceTolerance& tolerance,
-                     const RunContext& context, SurfaceAttempt& attempt) {
-  const auto statistics = surface::compute_surface_statistics(mesh);
+// The figures of `mesh` against the label's Marching Cubes surface; returns
+// the mesh's own statistics, which become the output's when it is delivered.
+surface::SurfaceStatistics measure_attempt(const TriangleMesh& mesh,
+                                           const surface::DistanceReference& reference,
+                                           double marching_cubes_volume,
+                                           const SurfaceTolerance& tolerance,
+                                           const RunContext& context, SurfaceAttempt& attempt) {
+  auto statistics = surface::compute_surface_statistics(mesh);
   const auto distance = surface::surface_distance(mesh, reference, context);
   attempt.volume_change =
       marching_cubes_volume > 0 ? statistics.volume_mm3 / marching_cubes_volume - 1 : 0;
@@ -197,6 +199,7 @@ void measure_attempt(const TriangleMesh& mesh, const surface::DistanceReference&
   attempt.min_angle_deg = statistics.min_angle_deg;
   attempt.max_angle_deg = statistics.max_angle_deg;
   attempt.within_tolerance = is_within(attempt, tolerance);
+  return statistics;
 }
 
 }  // namespace
@@ -289,14 +292,15 @@ absl::Status add_quality_surfaces(const volume::LabelVolume& volume,
     // smooths the pieces for Poisson (liver: 0.2 s beside 0.2 s).
     if (prepared.ok()) side_by_side(measure_repaired, smooth);
   } else {
+    // Without Poisson the repaired surface is the output, measured below
+    // as the guard's one attempt.
     side_by_side(build_reference, repair);
-    if (prepared.ok()) measure_repaired();
   }
   add_stage_time(stages, "surface_statistics", statistics_seconds);
   if (!prepared.ok()) return prepared;
-  // The repaired surface is only an intermediate when Poisson follows: its
-  // figures stay in the report, its triangles need not stay in memory.
-  if (to_poisson) repaired.mesh = {};
+  // The pieces hold the repaired surface; its figures stay in the report,
+  // the joined copy need not stay in memory.
+  repaired.mesh = {};
 
   // Each component's thickness, from its repaired surface.
   std::vector<double> thickness;
@@ -304,8 +308,13 @@ absl::Status add_quality_surfaces(const volume::LabelVolume& volume,
   SurfaceFidelity fidelity;
   fidelity.tolerance = tolerance;
   fidelity.marching_cubes_volume_mm3 = marching_cubes_volume;
-  std::vector<TriangleMesh> candidates;
-  // Builds and measures one attempt; `build(i, sizing, mesh)` makes piece i.
+  // Each attempt's surface and statistics, to deliver whichever is chosen.
+  struct Candidate {
+    TriangleMesh mesh;
+    surface::SurfaceStatistics statistics;
+  };
+  std::vector<Candidate> candidates;
+  // Builds and measures one attempt; `build(i, sizing)` makes piece i.
   auto try_surface =
       [&](std::string method, double refine,
           const std::function<absl::StatusOr<TriangleMesh>(size_t, const Sizing&)>& build)
@@ -328,16 +337,21 @@ absl::Status add_quality_surfaces(const volume::LabelVolume& volume,
     }
     if (auto s = context.check_stop(); !s.ok()) return s;
     build_reference();
+    surface::SurfaceStatistics statistics;
     if (attempt.error.empty()) {
       StageTimer timer(stages, "surface_distance");
       context.report("surface_distance", 0);
-      measure_attempt(mesh, *marching_cubes_reference, marching_cubes_volume, tolerance, context,
-                      attempt);
+      statistics = measure_attempt(mesh, *marching_cubes_reference, marching_cubes_volume,
+                                   tolerance, context, attempt);
     }
     if (auto s = context.check_stop(); !s.ok()) return s;
     fidelity.attempts.push_back(std::move(attempt));
-    candidates.push_back(std::move(mesh));
+    candidates.push_back({std::move(mesh), statistics});
     return absl::OkStatus();
+  };
+  // The repaired pieces as they are.
+  auto repaired_piece = [&](size_t i, const Sizing&) -> absl::StatusOr<TriangleMesh> {
+    return pieces->meshes[i];
   };
   auto delivered = [&] {
     return !fidelity.attempts.empty() && fidelity.attempts.back().within_tolerance;
@@ -399,21 +413,11 @@ absl::Status add_quality_surfaces(const volume::LabelVolume& volume,
     const bool none_built = std::none_of(fidelity.attempts.begin(), fidelity.attempts.end(),
                                          [](const SurfaceAttempt& a) { return a.error.empty(); });
     if (fall_back && none_built) {
-      if (auto s = try_surface("repaired", 1,
-                               [&](size_t i, const Sizing&) -> absl::StatusOr<TriangleMesh> {
-                                 return pieces->meshes[i];
-                               });
-          !s.ok())
-        return s;
+      if (auto s = try_surface("repaired", 1, repaired_piece); !s.ok()) return s;
     }
   } else {
     // The repaired surface is the output: measured, not rebuilt.
-    if (auto s = try_surface("repaired", 1,
-                             [&](size_t i, const Sizing&) -> absl::StatusOr<TriangleMesh> {
-                               return pieces->meshes[i];
-                             });
-        !s.ok())
-      return s;
+    if (auto s = try_surface("repaired", 1, repaired_piece); !s.ok()) return s;
   }
   // The first attempt within the tolerance, else the one least outside it.
   fidelity.delivered = fidelity.attempts.size() - 1;
@@ -425,28 +429,26 @@ absl::Status add_quality_surfaces(const volume::LabelVolume& volume,
     }
   }
   const SurfaceAttempt& chosen = fidelity.attempts[fidelity.delivered];
+  // With Poisson the repaired stage is listed before the output; without,
+  // the output is the repaired surface itself.
+  if (!to_poisson) output.repair = repaired.repair;
   if (!chosen.error.empty()) {
     // Nothing could be built: the label's error, and the run goes on.
     output.stage = to_poisson ? "poisson" : "repaired";
     output.error = chosen.error;
     output.fidelity = std::move(fidelity);
-    surfaces.push_back(std::move(repaired));
+    if (to_poisson) surfaces.push_back(std::move(repaired));
     surfaces.push_back(std::move(output));
     return absl::OkStatus();
   }
   output.stage = chosen.method;
-  output.mesh = std::move(candidates[fidelity.delivered]);
+  output.mesh = std::move(candidates[fidelity.delivered].mesh);
+  output.statistics = candidates[fidelity.delivered].statistics;
   output.distance_to_marching_cubes =
       surface::SurfaceDistance{chosen.hausdorff_mm, chosen.mean_distance_mm, chosen.hausdorff_at};
   output.fidelity = std::move(fidelity);
   candidates.clear();
   output.is_output = true;
-  if (to_poisson) {
-    StageTimer timer(stages, "surface_statistics");
-    output.statistics = surface::compute_surface_statistics(output.mesh);
-  } else {
-    output.statistics = repaired.statistics;
-  }
   {
     StageTimer timer(stages, "self_intersections");
     context.report("self_intersections", 0);
@@ -454,15 +456,8 @@ absl::Status add_quality_surfaces(const volume::LabelVolume& volume,
     context.report("self_intersections", 1);
   }
   add_stage_time(stages, "surface_distance", reference_seconds);
-  if (to_poisson) {
-    surfaces.push_back(std::move(repaired));
-    surfaces.push_back(std::move(output));
-  } else {
-    // The repaired surface is the output itself.
-    output.stage = "repaired";
-    output.repair = repaired.repair;
-    surfaces.push_back(std::move(output));
-  }
+  if (to_poisson) surfaces.push_back(std::move(repaired));
+  surfaces.push_back(std::move(output));
   return absl::OkStatus();
 }
 
