@@ -87,8 +87,8 @@ enum class VolumeMethod {
 
 // The guard on what is delivered: each label's output surface is compared
 // with its Marching Cubes surface; outside the tolerance it is rebuilt finer,
-// then replaced by a remeshed Marching Cubes surface, and what is delivered
-// outside it anyway is listed in the report's warnings.
+// then replaced by the label's smoothed voxel mask meshed at one half, and
+// what is delivered outside it anyway is listed in the report's warnings.
 struct GuardOptions {
   // Largest |volume change|, percent of the Marching Cubes volume, for labels
   // of at least kSmallLabelVoxels voxels, and for smaller ones.

@@ -51,8 +51,8 @@ struct ComponentCounts {
 struct SurfaceResult {
   int32_t label = 0;
   // Stage that produced the surface: "marching_cubes", "repaired", or the
-  // delivery guard's method ("poisson", "poisson_refined", "remeshed_smoothed",
-  // "remeshed").
+  // delivery guard's method ("poisson", "poisson_refined", "mask",
+  // "mask_refined").
   std::string stage;
   // True for the stage whose surface is the run's output.
   bool is_output = false;

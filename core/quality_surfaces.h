@@ -23,7 +23,8 @@ double voxel_size_mm(const volume::ImageGeometry& geometry);
 // the delivered one; the last appended is marked as the output. The delivery
 // guard measures each surface it builds against the label's Marching Cubes
 // surface (volume, distances) and, outside `tolerance`, tries a finer Poisson
-// surface, then the smoothed and the plain repaired surface remeshed, and
+// surface, then the label's smoothed voxel mask meshed at one half (at the
+// label's sizing, then at half of it), and
 // delivers the first within it or else the one least outside it; what it
 // tried is in the output's `fidelity`. When no attempt could be built, the
 // output carries the `error` and no surface. When every component is under

@@ -33,8 +33,8 @@ except OSError:
 outputs = [s for s in report["surfaces"] if s.get("output")]
 labels = len(report["input"]["labels"])
 within = sum(1 for s in outputs if s["fidelity"]["within_tolerance"])
-poisson = sum(1 for s in outputs if s["stage"] == "poisson")
-fellback = sum(1 for s in outputs if s["stage"] != "poisson")
+poisson = sum(1 for s in outputs if s["stage"].startswith("poisson"))
+fellback = len(outputs) - poisson
 warned = len(report.get("warnings", []))
 print(f"{name:45s} {labels:6d} {within:7d} {poisson:7d} {fellback:8d} {warned:7d} "
       f"{seconds:>8s} {int(kib) // 1024:9d}")

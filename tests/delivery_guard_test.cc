@@ -1,5 +1,5 @@
 // The delivery guard on thin and small shapes: no crash, every label either
-// delivered within its tolerance (Poisson or a remeshed fallback with 30
+// delivered within its tolerance (Poisson or the meshed voxel mask, with 30
 // degree angles) or named in the warnings; --strict turns warnings into a
 // failure.
 #include <gtest/gtest.h>
@@ -9,11 +9,14 @@
 #include <string>
 
 #include "core/pipeline.h"
+#include "core/surface/component_field.h"
 #include "core/surface/extract_surfaces.h"
-#include "core/surface/remesh_surface.h"
+#include "core/surface/level_set_surface.h"
 #include "core/surface/surface_checks.h"
 #include "core/surface/surface_statistics.h"
 #include "core/surface_fidelity.h"
+#include "core/volume/label_components.h"
+#include "core/volume/label_statistics.h"
 #include "core/volume/phantom.h"
 #include "core/volume/thin_shapes.h"
 #include "core/volume/write_label_volume.h"
@@ -183,41 +186,117 @@ TEST(DeliveryGuard, TolerancesFollowLabelSizeAndDrawnSpacing) {
   EXPECT_TRUE(std::isinf(excess_over(attempt, small)));
 }
 
-TEST(RemeshSurface, KeepsAStaircaseSphereWithThirtyDegreeAngles) {
+TEST(LevelSetSurface, MeshesASphereMaskWithThirtyDegreeAnglesCloseToItsVoxels) {
   const auto phantom = make_phantom(PhantomShape::kSphere);
-  auto stats = volume::compute_label_statistics(phantom.volume);
-  auto surfaces = surface::extract_surfaces(phantom.volume, stats, {1}, RunContext{});
-  ASSERT_TRUE(surfaces.ok());
-  const auto& staircase = surfaces->front().mesh;
-  surface::RemeshParams params;
+  const auto statistics = volume::compute_label_statistics(phantom.volume);
+  auto components = volume::find_label_components(phantom.volume, *statistics.find(1),
+                                                  volume::ComponentOptions{}, RunContext{});
+  ASSERT_TRUE(components.ok());
+  ASSERT_EQ(components->components.size(), 1u);
+  auto marching_cubes =
+      surface::extract_component_surfaces(*components, {1}, phantom.volume.geometry, RunContext{});
+  ASSERT_TRUE(marching_cubes.ok());
+  const auto& staircase = marching_cubes->front();
+  auto field = surface::component_field(*components, 1, phantom.volume.geometry, 0.4);
+  ASSERT_TRUE(field.ok()) << field.status();
+  surface::LevelSetParams params;
   params.max_edge_mm = 3;
   params.max_distance_mm = 0.1;
-  auto remeshed = surface::remesh_surface(staircase, params, RunContext{});
-  ASSERT_TRUE(remeshed.ok()) << remeshed.status();
-  const auto s = surface::compute_surface_statistics(*remeshed);
+  auto mesh = surface::mesh_level_set(*field, params, staircase.points, RunContext{});
+  ASSERT_TRUE(mesh.ok()) << mesh.status();
+  const auto s = surface::compute_surface_statistics(*mesh);
   EXPECT_TRUE(s.closed);
   EXPECT_TRUE(s.manifold);
   EXPECT_EQ(s.euler_characteristic, 2);
   EXPECT_GE(s.min_angle_deg, 29.99);
-  const double staircase_volume = surface::signed_volume(staircase);
-  EXPECT_NEAR(s.volume_mm3 / staircase_volume, 1.0, 0.01);
-  const auto distance = surface::surface_distance(*remeshed, staircase, 0.5);
-  // Within about a voxel's corner of the staircase everywhere.
+  EXPECT_NEAR(s.volume_mm3 / surface::signed_volume(staircase), 1.0, 0.01);
+  const auto distance = surface::surface_distance(*mesh, staircase, 0.5);
+  // Within a voxel's corner of the staircase everywhere, and far closer on
+  // average.
   EXPECT_LT(distance.hausdorff_mm, 1.0);
   EXPECT_LT(distance.mean_mm, 0.2);
 }
 
-TEST(RemeshSurface, RefusesAnOpenSurfaceAndBadSizes) {
-  surface::TriangleMesh open;
-  open.points = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
-  open.triangles = {{0, 1, 2}};
-  surface::RemeshParams params;
+// A ball's signed distance sampled on an anisotropic, rotated and mirrored
+// grid: the meshed level set lies on the ball wherever the grid puts it.
+TEST(LevelSetSurface, PlacesTheSurfaceThroughTheGridsPlacement) {
+  surface::ScalarGrid grid;
+  grid.dims = {40, 30, 16};
+  grid.origin = {-20, 35, 7};
+  // Axis 0 along -y (0.8 mm), axis 1 along x (1.1 mm), axis 2 along z (2.5 mm).
+  grid.index_to_mm = {0, 1.1, 0, -0.8, 0, 0, 0, 0, 2.5};
+  const std::array<double, 3> centre{-4, 20, 26};
+  const double radius = 9;
+  grid.values.resize(size_t(40 * 30 * 16));
+  size_t at = 0;
+  for (int k = 0; k < 16; ++k) {
+    for (int j = 0; j < 30; ++j) {
+      for (int i = 0; i < 40; ++i, ++at) {
+        const std::array<double, 3> p{grid.origin[0] + 1.1 * j, grid.origin[1] - 0.8 * i,
+                                      grid.origin[2] + 2.5 * k};
+        grid.values[at] =
+            float(radius - std::hypot(p[0] - centre[0], p[1] - centre[1], p[2] - centre[2]));
+      }
+    }
+  }
+  surface::LevelSetParams params;
+  params.level = 0;
+  params.max_edge_mm = 2;
+  params.max_distance_mm = 0.05;
+  const std::vector<std::array<double, 3>> seeds{{centre[0] + radius, centre[1], centre[2]}};
+  auto mesh = surface::mesh_level_set(grid, params, seeds, RunContext{});
+  ASSERT_TRUE(mesh.ok()) << mesh.status();
+  double worst = 0;
+  for (const auto& p : mesh->points) {
+    const double r = std::hypot(p[0] - centre[0], p[1] - centre[1], p[2] - centre[2]);
+    worst = std::max(worst, std::abs(r - radius));
+  }
+  // Trilinear interpolation cuts the ball's curve by at most h^2 / 8R
+  // (0.09 mm along the 2.5 mm axis), plus the mesher's 0.05 mm bound; a
+  // misplaced axis would put points millimetres off.
+  EXPECT_LT(worst, 0.15);
+  const auto s = surface::compute_surface_statistics(*mesh);
+  EXPECT_EQ(s.euler_characteristic, 2);
+  EXPECT_GE(s.min_angle_deg, 29.99);
+  // Less the chords of 2 mm triangles and the interpolation's cut.
+  EXPECT_NEAR(s.volume_mm3 / (4.0 / 3 * M_PI * radius * radius * radius), 0.98, 0.01);
+}
+
+TEST(LevelSetSurface, RefusesBadGridsAndSizes) {
+  surface::ScalarGrid grid;
+  grid.dims = {3, 3, 3};
+  grid.values.assign(27, 0.0f);
+  grid.values[13] = 1;
+  surface::LevelSetParams params;
   params.max_edge_mm = 1;
   params.max_distance_mm = 0.1;
-  EXPECT_EQ(surface::remesh_surface(open, params, RunContext{}).status().code(),
-            absl::StatusCode::kInvalidArgument);
-  params.max_edge_mm = 0;
-  EXPECT_EQ(surface::remesh_surface(open, params, RunContext{}).status().code(),
+  const std::vector<std::array<double, 3>> seeds{{0.5, 1, 1}};
+  EXPECT_TRUE(surface::mesh_level_set(grid, params, seeds, RunContext{}).ok());
+  auto expect_refused = [&](const surface::ScalarGrid& g, const surface::LevelSetParams& p,
+                            const std::vector<std::array<double, 3>>& s) {
+    EXPECT_EQ(surface::mesh_level_set(g, p, s, RunContext{}).status().code(),
+              absl::StatusCode::kInvalidArgument);
+  };
+  auto short_grid = grid;
+  short_grid.values.pop_back();
+  expect_refused(short_grid, params, seeds);
+  auto flat = grid;
+  flat.index_to_mm = {1, 0, 0, 0, 1, 0, 0, 0, 0};
+  expect_refused(flat, params, seeds);
+  auto bad_edge = params;
+  bad_edge.max_edge_mm = 0;
+  expect_refused(grid, bad_edge, seeds);
+  auto bad_angle = params;
+  bad_angle.min_angle_deg = 31;
+  expect_refused(grid, bad_angle, seeds);
+  // Nothing above the level, and no seeds at all.
+  auto empty = grid;
+  empty.values.assign(27, 0.0f);
+  expect_refused(empty, params, seeds);
+  expect_refused(grid, params, {});
+  // An unknown component, and a negative smoothing.
+  volume::LabelComponents none;
+  EXPECT_EQ(surface::component_field(none, 1, volume::ImageGeometry{}, 0.4).status().code(),
             absl::StatusCode::kInvalidArgument);
 }
 

@@ -1,6 +1,6 @@
 // The restricted Delaunay triangulation CGAL's surface mesher builds, and
 // the closed surface read out of it. Included only by the CGAL translation
-// units that mesh surfaces (Poisson, remeshing): the headers are slow to
+// units that mesh surfaces (Poisson, level sets): the headers are slow to
 // compile.
 #pragma once
 
