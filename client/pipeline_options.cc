@@ -46,6 +46,12 @@ void add_pipeline_flags(CLI::App& command, PipelineFlags& flags) {
   command.add_flag("--no-adapt-to-thickness", flags.no_adapt_to_thickness,
                    "Keep the same sizing for thin components (by default each component's edges "
                    "are at most half its thickness, 3 x volume / area)");
+  command
+      .add_option("--poisson-min-thickness", poisson.min_thickness_voxels,
+                  "Try Poisson first only on labels at least this many voxels thick (3 x volume / "
+                  "area); thinner ones start with the meshed voxel mask; 0 for every label")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
   command.add_option("--label-sizing", flags.label_sizing,
                      "Per-label sizing LABEL:EDGE_MM[:DISTANCE_MM], e.g. 114:2:0.2; repeatable");
   auto& guard = flags.guard;
@@ -169,6 +175,7 @@ absl::StatusOr<v1::MeshOptions> to_mesh_options(const PipelineFlags& flags) {
   if (flags.poisson.max_edge_mm > 0) proto.set_max_edge_mm(flags.poisson.max_edge_mm);
   if (flags.poisson.max_distance_mm > 0) proto.set_max_distance_mm(flags.poisson.max_distance_mm);
   proto.set_adapt_to_thickness(!flags.no_adapt_to_thickness);
+  proto.set_poisson_min_thickness_voxels(flags.poisson.min_thickness_voxels);
   proto.set_volume_tolerance_percent(flags.guard.volume_percent);
   proto.set_small_volume_tolerance_percent(flags.guard.small_volume_percent);
   proto.set_hausdorff_tolerance_mm(flags.guard.hausdorff_mm);

@@ -44,6 +44,13 @@ struct PoissonOptions {
   // so a rib or vessel gets edges as short as it is thin while a large organ
   // keeps the defaults.
   bool adapt_to_thickness = true;
+  // Poisson is tried first only on labels at least this thick (3 x volume /
+  // area of the repaired surface, in voxels); thinner ones go straight to the
+  // guard's meshed voxel mask. Across the shared multi-label volumes the
+  // first Poisson surface was within tolerance for 7 of 157 labels thinner
+  // than 15 voxels and 4 of 11 thicker ones, and it is most of their time.
+  // 0 tries Poisson on every label; without fall-back it always is.
+  double min_thickness_voxels = 15;
   // Per-label sizing; it also overrides the adaptation.
   std::vector<LabelSizing> label_sizing;
   // Islands smaller than 4^3 voxels are segmentation noise in practice, and too

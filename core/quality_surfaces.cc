@@ -298,11 +298,31 @@ absl::Status add_quality_surfaces(const volume::LabelVolume& volume,
     repaired.statistics = surface::compute_surface_statistics(repaired.mesh);
     statistics_seconds = seconds_since(start);
   };
+  // Each component's thickness, and the label's, from its repaired surface.
+  std::vector<double> thickness;
+  double thickness_voxels = 0;
+  auto measure_thickness = [&] {
+    double volume_sum = 0, area_sum = 0;
+    for (const auto& piece : pieces->meshes) {
+      thickness.push_back(thickness_mm(piece));
+      volume_sum += std::abs(surface::signed_volume(piece));
+      area_sum += surface::surface_area(piece);
+    }
+    thickness_voxels = area_sum > 0 ? 3 * volume_sum / area_sum / voxel : 0;
+  };
+  bool try_poisson = false;
   if (to_poisson) {
     repair();
+    if (prepared.ok()) {
+      measure_thickness();
+      try_poisson =
+          !params.guard.fall_back || thickness_voxels >= params.poisson.min_thickness_voxels;
+    }
     // The repaired surface's figures on the second core while this one
     // smooths the pieces for Poisson (liver: 0.2 s beside 0.2 s).
-    if (prepared.ok()) side_by_side(measure_repaired, smooth);
+    if (prepared.ok() && try_poisson) side_by_side(measure_repaired, smooth);
+    // Without Poisson, the Marching Cubes side of the distance check there.
+    if (prepared.ok() && !try_poisson) side_by_side(measure_repaired, build_reference);
   } else {
     // Without Poisson the repaired surface is the output, measured below
     // as the guard's one attempt.
@@ -314,10 +334,9 @@ absl::Status add_quality_surfaces(const volume::LabelVolume& volume,
   // the joined copy need not stay in memory.
   repaired.mesh = {};
 
-  // Each component's thickness, from its repaired surface.
-  std::vector<double> thickness;
-  for (const auto& piece : pieces->meshes) thickness.push_back(thickness_mm(piece));
+  if (!to_poisson) measure_thickness();
   SurfaceFidelity fidelity;
+  fidelity.thickness_voxels = thickness_voxels;
   fidelity.tolerance = tolerance;
   fidelity.marching_cubes_volume_mm3 = marching_cubes_volume;
   // Each attempt's surface and statistics, to deliver whichever is chosen.
@@ -373,7 +392,6 @@ absl::Status add_quality_surfaces(const volume::LabelVolume& volume,
   output.label = label.label;
   output.components = pieces->counts;
   if (to_poisson) {
-    output.poisson.emplace();
     const bool fall_back = params.guard.fall_back;
     // The smoothed pieces stay for the finer Poisson attempt.
     auto poisson_attempt = [&](const char* method, double refine) {
@@ -395,13 +413,16 @@ absl::Status add_quality_surfaces(const volume::LabelVolume& volume,
       if (fidelity.attempts.size() == 1) *output.poisson = sum;
       return status;
     };
-    if (auto s = poisson_attempt("poisson", 1); !s.ok()) return s;
-    // A finer Poisson surface only helps one that was nearly within: on the
-    // 61-label TotalSegmentator volume it rescued two labels, both within
-    // 1.5 times the tolerance, and never one further out.
-    if (fall_back && !delivered() &&
-        excess_over(fidelity.attempts.back(), tolerance) <= kRefineWithin) {
-      if (auto s = poisson_attempt("poisson_refined", 0.5); !s.ok()) return s;
+    if (try_poisson) {
+      output.poisson.emplace();
+      if (auto s = poisson_attempt("poisson", 1); !s.ok()) return s;
+      // A finer Poisson surface only helps one that was nearly within: on
+      // the 61-label TotalSegmentator volume it rescued two labels, both
+      // within 1.5 times the tolerance, and never one further out.
+      if (fall_back && !delivered() &&
+          excess_over(fidelity.attempts.back(), tolerance) <= kRefineWithin) {
+        if (auto s = poisson_attempt("poisson_refined", 0.5); !s.ok()) return s;
+      }
     }
     smoothed = {};
     // The label's voxel mask, smoothed, meshed where it crosses one half.

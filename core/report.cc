@@ -41,6 +41,8 @@ absl::Status check_voxels(std::string_view field, double value) {
 
 // Lengths in mm beyond a metre are mistakes.
 constexpr double kMaxLengthMm = 1000;
+// No label is this many voxels thick.
+constexpr double kMaxThicknessVoxels = 100000;
 // One entry per label is plenty; the bound keeps a job record small.
 constexpr int kMaxLabelSizings = 1000;
 
@@ -104,6 +106,13 @@ absl::Status read_poisson_options(const v1::MeshOptions& options, PoissonOptions
     if (auto s = check_millimetres("max_distance_mm", poisson.max_distance_mm); !s.ok()) return s;
   }
   if (options.has_adapt_to_thickness()) poisson.adapt_to_thickness = options.adapt_to_thickness();
+  if (options.has_poisson_min_thickness_voxels()) {
+    poisson.min_thickness_voxels = options.poisson_min_thickness_voxels();
+    if (!(poisson.min_thickness_voxels >= 0 && poisson.min_thickness_voxels <= kMaxThicknessVoxels))
+      return absl::InvalidArgumentError(
+          cat("poisson_min_thickness_voxels: ", poisson.min_thickness_voxels, " is outside [0, ",
+              kMaxThicknessVoxels, "] voxels"));
+  }
   if (options.label_sizing_size() > kMaxLabelSizings)
     return absl::InvalidArgumentError(
         cat("label_sizing: ", options.label_sizing_size(), " entries; at most ", kMaxLabelSizings));
@@ -296,6 +305,7 @@ void add_quality_figures(const SurfaceResult& surface, v1::SurfaceSummary& entry
     fidelity->set_volume_tolerance_percent(100 * f.tolerance.volume_fraction);
     fidelity->set_hausdorff_tolerance_mm(f.tolerance.hausdorff_mm);
     fidelity->set_marching_cubes_volume_mm3(f.marching_cubes_volume_mm3);
+    fidelity->set_thickness_voxels(f.thickness_voxels);
     fidelity->set_within_tolerance(f.within_tolerance());
     if (f.delivered < f.attempts.size()) fidelity->set_delivered(f.attempts[f.delivered].method);
     for (const auto& a : f.attempts) {
@@ -377,6 +387,7 @@ v1::MeshOptions make_options(const MeshParams& params) {
   if (poisson.max_edge_mm > 0) options.set_max_edge_mm(poisson.max_edge_mm);
   if (poisson.max_distance_mm > 0) options.set_max_distance_mm(poisson.max_distance_mm);
   options.set_adapt_to_thickness(poisson.adapt_to_thickness);
+  options.set_poisson_min_thickness_voxels(poisson.min_thickness_voxels);
   for (const auto& sizing : poisson.label_sizing) {
     auto* entry = options.add_label_sizing();
     entry->set_label(sizing.label);

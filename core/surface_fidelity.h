@@ -41,6 +41,8 @@ struct SurfaceFidelity {
   SurfaceTolerance tolerance;
   // Enclosed volume of the label's Marching Cubes surface, mm^3.
   double marching_cubes_volume_mm3 = 0;
+  // 3 x volume / area of the label's repaired surface, voxels.
+  double thickness_voxels = 0;
   // In the order tried; the delivered one is `delivered`.
   std::vector<SurfaceAttempt> attempts;
   size_t delivered = 0;

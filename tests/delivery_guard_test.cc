@@ -168,6 +168,40 @@ TEST(DeliveryGuard, LabelsInParallelGiveTheSameSurfacesAsOneAtATime) {
     EXPECT_EQ(serial->warnings[i].reason, parallel->warnings[i].reason);
 }
 
+// The torus (a tube of radius 6 voxels, 3V/A = 1.5 r = 9 voxels) is thinner
+// than the 15 voxels from which Poisson is tried first: by default its first
+// surface is the meshed mask; asked to, or without fall-back, it is Poisson.
+TEST(DeliveryGuard, ThinLabelsStartWithTheMaskUnlessPoissonIsAskedFor) {
+  const auto path = phantom_file(PhantomShape::kTorus, "torus.mha");
+  auto first_attempt = [&](const MeshParams& params) {
+    auto result = run_pipeline(path, params, RunContext{});
+    EXPECT_TRUE(result.ok()) << result.status();
+    const SurfaceResult* s = result.ok() ? output_of(*result, 1) : nullptr;
+    EXPECT_TRUE(s != nullptr && s->fidelity && !s->fidelity->attempts.empty());
+    return s != nullptr && s->fidelity && !s->fidelity->attempts.empty() ? *s : SurfaceResult{};
+  };
+  const SurfaceResult by_default = first_attempt(MeshParams{});
+  ASSERT_TRUE(by_default.fidelity);
+  EXPECT_NEAR(by_default.fidelity->thickness_voxels, 9, 1);
+  EXPECT_EQ(by_default.fidelity->attempts.front().method, "mask");
+  EXPECT_FALSE(by_default.poisson.has_value());
+  EXPECT_TRUE(by_default.fidelity->within_tolerance());
+  EXPECT_GE(by_default.statistics.min_angle_deg, 29.99);
+
+  MeshParams everywhere;
+  everywhere.poisson.min_thickness_voxels = 0;
+  const SurfaceResult asked = first_attempt(everywhere);
+  ASSERT_TRUE(asked.fidelity);
+  EXPECT_EQ(asked.fidelity->attempts.front().method, "poisson");
+  EXPECT_TRUE(asked.poisson.has_value());
+
+  MeshParams no_fall_back;
+  no_fall_back.guard.fall_back = false;
+  const SurfaceResult measured = first_attempt(no_fall_back);
+  ASSERT_TRUE(measured.fidelity);
+  EXPECT_EQ(measured.fidelity->attempts.front().method, "poisson");
+}
+
 TEST(DeliveryGuard, TolerancesFollowLabelSizeAndDrawnSpacing) {
   const auto small = tolerance_for(999, {0.6, 0.6, 2.0}, 3, 10, 0);
   EXPECT_DOUBLE_EQ(small.volume_fraction, 0.10);

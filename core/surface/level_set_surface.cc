@@ -27,9 +27,6 @@ using restricted_delaunay::Triangulation;
 using Point = cgal::Point;
 using Vec3 = std::array<double, 3>;
 
-// The most field evaluations one meshing may make: about 15 s.
-constexpr uint64_t kMaxEvaluations = 40'000'000;
-
 // Fewer seeds than this are joined by crossings around the field's top.
 constexpr size_t kFewSeeds = 20;
 
@@ -256,9 +253,9 @@ absl::StatusOr<TriangleMesh> mesh_level_set(const ScalarGrid& grid, const LevelS
     // Crossings to a twentieth of the distance bound (CGAL takes it relative
     // to the radius). TotalSegmentator's labels took at most 340
     // evaluations per seed (and 340,000 more); an evaluation costs the mesher
-    // about 0.4 us, so the budget stops one that does not settle within
-    // seconds.
-    const uint64_t budget = std::min<uint64_t>(2'000 * (on_level.size() + 1000), kMaxEvaluations);
+    // about 0.4 us, so the budget stops one that does not settle within a
+    // millisecond per seed, about five times what it needs.
+    const uint64_t budget = 2'000 * (on_level.size() + 1000);
     const LevelFunction function(&field, params.level, &context, budget);
     CGAL::Implicit_surface_3<MesherTraits, LevelFunction> implicit(
         function, MesherTraits::Sphere_3(Point(centre[0], centre[1], centre[2]), radius * radius),

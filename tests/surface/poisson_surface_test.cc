@@ -42,7 +42,14 @@ const SurfaceResult* find_stage(const MeshResult& result, int32_t label, const s
   return nullptr;
 }
 
-MeshResult mesh_file(const std::string& path, const MeshParams& params = {}) {
+// Poisson on every label, however thin: these tests are about Poisson itself.
+MeshParams poisson_everywhere() {
+  MeshParams params;
+  params.poisson.min_thickness_voxels = 0;
+  return params;
+}
+
+MeshResult mesh_file(const std::string& path, const MeshParams& params = poisson_everywhere()) {
   auto result = run_pipeline(path, params, RunContext{});
   EXPECT_TRUE(result.ok()) << result.status();
   return result.ok() ? std::move(*result) : MeshResult{};
@@ -72,7 +79,7 @@ void expect_quality_surface(const SurfaceResult& s) {
 TEST(PoissonSurface, SphereIsSmootherThanMarchingCubes) {
   const auto path = phantom_file(PhantomShape::kSphere, "sphere.nii.gz");
   const auto phantom = make_phantom(PhantomShape::kSphere);
-  MeshParams mc_params;
+  MeshParams mc_params = poisson_everywhere();
   mc_params.surface = SurfaceMethod::kMarchingCubes;
   const MeshResult mc = mesh_file(path, mc_params);
   const MeshResult poisson = mesh_file(path);
@@ -115,7 +122,7 @@ TEST(PoissonSurface, HierarchyClustersBoundThePointCount) {
   const auto path = phantom_file(PhantomShape::kTorus, "torus-hierarchy.mha");
   size_t previous_points = SIZE_MAX;
   for (uint32_t cluster : {2u, 3u, 5u}) {
-    MeshParams params;
+    MeshParams params = poisson_everywhere();
     params.poisson.point_reduction = surface::PointReduction::kHierarchy;
     params.poisson.point_cluster_size = cluster;
     const MeshResult result = mesh_file(path, params);
@@ -134,7 +141,7 @@ TEST(PoissonSurface, HierarchyClustersBoundThePointCount) {
 
 TEST(PoissonSurface, PointBudgetCoarsensTheGridOfLargeSurfacesOnly) {
   const auto path = phantom_file(PhantomShape::kTorus, "torus-budget.mha");
-  MeshParams unbounded;
+  MeshParams unbounded = poisson_everywhere();
   unbounded.poisson.max_points = 0;
   const MeshResult full_result = mesh_file(path, unbounded);
   const SurfaceResult* full = find_stage(full_result, 1, "poisson");
@@ -151,7 +158,7 @@ TEST(PoissonSurface, PointBudgetCoarsensTheGridOfLargeSurfacesOnly) {
   EXPECT_EQ(same->statistics.nodes, full->statistics.nodes);
 
   // Half the points as a budget: a cell about sqrt(2) larger keeps about half.
-  MeshParams halved;
+  MeshParams halved = poisson_everywhere();
   halved.poisson.max_points = full_points / 2;
   const MeshResult result = mesh_file(path, halved);
   const SurfaceResult* thinned = find_stage(result, 1, "poisson");
@@ -165,9 +172,9 @@ TEST(PoissonSurface, PointBudgetCoarsensTheGridOfLargeSurfacesOnly) {
 
 TEST(PoissonSurface, TwoHalvesGiveTheOneSolveSurface) {
   const auto path = phantom_file(PhantomShape::kTorus, "torus-halves.nrrd");
-  MeshParams one;
+  MeshParams one = poisson_everywhere();
   one.poisson.split_points = 0;
-  MeshParams halves;
+  MeshParams halves = poisson_everywhere();
   halves.poisson.split_points = surface::kMinPointBudget;  // far below the torus's points
   const MeshResult one_result = mesh_file(path, one);
   const MeshResult halves_result = mesh_file(path, halves);
@@ -262,7 +269,7 @@ TEST(PoissonSurface, ALabelOfOnlySpecksIsReportedUnlessAskedFor) {
   EXPECT_GT(speck_mc->statistics.triangles, 0u);
 
   // Asked for by name, it is an error that names it.
-  MeshParams only_speck;
+  MeshParams only_speck = poisson_everywhere();
   only_speck.labels = {2};
   const auto refused = run_pipeline(path, only_speck, RunContext{});
   EXPECT_EQ(refused.status().code(), absl::StatusCode::kFailedPrecondition);
@@ -321,7 +328,7 @@ TEST(PoissonSurface, CancellingStopsWithinASecond) {
   context.progress = [&](std::string_view stage, double) {
     if (stage == "poisson") in_poisson = true;
   };
-  MeshParams params;
+  MeshParams params = poisson_everywhere();
   params.poisson.max_edge_voxels = 1;  // slow meshing, so there is time to cancel
   params.poisson.max_distance_voxels = 0.05;
   std::chrono::steady_clock::time_point asked;
@@ -350,7 +357,7 @@ TEST(PoissonSurface, AStopDuringTheChecksCancelsTheRun) {
   context.progress = [&](std::string_view stage, double) {
     if (stage == "surface_distance") stop = true;
   };
-  auto result = run_pipeline(path, MeshParams{}, context);
+  auto result = run_pipeline(path, poisson_everywhere(), context);
   EXPECT_EQ(result.status().code(), absl::StatusCode::kCancelled);
 }
 
@@ -387,9 +394,9 @@ TEST(PoissonSurface, AStopCancelsBothHalves) {
 
 TEST(PoissonSurface, RepairedStageWritesTheRepairedSurface) {
   const auto path = phantom_file(PhantomShape::kNestedSpheres, "nested.nrrd");
-  MeshParams params;
+  MeshParams params = poisson_everywhere();
   params.surface = SurfaceMethod::kRepaired;
-  MeshParams ball;
+  MeshParams ball = poisson_everywhere();
   ball.labels = {1};
   const MeshResult result = mesh_file(path, ball);
   const MeshResult repaired = mesh_file(path, params);
@@ -416,7 +423,7 @@ TEST(PoissonSurface, HollowComponentsKeepTheirCavity) {
   // Labels 2 and 3 are shells: one component each, bounded by two surfaces.
   const auto path = phantom_file(PhantomShape::kNestedSpheres, "shells.nii.gz");
   const auto phantom = make_phantom(PhantomShape::kNestedSpheres);
-  MeshParams params;
+  MeshParams params = poisson_everywhere();
   params.labels = {2, 3};
   const MeshResult result = mesh_file(path, params);
   for (int32_t label : {2, 3}) {
@@ -437,7 +444,7 @@ TEST(PoissonSurface, HollowComponentsKeepTheirCavity) {
 
 TEST(PoissonSurfaceRealData, LiverMeetsTheQualityTargets) {
   const auto path = testing::shared_data("liver.inr.gz");
-  MeshParams params;
+  MeshParams params = poisson_everywhere();
   params.labels = {255};
   const MeshResult result = mesh_file(path, params);
   const SurfaceResult* smooth = find_stage(result, 255, "poisson");
