@@ -7,6 +7,7 @@
 #include "client/commands.h"
 #include "client/exit_codes.h"
 #include "client/job_follow.h"
+#include "client/label_warnings.h"
 #include "client/server_connection.h"
 #include "core/report.h"
 #include "grpc/health/v1/health.grpc.pb.h"
@@ -85,6 +86,7 @@ int run_status(const JobFlags& flags) {
   } else {
     print_job_line(job);
   }
+  print_label_warnings("status", job.report());
   return kExitSuccess;
 }
 

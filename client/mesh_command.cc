@@ -6,6 +6,7 @@
 
 #include "client/commands.h"
 #include "client/exit_codes.h"
+#include "client/label_warnings.h"
 #include "client/pipeline_options.h"
 #include "client/terminal_progress.h"
 #include "core/pipeline.h"
@@ -70,16 +71,6 @@ void print_summary(const MeshResult& result, const std::string& out_dir) {
   std::printf("meshes and report.json written to %s\n", out_dir.c_str());
 }
 
-// The labels delivered outside tolerance or not at all, on stderr, so they
-// are seen even when stdout goes elsewhere.
-void print_warnings(const MeshResult& result) {
-  if (result.warnings.empty()) return;
-  std::fprintf(stderr, "labelmesh mesh: %zu label(s) outside tolerance or not delivered:\n",
-               result.warnings.size());
-  for (const auto& warning : result.warnings)
-    std::fprintf(stderr, "  label %d: %s\n", warning.label, warning.reason.c_str());
-}
-
 }  // namespace
 
 CommandRunner add_mesh_command(CLI::App& app) {
@@ -123,7 +114,7 @@ CommandRunner add_mesh_command(CLI::App& app) {
     } else {
       print_summary(*result, options->out_dir);
     }
-    print_warnings(*result);
+    print_label_warnings("mesh", make_report(*result, *params));
     return int{kExitSuccess};
   };
 }

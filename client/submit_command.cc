@@ -11,6 +11,7 @@
 #include "client/commands.h"
 #include "client/exit_codes.h"
 #include "client/job_follow.h"
+#include "client/label_warnings.h"
 #include "client/pipeline_options.h"
 #include "client/server_connection.h"
 #include "core/report.h"
@@ -130,6 +131,7 @@ int run_submit(const SubmitFlags& flags) {
     std::printf("job %s finished: %d files written to %s\n", reply->job_id().c_str(), *written,
                 flags.out_dir.c_str());
   }
+  print_label_warnings("submit", job->report());
   return kExitSuccess;
 }
 

@@ -89,6 +89,18 @@ grep -q '"state": "JOB_STATE_SUCCEEDED"' <<<"$status_json" || fail "status"
 listed=$("$labelmesh" list) || fail "list exited $?"
 grep -q "$job" <<<"$listed" || fail "list does not show the job"
 
+# Labels not delivered are named on stderr by submit and by status: the
+# thin-shapes phantom's one- and two-voxel labels are too small to mesh.
+"$labelmesh" phantom thin-shapes --out "$work/thin.nii.gz" >/dev/null
+"$labelmesh" submit "$work/thin.nii.gz" --surface repaired --out "$work/thin" \
+  >"$work/thin.out" 2>"$work/thin.err" || fail "submit of the thin shapes exited $?"
+grep -q "label(s) outside tolerance or not delivered" "$work/thin.err" ||
+  fail "submit printed no warnings"
+grep -q "too small to mesh" "$work/thin.err" || fail "submit did not say which label is too small"
+thin_job=$(sed -n 's/^job \([0-9a-f]\{32\}\) finished.*/\1/p' "$work/thin.out")
+"$labelmesh" status "$thin_job" >/dev/null 2>"$work/thin-status.err" || fail "status exited $?"
+grep -q "too small to mesh" "$work/thin-status.err" || fail "status printed no warnings"
+
 # Exit codes: unknown job 3, cancel of an ended job 4, a volume that fails 3.
 set +e
 "$labelmesh" status 00000000000000000000000000000000 >/dev/null 2>&1
@@ -101,7 +113,8 @@ head -c 5000 /dev/urandom >"$work/noise.nii"
 set -e
 grep -q "noise" "$work/server.log" && fail "the server log names an uploaded file"
 
-# The metrics endpoint of the same labelmeshd that runs the jobs counts them.
+# The metrics endpoint of the same labelmeshd that runs the jobs counts them:
+# the liver, the torus and the thin shapes.
 metrics=$(curl -sf "http://127.0.0.1:$metrics_port/metrics") || fail "no /metrics"
 /usr/bin/python3 - "$metrics" <<'PY' || fail "metrics do not count the jobs"
 import sys
@@ -111,7 +124,7 @@ for line in sys.argv[1].splitlines():
         name, value = line.rsplit(" ", 1)
         samples[name] = float(value)
 print({k: v for k, v in samples.items() if k.startswith(("labelmesh_jobs", "labelmesh_rej"))})
-assert samples['labelmesh_jobs_total{outcome="succeeded"}'] == 2
+assert samples['labelmesh_jobs_total{outcome="succeeded"}'] == 3
 assert samples["labelmesh_jobs_running"] == 0
 # The noise upload was refused at its header, before it became a job.
 assert sum(v for k, v in samples.items() if k.startswith("labelmesh_rejections_total")) == 1

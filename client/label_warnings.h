@@ -1,0 +1,14 @@
+// The labels a run delivered outside tolerance or not at all, printed on
+// stderr so they are seen even when stdout goes to a file or a pipe.
+#pragma once
+
+#include <string_view>
+
+#include "labelmesh/v1/report.pb.h"
+
+namespace labelmesh::client {
+
+// Nothing when the report has no warnings.
+void print_label_warnings(std::string_view command, const v1::Report& report);
+
+}  // namespace labelmesh::client
