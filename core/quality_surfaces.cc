@@ -432,7 +432,7 @@ absl::Status add_quality_surfaces(const volume::LabelVolume& volume,
       }
     }
     smoothed = {};
-    // The label's voxel mask, smoothed, meshed where it crosses one half.
+    // The label's voxel mask, smoothed, meshed just under one half.
     auto mask_attempt = [&](const char* method, double refine) {
       StageTimer timer(stages, "level_set");
       context.report("level_set", 0);
