@@ -1,5 +1,5 @@
 // Everything labelmeshd can be told, with its defaults. Flags and LABELMESHD_*
-// environment variables fill it (server_flags.cc); tests build it directly.
+// environment variables fill it (main.cc); tests build it directly.
 #pragma once
 
 #include <cstdint>

@@ -134,7 +134,7 @@ TEST(VolumeMeshesRealData, LiverTetrahedraAreValid) {
   // Q min 0.092 and 5 questionable elements; the improvement pass (46 3-2
   // flips, 344 moves, 12 inserted points, no sliver peeled on this surface)
   // leaves Q min 0.227, none questionable, dihedral 11.6-157.7 degrees:
-  // issue 4's targets (Q >= 0.2, dihedral >= 10).
+  // what the pass promises (Q >= 0.2, dihedral >= 10).
   EXPECT_GT(volume.mesh.tetrahedra.size(), 80000u);
   expect_valid_elements(volume);
   EXPECT_EQ(volume.summary.very_bad, 0);

@@ -30,7 +30,7 @@ enum class PointReduction {
   // input surface, as with the grid, but the density follows the points
   // rather than a fixed lattice. On the liver, clusters of 3 keep the
   // one-voxel grid's Hausdorff distance with 44 % fewer points, but the
-  // sphere's vertices come out rougher (README, "Point reduction").
+  // sphere's vertices come out rougher (docs/pipeline.md, "Point reduction").
   kHierarchy,
 };
 

@@ -1,4 +1,4 @@
-// Mesh improvement after TetGen (issue 4): local operations that raise the
+// Mesh improvement after TetGen: local operations that raise the
 // worst tetrahedron quality Q without touching the boundary.
 #pragma once
 

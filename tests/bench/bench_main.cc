@@ -266,7 +266,7 @@ int bench_tetrahedra(const std::string& path, const std::vector<int32_t>& labels
 
 // Stops a run of the liver's label 255 (through TetGen) at one time after
 // another and prints how long each stop took to return, and in which stage
-// it came (the target: under 1 s).
+// it came (each should take under 1 s).
 int bench_cancellation(const std::string& path, const std::vector<int32_t>& labels) {
   labelmesh::MeshParams params;
   params.labels = labels;

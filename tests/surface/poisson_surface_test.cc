@@ -91,14 +91,13 @@ TEST(PoissonSurface, SphereIsSmootherThanMarchingCubes) {
   EXPECT_EQ(smooth->statistics.euler_characteristic, 2);
   const double mc_error = rms_radial_error(mc_surface->mesh, phantom.centre, 20);
   const double poisson_error = rms_radial_error(smooth->mesh, phantom.centre, 20);
-  // The targets: under 0.1 voxel and under half the staircase's
-  // error. Measured: 0.208 voxel for Marching Cubes, 0.094 for Poisson from
-  // the smoothed samples (0.141 without smoothing).
+  // Under 0.1 voxel and under half the staircase's error. Measured: 0.208 voxel for Marching Cubes,
+  // 0.094 for Poisson from the smoothed samples (0.141 without smoothing).
   EXPECT_GT(mc_error, 0.18);
   EXPECT_LT(poisson_error, 0.1);
   EXPECT_LT(poisson_error, 0.5 * mc_error);
   // Measured -3.0 %: with 8-voxel edges on a 20-voxel sphere, the flat
-  // triangles cut inside the curve (see README on --max-edge for small organs).
+  // triangles cut inside the curve (see docs/pipeline.md on --max-edge for small organs).
   EXPECT_NEAR(smooth->statistics.volume_mm3 / phantom.truth[0].volume_mm3, 1.0, 0.035);
   ASSERT_TRUE(smooth->distance_to_marching_cubes.has_value());
   EXPECT_LT(smooth->distance_to_marching_cubes->hausdorff_mm, 1.0);
@@ -454,7 +453,7 @@ TEST(PoissonSurfaceRealData, LiverMeetsTheQualityTargets) {
   EXPECT_NEAR(smooth->statistics.volume_mm3 / voxel_volume_mm3, 1.0, 0.01);
   ASSERT_TRUE(smooth->distance_to_marching_cubes.has_value());
   // Measured 1.72 mm at a sharp 90-degree edge of the segmentation (the
-  // issue's target of one voxel diagonal, 1.1 mm, is not met: see README,
+  // one voxel diagonal, 1.1 mm, is not reached: see docs/pipeline.md,
   // "Poisson fidelity"; the segmentation was drawn on 2 mm slices, each copied
   // to three 0.67 mm ones, so its Marching Cubes surface steps 2 mm at a
   // time) and a mean of 0.25 mm.

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""The liver's tetrahedral mesh in solvers nobody here wrote (issue 4).
+"""The liver's tetrahedral mesh in solvers nobody here wrote.
 
 `labelmesh mesh liver.inr.gz --labels 255 --volume tet --formats inp,msh`, then:
 - Gmsh loads volume.msh and its coherence check (duplicate nodes and
