@@ -12,6 +12,7 @@ int main(int argc, char** argv) {
   CLI::App app{"labelmesh " LABELMESH_VERSION
                ": meshes segmented medical label volumes (NIfTI, MetaImage, NRRD, INR, VTI).\n"
                "Coordinates are in millimetres, in the input's patient space, LPS convention."};
+  app.set_version_flag("--version", "labelmesh " LABELMESH_VERSION);
   app.require_subcommand(1);
   app.footer(kExitCodeHelp);
   std::map<const CLI::App*, CommandRunner> runners;

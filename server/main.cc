@@ -128,6 +128,7 @@ int main(int argc, char** argv) {
   CLI::App app{"labelmeshd " LABELMESH_VERSION
                ": the labelmesh gRPC meshing service. Every flag can also be set with the "
                "environment variable named after it. Without TLS it listens on loopback only."};
+  app.set_version_flag("--version", "labelmeshd " LABELMESH_VERSION);
   add_server_flags(app, config);
   CLI11_PARSE(app, argc, argv);
 

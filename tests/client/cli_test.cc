@@ -82,6 +82,12 @@ TEST(Cli, MeshWritesSurfacesAndReport) {
   EXPECT_NE(slurp(dir / "out" / "report.json").find("\"min_angle_deg\""), std::string::npos);
 }
 
+TEST(Cli, VersionIsTheProjects) {
+  const CliRun run = run_cli("--version");
+  EXPECT_EQ(run.exit_code, 0);
+  EXPECT_NE(run.output.find("labelmesh " LABELMESH_VERSION), std::string::npos) << run.output;
+}
+
 TEST(Cli, JsonReportOnStdout) {
   const auto dir = testing::scratch_dir("cli-json");
   ASSERT_EQ(run_cli("phantom torus --out " + (dir / "t.mha").string()).exit_code, 0);
