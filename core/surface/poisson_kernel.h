@@ -7,8 +7,16 @@
 #include <cstdint>
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/version.h>
 
 #include "core/run_context.h"
+
+// The Poisson adapters reach into CGAL 5.5's Poisson_reconstruction_function:
+// they evaluate its function with their own cell hints and assemble and solve
+// its linear system themselves. Another CGAL version has to be checked against
+// them before it is built.
+static_assert(CGAL_VERSION_NR >= 1050500000 && CGAL_VERSION_NR < 1050600000,
+              "the Poisson adapters follow CGAL 5.5's Poisson_reconstruction_function");
 
 namespace labelmesh::surface::poisson {
 
