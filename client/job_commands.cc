@@ -43,7 +43,10 @@ int fail(const char* command, const absl::Status& status) {
 
 std::string state_name(v1::JobState state) {
   std::string name = v1::JobState_Name(state);
-  name = name.substr(std::string("JOB_STATE_").size());
+  // A state this client does not know (from a newer server) has no name.
+  const std::string prefix = "JOB_STATE_";
+  if (name.rfind(prefix, 0) != 0) return "state " + std::to_string(int(state));
+  name = name.substr(prefix.size());
   for (char& c : name) c = static_cast<char>(std::tolower(c));
   return name;
 }
@@ -51,7 +54,8 @@ std::string state_name(v1::JobState state) {
 void print_job_line(const v1::Job& job) {
   char created[32] = "";
   const std::time_t when = static_cast<std::time_t>(job.created_at());
-  std::strftime(created, sizeof created, "%Y-%m-%d %H:%M:%S", std::localtime(&when));
+  if (const std::tm* local = std::localtime(&when))
+    std::strftime(created, sizeof created, "%Y-%m-%d %H:%M:%S", local);
   std::printf("%s  %-9s  %s", job.job_id().c_str(), state_name(job.state()).c_str(), created);
   if (job.state() == v1::JOB_STATE_QUEUED) std::printf("  position %u", job.queue_position());
   if (job.state() == v1::JOB_STATE_RUNNING) {

@@ -134,12 +134,13 @@ constexpr double kRefineWithin = 1.5;
 // tolerance; 0.5 and more rounded off thin parts (58), and 0.3 or none left
 // creases the mesher refines without end.
 constexpr double kMaskSigmaVoxels = 0.4;
-// The level the mask is meshed at: a little under one half. Where voxels
-// meet only along an edge or at a corner, the smoothed mask has a saddle at
-// exactly one half whatever the smoothing (inside and outside are mirror
-// images there), and the mesher refines around that pinch without end (the
-// DICOM slab's label 33 at 0.5; at 0.495, 1.5 s and volume -1.0 %). Just
-// under it such voxels join, as they do in the 26-connected components.
+// The level the mask is meshed at: a little under one half. Where the voxels
+// around a point are symmetric between inside and outside (a checkerboard of
+// voxels meeting along edges, say), the smoothed mask has a saddle at exactly
+// one half whatever the smoothing, and the mesher refines around that pinch
+// without end (the DICOM slab's label 33 at 0.5; at 0.495, 1.5 s and volume
+// -1.0 %). Just under one half such a saddle is inside, and the surface
+// passes it as a neck.
 constexpr double kMaskLevel = 0.495;
 
 // Triangle sizing of one component, mm.
@@ -433,6 +434,7 @@ absl::Status add_quality_surfaces(const volume::LabelVolume& volume,
     }
     smoothed = {};
     // The label's voxel mask, smoothed, meshed just under one half.
+    bool mask_did_not_settle = false;
     auto mask_attempt = [&](const char* method, double refine) {
       StageTimer timer(stages, "level_set");
       context.report("level_set", 0);
@@ -446,13 +448,20 @@ absl::Status add_quality_surfaces(const volume::LabelVolume& volume,
             level_set.level = kMaskLevel;
             level_set.max_edge_mm = sizing.max_edge_mm;
             level_set.max_distance_mm = sizing.max_distance_mm;
-            return surface::mesh_level_set(*field, level_set, pieces->meshes[i].points, context);
+            auto mesh =
+                surface::mesh_level_set(*field, level_set, pieces->meshes[i].points, context);
+            if (mesh.status().code() == absl::StatusCode::kResourceExhausted)
+              mask_did_not_settle = true;
+            return mesh;
           });
     };
     if (fall_back && !delivered()) {
       if (auto s = mask_attempt("mask", 1); !s.ok()) return s;
     }
-    if (fall_back && !delivered()) {
+    // A mask the mesher could not settle on at the label's sizing has a
+    // feature no finer sizing resolves, and the finer attempt would spend four
+    // times the budget on it.
+    if (fall_back && !delivered() && !mask_did_not_settle) {
       if (auto s = mask_attempt("mask_refined", 0.5); !s.ok()) return s;
     }
     // Last: the repaired surface itself, when nothing smoother was built.

@@ -22,11 +22,14 @@ double voxel_size_mm(const volume::ImageGeometry& geometry);
 // Appends the "repaired" surface of `label` and, for SurfaceMethod::kPoisson,
 // the delivered one; the last appended is marked as the output. The delivery
 // guard measures each surface it builds against the label's Marching Cubes
-// surface (volume, distances) and, outside `tolerance`, tries a finer Poisson
-// surface, then the label's smoothed voxel mask meshed at one half (at the
-// label's sizing, then at half of it), and
-// delivers the first within it or else the one least outside it; what it
-// tried is in the output's `fidelity`. When no attempt could be built, the
+// surface (volume, distances). Poisson comes first on labels at least
+// params.poisson.min_thickness_voxels thick (always without fall-back);
+// outside `tolerance` the guard tries a finer Poisson surface (only within 1.5
+// times the tolerance), then the label's smoothed voxel mask meshed just under
+// one half (at the label's sizing, then at half of it), and last, when nothing
+// smoother was built, the repaired surface. It delivers the first within the
+// tolerance or else the one least outside it; what it tried is in the
+// output's `fidelity`. When no attempt could be built, the
 // output carries the `error` and no surface. When every component is under
 // the size threshold, only a "repaired" entry with the dropped counts (and no
 // surface) is appended, unless the label was asked for by name

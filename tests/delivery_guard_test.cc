@@ -314,6 +314,11 @@ TEST(LevelSetSurface, RefusesBadGridsAndSizes) {
   auto short_grid = grid;
   short_grid.values.pop_back();
   expect_refused(short_grid, params, seeds);
+  // Sides whose product wraps around 2^64 to the number of values.
+  auto wrapping = grid;
+  wrapping.dims = {int64_t(1) << 32, int64_t(1) << 32, 4};
+  wrapping.values.clear();
+  expect_refused(wrapping, params, seeds);
   auto flat = grid;
   flat.index_to_mm = {1, 0, 0, 0, 1, 0, 0, 0, 0};
   expect_refused(flat, params, seeds);

@@ -137,6 +137,10 @@ absl::Status check_input(const ScalarGrid& grid, const LevelSetParams& params) {
   uint64_t count = 1;
   for (int64_t n : grid.dims) {
     if (n < 2) return absl::InvalidArgumentError("level-set grid: each side needs 2 samples");
+    // Checked before multiplying, so the count cannot wrap around.
+    if (uint64_t(n) > grid.values.size() / count)
+      return absl::InvalidArgumentError(
+          cat("level-set grid: ", grid.values.size(), " values for more voxels"));
     count *= uint64_t(n);
   }
   if (count != grid.values.size())
@@ -145,15 +149,16 @@ absl::Status check_input(const ScalarGrid& grid, const LevelSetParams& params) {
   return absl::OkStatus();
 }
 
-// Moves a point onto the level set by Newton steps along the field's
-// gradient (central differences a quarter voxel apart); nullopt when it does
-// not land within a hundredth of the field's range of the level, or strays
-// more than a voxel.
+// Moves a point onto the level set by up to six Newton steps along the
+// field's gradient (central differences half a voxel apart, in grid index
+// space); nullopt when it does not land within 0.01 of the level (a mask
+// runs from 0 to 1), or strays more than a voxel along any axis.
 std::optional<Vec3> onto_level(const Field& field, double level, const Vec3& start_index) {
   Vec3 x = start_index;
-  for (int step = 0; step < 6; ++step) {
+  for (int step = 0;; ++step) {
     const double value = field.at_index(x, level - 1) - level;
     if (std::abs(value) < 0.01) return x;
+    if (step == 6) return std::nullopt;
     Vec3 gradient{};
     double norm2 = 0;
     for (int a = 0; a < 3; ++a) {
@@ -169,7 +174,6 @@ std::optional<Vec3> onto_level(const Field& field, double level, const Vec3& sta
       if (std::abs(x[a] - start_index[a]) > 1) return std::nullopt;
     }
   }
-  return std::nullopt;
 }
 
 // Where the field crosses the level along the 26 grid directions from
@@ -273,7 +277,7 @@ absl::StatusOr<TriangleMesh> mesh_level_set(const ScalarGrid& grid, const LevelS
   } catch (const Stopped&) {
     return absl::CancelledError("the run was cancelled");
   } catch (const BudgetSpent&) {
-    return absl::InternalError(
+    return absl::ResourceExhaustedError(
         "level-set: the mesher did not settle within its budget of field evaluations");
   } catch (const std::exception& e) {
     return absl::InternalError(cat("level-set: ", e.what()));

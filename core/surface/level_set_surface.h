@@ -1,6 +1,6 @@
 // A closed surface where a sampled field crosses a level: CGAL's surface
 // mesher on the trilinear interpolation of a voxel grid. Run on a label's
-// (lightly smoothed) voxel mask at one half, it gives the Marching Cubes
+// (lightly smoothed) voxel mask just under one half, it gives the Marching Cubes
 // surface's shape with the mesher's angle and size guarantees; the fallback
 // for labels whose Poisson surface strays from the voxels.
 #pragma once
@@ -43,9 +43,10 @@ struct LevelSetParams {
 // gives the same mesh. `seeds` (mm) are points on or near the level set, at
 // least one on every component of it (a Marching Cubes surface's points do);
 // they are moved onto it before meshing. Errors: INVALID_ARGUMENT for bad
-// parameters, a grid whose size does not match its values or no seed inside;
-// INTERNAL when the result is not a closed manifold or the mesher does not
-// settle within a bounded number of field evaluations; CANCELLED.
+// parameters, a grid whose size does not match its values, no seed on the
+// level set or nothing above the level; RESOURCE_EXHAUSTED when the mesher
+// does not settle within 2,000 field evaluations per seed (and 2,000,000
+// more); INTERNAL when the result is not a closed manifold; CANCELLED.
 absl::StatusOr<TriangleMesh> mesh_level_set(const ScalarGrid& grid, const LevelSetParams& params,
                                             const std::vector<std::array<double, 3>>& seeds,
                                             const RunContext& context);
