@@ -1,6 +1,8 @@
+# SPDX-License-Identifier: AGPL-3.0-or-later
 # labelmesh in a container: Debian 12 with the packages from the same
 # scripts/install-deps.sh that README.md and CI use. The image holds the
-# labelmesh client and the labelmeshd service (its workers are labelmeshd too).
+# labelmesh client, the labelmeshd service and labelmesh-worker, which runs its
+# jobs, installed by the build's install() rules.
 FROM debian:12
 
 WORKDIR /opt/labelmesh
@@ -9,8 +11,7 @@ RUN bash scripts/install-deps.sh && rm -rf /var/lib/apt/lists/*
 
 COPY . .
 RUN bash scripts/build.sh release \
- && install -m 0755 build/release/client/labelmesh build/release/server/labelmeshd \
-      /usr/local/bin/
+ && cmake --install build/release --prefix /usr/local --strip
 
 # Run as an unprivileged user; volumes and the spool live under /data.
 RUN useradd --system --create-home labelmesh && mkdir -p /data/spool && chown -R labelmesh /data

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // The labelmesh subcommands. Each registers its options on the CLI11 app and
 // returns a runner that yields the process exit code.
 #pragma once

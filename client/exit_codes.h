@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // Process exit codes of the labelmesh CLI, and the one mapping from errors.
 #pragma once
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // `labelmesh info FILE [--json]`: what a volume holds and where it sits.
 #include <CLI/CLI.hpp>
 
@@ -6,8 +7,8 @@
 
 #include "client/commands.h"
 #include "client/exit_codes.h"
-#include "core/pipeline.h"
-#include "core/report.h"
+#include "core/pipeline/pipeline.h"
+#include "core/pipeline/report.h"
 
 namespace labelmesh::client {
 namespace {

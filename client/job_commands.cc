@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // Commands about jobs on a labelmeshd server: watch, status, fetch, cancel,
 // list, health. Each takes --json and the connection flags.
 #include <CLI/CLI.hpp>
@@ -9,7 +10,7 @@
 #include "client/job_follow.h"
 #include "client/label_warnings.h"
 #include "client/server_connection.h"
-#include "core/report.h"
+#include "core/pipeline/report.h"
 #include "grpc/health/v1/health.grpc.pb.h"
 #include "labelmesh/v1/service.grpc.pb.h"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 #include "client/job_follow.h"
 
 #include <filesystem>
@@ -7,7 +8,7 @@
 #include "absl/strings/str_cat.h"
 #include "client/exit_codes.h"
 #include "client/terminal_progress.h"
-#include "core/report.h"
+#include "core/pipeline/report.h"
 #include "google/protobuf/util/json_util.h"
 #include "labelmesh/v1/service.grpc.pb.h"
 #include "server/sha256.h"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // Following a remote job to its end and fetching its results: shared by
 // `submit`, `watch` and `fetch`.
 #pragma once

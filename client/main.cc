@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // labelmesh: segmented label volumes in, surface meshes and a quality report out.
 #include <CLI/CLI.hpp>
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // `labelmesh mesh FILE --out DIR`: the whole pipeline, in this process.
 #include <CLI/CLI.hpp>
 
@@ -9,9 +10,11 @@
 #include "client/label_warnings.h"
 #include "client/pipeline_options.h"
 #include "client/terminal_progress.h"
-#include "core/pipeline.h"
-#include "core/report.h"
-#include "core/text.h"
+#include "core/pipeline/job_options.h"
+#include "core/pipeline/pipeline.h"
+#include "core/pipeline/report.h"
+#include "core/pipeline/write_results.h"
+#include "core/util/text.h"
 
 namespace labelmesh::client {
 namespace {

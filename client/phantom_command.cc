@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // `labelmesh phantom SHAPE --out FILE`: synthetic volumes with known geometry.
 #include <CLI/CLI.hpp>
 

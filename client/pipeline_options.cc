@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 #include "client/pipeline_options.h"
 
 #include <CLI/CLI.hpp>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // The pipeline options of `labelmesh mesh` and `labelmesh submit`: one set of
 // flags, turned into the one job-options message both paths run with.
 #pragma once
@@ -6,7 +7,7 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
-#include "core/mesh_params.h"
+#include "core/pipeline/mesh_params.h"
 #include "labelmesh/v1/options.pb.h"
 
 namespace CLI {

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // How the client reaches labelmeshd: address, TLS and bearer token, from
 // flags or LABELMESH_SERVER / LABELMESH_TOKEN.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // `labelmesh submit FILE --out DIR`: upload a volume to labelmeshd, follow the
 // job, fetch its results. The same pipeline flags as `labelmesh mesh`.
 #include <unistd.h>
@@ -14,7 +15,8 @@
 #include "client/label_warnings.h"
 #include "client/pipeline_options.h"
 #include "client/server_connection.h"
-#include "core/report.h"
+#include "core/pipeline/job_options.h"
+#include "core/pipeline/report.h"
 #include "labelmesh/v1/service.grpc.pb.h"
 #include "server/sha256.h"
 

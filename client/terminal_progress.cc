@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 #include "client/terminal_progress.h"
 
 #include <unistd.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // One progress line per stage on a terminal; silent when stderr is not one.
 #pragma once
 

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: AGPL-3.0-or-later
 # Benchmark of the delivery guard on every multi-label volume in ../shared/data:
 # per file, labels delivered within tolerance, labels that kept Poisson, that
 # fell back, that were warned about, seconds and peak RSS of `labelmesh mesh`.

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: AGPL-3.0-or-later
 # Service benchmark: upload throughput, start latency and job throughput of
 # labelmeshd on loopback, beside their targets. Prints figures only: it never
 # fails on speed, only when a server, an upload or a job breaks.

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: AGPL-3.0-or-later
 # Benchmark: per-stage seconds, voxels per second and peak RSS on the liver
 # and vb-seg.mha, beside the baselines they are held to. Prints figures only.
 set -euo pipefail

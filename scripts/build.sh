@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: AGPL-3.0-or-later
 # Configures and builds one CMake preset (default: dev) with Ninja and ccache.
 # Usage: scripts/build.sh [preset]
 set -euo pipefail

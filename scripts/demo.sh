@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: AGPL-3.0-or-later
 # The main job, end to end: installs, builds, starts labelmeshd on loopback,
 # submits a phantom volume with the client (Poisson surface and TetGen volume
 # mesh), fetches the meshes and the report, and stops the server. Idempotent.

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: AGPL-3.0-or-later
 # Installs every Debian 12 package labelmesh needs to build, test and run.
 # Used by README.md, .ci/run and the Dockerfile, so all three install the same way.
 set -euo pipefail

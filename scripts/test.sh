@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: AGPL-3.0-or-later
 # The test command: installs dependencies, builds (Release with assertions
 # on), and runs the whole suite with ctest. Idempotent.
 # Usage: scripts/test.sh            the suite

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // JobEvents between a worker process and the server over a pipe, each as a
 // varint length and the serialized message (protobuf's delimited form).
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // Every job the server knows: the queue, each job's state and event history,
 // and the waits of workers and watchers. Each state change is written to the
 // spool before it is visible to anyone.

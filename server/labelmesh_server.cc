@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 #include "server/labelmesh_server.h"
 
 #include <grpcpp/ext/proto_server_reflection_plugin.h>
@@ -14,6 +15,7 @@
 #include "server/metrics.h"
 #include "server/spool.h"
 #include "server/worker_pool.h"
+#include "server/worker_process.h"
 #include "spdlog/spdlog.h"
 
 namespace labelmesh::server {
@@ -48,6 +50,7 @@ absl::StatusOr<std::shared_ptr<grpc::ServerCredentials>> credentials(const Serve
 
 absl::StatusOr<std::unique_ptr<LabelmeshServer>> LabelmeshServer::start(ServerConfig config) {
   if (auto status = validate_config(config); !status.ok()) return status;
+  if (auto status = check_worker_version(worker_executable(config)); !status.ok()) return status;
   std::unique_ptr<LabelmeshServer> server(new LabelmeshServer());
   server->config_ = std::move(config);
   const ServerConfig& c = server->config_;

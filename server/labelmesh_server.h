@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // labelmeshd assembled: spool, job table, worker pool, gRPC services
 // (meshing, health, reflection), metrics and the expiry of old results.
 #pragma once

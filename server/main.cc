@@ -1,11 +1,10 @@
-// labelmeshd: the meshing service. Each job runs in a child labelmeshd
-// started in worker mode (`labelmeshd --worker JOB_DIR`).
-#include <fcntl.h>
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// labelmeshd: the meshing service. Each job runs in a child process,
+// labelmesh-worker, which alone links the core meshing library.
 #include <signal.h>
 #include <CLI/CLI.hpp>
 
 #include <cstdio>
-#include <filesystem>
 #include <string_view>
 #include <thread>
 
@@ -77,6 +76,9 @@ void add_server_flags(CLI::App& app, ServerConfig& c) {
                      "CPU-time limit of each worker process (0: twice --job-timeout)")
           ->capture_default_str(),
       "LABELMESHD_WORKER_CPU_SECONDS");
+  env(app.add_option("--worker-executable", c.worker_executable,
+                     "The worker program (default: labelmesh-worker beside labelmeshd)"),
+      "LABELMESHD_WORKER_EXECUTABLE");
   env(app.add_option("--tls-cert", c.tls_cert, "PEM server certificate (chain)"),
       "LABELMESHD_TLS_CERT");
   env(app.add_option("--tls-key", c.tls_key, "PEM private key of --tls-cert"),
@@ -105,18 +107,6 @@ sigset_t stop_signals() {
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (argc >= 2 && std::string_view(argv[1]) == labelmesh::server::kWorkerMode) {
-    // Only labelmeshd starts this mode, with the event pipe as descriptor 3:
-    // refuse anything else (`--worker 4` typed for `--workers 4`, say).
-    if (argc != 3 || fcntl(3, F_GETFD) == -1 ||
-        !std::filesystem::is_regular_file(std::filesystem::path(argv[2]) / "job.pb")) {
-      std::fprintf(stderr,
-                   "labelmeshd --worker JOB_DIR is started by labelmeshd itself, with a job "
-                   "directory and an event pipe; did you mean --workers?\n");
-      return 2;
-    }
-    return labelmesh::server::worker_main(argv[2], 3);
-  }
   // Blocked before any thread starts, so every thread inherits the mask.
   const sigset_t signals = stop_signals();
   pthread_sigmask(SIG_BLOCK, &signals, nullptr);

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 #include "server/meshing_service.h"
 
 #include <filesystem>
@@ -5,7 +6,7 @@
 
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
-#include "core/report.h"
+#include "core/pipeline/job_options.h"
 #include "server/sha256.h"
 #include "server/upload_checks.h"
 #include "spdlog/spdlog.h"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // The gRPC MeshingService: uploads become jobs, jobs are watched, cancelled,
 // listed, and their results fetched. The work itself is the worker pool's.
 #pragma once

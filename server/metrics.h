@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // The server's Prometheus metrics, all named labelmesh_*, in base units.
 #pragma once
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // Everything labelmeshd can be told, with its defaults. Flags and LABELMESHD_*
 // environment variables fill it (main.cc); tests build it directly.
 #pragma once
@@ -45,8 +46,8 @@ struct ServerConfig {
   // Allow a non-loopback listen address without TLS.
   bool insecure = false;
 
-  // The worker started as `<it> --worker JOB_DIR`; empty for this process's
-  // own executable (labelmeshd in worker mode), through /proc/self/exe.
+  // The worker started as `<it> --worker JOB_DIR`; empty for labelmesh-worker
+  // beside this process's own executable. Its --version must match ours.
   std::string worker_executable;
 
   bool tls() const { return !tls_cert.empty(); }

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // SHA-256 of byte streams and files, as lowercase hex: how uploads and
 // fetched artifacts are checked end to end.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // The spool directory: every accepted job and its files, on disk before the
 // client hears "accepted", so that a crash or restart loses nothing.
 //

@@ -1,9 +1,10 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 #include "server/upload_checks.h"
 
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_replace.h"
-#include "core/report.h"
+#include "core/pipeline/job_options.h"
 #include "core/volume/volume_header.h"
 #include "server/sha256.h"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // Checks of an upload before it becomes a job: the spec, then the bytes, then
 // the volume's header with our own validation, before any library reader.
 #pragma once

@@ -1,17 +1,25 @@
-// `labelmeshd --worker JOB_DIR`: one job, run with the core library, its
-// events sent to the parent labelmeshd over file descriptor 3. The server
-// kills it to stop it.
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// labelmesh-worker: one job, run with the core library, its events sent to
+// the parent labelmeshd over file descriptor 3. The server kills it to stop
+// it. Only this program links the core library (CGAL, VTK, TetGen); the
+// serving process does not.
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+
+#include <fcntl.h>
+#include <filesystem>
 #include <fstream>
 #include <new>
+#include <string_view>
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_replace.h"
-#include "core/pipeline.h"
-#include "core/report.h"
+#include "core/pipeline/job_options.h"
+#include "core/pipeline/pipeline.h"
+#include "core/pipeline/report.h"
+#include "core/pipeline/write_results.h"
 #include "server/event_pipe.h"
 #include "server/worker_process.h"
 
@@ -109,7 +117,7 @@ absl::Status run_job(const std::string& job_dir, int fd) {
 
 }  // namespace
 
-int worker_main(const std::string& job_dir, int event_fd) {
+int run_worker(const std::string& job_dir, int event_fd) {
   absl::Status status;
   try {
     status = run_job(job_dir, event_fd);
@@ -123,3 +131,21 @@ int worker_main(const std::string& job_dir, int event_fd) {
 }
 
 }  // namespace labelmesh::server
+
+int main(int argc, char** argv) {
+  using labelmesh::server::kWorkerMode;
+  if (argc == 2 && std::string_view(argv[1]) == "--version") {
+    std::printf("%s\n", labelmesh::server::kWorkerVersionLine);
+    return 0;
+  }
+  // Only labelmeshd starts it, with the event pipe as descriptor 3: refuse
+  // anything else.
+  if (argc != 3 || std::string_view(argv[1]) != kWorkerMode || fcntl(3, F_GETFD) == -1 ||
+      !std::filesystem::is_regular_file(std::filesystem::path(argv[2]) / "job.pb")) {
+    std::fprintf(stderr,
+                 "labelmesh-worker runs one job for labelmeshd, which starts it as "
+                 "`labelmesh-worker --worker JOB_DIR` with an event pipe; it is not run by hand\n");
+    return 2;
+  }
+  return labelmesh::server::run_worker(argv[2], 3);
+}

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 #include "server/worker_pool.h"
 
 #include <algorithm>
@@ -13,10 +14,7 @@ namespace labelmesh::server {
 
 WorkerPool::WorkerPool(JobTable& table, const Spool& spool, const ServerConfig& config)
     : table_(table), spool_(spool), config_(config) {
-  // /proc/self/exe is this very binary even after an upgrade has replaced
-  // the file on disk: workers match the server that starts them.
-  executable_ =
-      config.worker_executable.empty() ? std::string("/proc/self/exe") : config.worker_executable;
+  executable_ = worker_executable(config);
 }
 
 WorkerPool::~WorkerPool() { join(); }

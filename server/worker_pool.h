@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // Threads that take queued jobs and run each in a worker process.
 #pragma once
 

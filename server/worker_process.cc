@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 #include "server/worker_process.h"
 
 #include <fcntl.h>
@@ -9,10 +10,12 @@
 
 #include <cerrno>
 #include <cstring>
+#include <filesystem>
 #include <optional>
 #include <vector>
 
 #include "absl/status/status.h"
+#include "absl/strings/ascii.h"
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 #include "server/event_pipe.h"
@@ -196,6 +199,51 @@ WorkerOutcome run_worker_process(const WorkerRun& run) {
   if (stopped) return *stopped;
   if (result) return *result;
   return outcome_of_exit(wait_status);
+}
+
+std::string worker_executable(const ServerConfig& config) {
+  if (!config.worker_executable.empty()) return config.worker_executable;
+  std::error_code error;
+  const auto self = std::filesystem::read_symlink("/proc/self/exe", error);
+  return (error ? std::filesystem::path("labelmesh-worker")
+                : self.parent_path() / "labelmesh-worker")
+      .string();
+}
+
+absl::Status check_worker_version(const std::string& executable) {
+  int out[2];
+  if (pipe2(out, O_CLOEXEC) != 0) return absl::InternalError("cannot create a pipe");
+  std::string path = executable, flag = "--version";
+  std::vector<char*> argv{path.data(), flag.data(), nullptr};
+  const pid_t pid = fork();
+  if (pid == 0) {
+    dup2(out[1], STDOUT_FILENO);
+    execv(argv[0], argv.data());
+    _exit(127);
+  }
+  ::close(out[1]);
+  std::string printed;
+  char buffer[256];
+  for (ssize_t n;
+       pid > 0 && printed.size() < 4096 && (n = ::read(out[0], buffer, sizeof buffer)) != 0;) {
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) break;
+    printed.append(buffer, size_t(n));
+  }
+  ::close(out[0]);
+  int status = 0;
+  if (pid > 0) waitpid(pid, &status, 0);
+  const std::string line(absl::StripAsciiWhitespace(printed));
+  if (pid > 0 && WIFEXITED(status) && WEXITSTATUS(status) == 0 && line == kWorkerVersionLine)
+    return absl::OkStatus();
+  if (pid > 0 && WIFEXITED(status) && WEXITSTATUS(status) == 127)
+    return absl::FailedPreconditionError(
+        absl::StrCat("worker ", executable,
+                     ": cannot be run (install labelmesh-worker beside "
+                     "labelmeshd, or name it with --worker-executable)"));
+  return absl::FailedPreconditionError(absl::StrCat("worker ", executable, ": --version printed '",
+                                                    line.substr(0, 80), "', expected '",
+                                                    kWorkerVersionLine, "'"));
 }
 
 }  // namespace labelmesh::server

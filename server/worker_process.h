@@ -1,4 +1,5 @@
-// Runs one job in a child process (`labelmeshd --worker JOB_DIR`) under
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// Runs one job in a child process (`labelmesh-worker --worker JOB_DIR`) under
 // resource limits: CGAL Poisson and TetGen cannot be interrupted mid-call and
 // may crash on hostile geometry, so a job that must stop is killed, and a
 // crash takes only its own job down.
@@ -8,8 +9,10 @@
 #include <functional>
 #include <string>
 
+#include "absl/status/status.h"
 #include "absl/time/time.h"
 #include "labelmesh/v1/service.pb.h"
+#include "server/server_config.h"
 
 namespace labelmesh::server {
 
@@ -51,15 +54,20 @@ struct WorkerRun {
   std::function<StopRequest()> stop_request;
 };
 
-// The first argument that makes labelmeshd a worker rather than a server.
+// The first argument of a worker started for a job.
 inline constexpr char kWorkerMode[] = "--worker";
+// What `labelmesh-worker --version` prints, and what the server expects.
+inline constexpr char kWorkerVersionLine[] = "labelmesh-worker " LABELMESH_VERSION;
 
 WorkerOutcome run_worker_process(const WorkerRun& run);
 
-// The child's side: runs the pipeline on JOB_DIR/input<ext> into JOB_DIR/out
-// and writes events to `event_fd`. Returns the process exit code. Defined in
-// worker_main.cc, which only labelmeshd links: the server library itself
-// never calls the core pipeline.
-int worker_main(const std::string& job_dir, int event_fd);
+// The worker executable of `config`: its own, else labelmesh-worker beside
+// the running executable.
+std::string worker_executable(const ServerConfig& config);
+
+// Runs `executable --version` and checks that it prints kWorkerVersionLine,
+// so a server never runs jobs on a worker of another version.
+// FAILED_PRECONDITION naming the executable otherwise.
+absl::Status check_worker_version(const std::string& executable);
 
 }  // namespace labelmesh::server

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // Volume-element quality metrics used by every volume mesher: the tetrahedron quality
 // Q = 1/A_gamma, the Jacobian ratio of hexahedra, wedges and pyramids, a signed aspect ratio for
 // pyramids, and the quality categories of Table 1. Reference for the whole file: §2.4.1 of "From
@@ -15,7 +16,7 @@
 #include <span>
 #include <utility>
 
-#include "core/geometry/vec3.h"
+#include "core/util/vec3.h"
 
 namespace labelmesh::quality {
 

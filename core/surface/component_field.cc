@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 #include "core/surface/component_field.h"
 
 #include <cmath>
@@ -6,7 +7,7 @@
 #include <vtkImageGaussianSmooth.h>
 #include <vtkNew.h>
 
-#include "core/text.h"
+#include "core/util/text.h"
 
 namespace labelmesh::surface {
 

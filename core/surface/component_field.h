@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // One label component's voxel mask as a field for the level-set mesher: 1 in
 // the component, 0 elsewhere, optionally smoothed with a Gaussian so the
 // level set at one half loses the voxels' staircase.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 #include "core/surface/extract_surfaces.h"
 
 #include <vtkCellArray.h>
@@ -10,7 +11,7 @@
 #include <vtkPolyData.h>
 
 #include "core/surface/surface_statistics.h"
-#include "core/text.h"
+#include "core/util/text.h"
 
 namespace labelmesh::surface {
 namespace {

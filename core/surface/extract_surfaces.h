@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // Marching Cubes surfaces of labels (paper §2.2), with VTK's discrete flying
 // edges: one closed surface per label, in patient (LPS) space, outward.
 #pragma once
@@ -6,8 +7,8 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
-#include "core/run_context.h"
 #include "core/surface/triangle_mesh.h"
+#include "core/util/run_context.h"
 #include "core/volume/label_components.h"
 #include "core/volume/label_statistics.h"
 #include "core/volume/label_volume.h"

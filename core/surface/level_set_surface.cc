@@ -1,7 +1,9 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // CGAL's surface mesher on a trilinearly interpolated voxel grid, its
 // crossings found by bisection. Its own translation unit: the mesher's headers
 // are slow to compile.
 #include "core/surface/level_set_surface.h"
+#include "core/util/exception_status.h"
 
 #include <algorithm>
 #include <cmath>
@@ -14,9 +16,9 @@
 #include <CGAL/grid_simplify_point_set.h>
 #include <CGAL/make_surface_mesh.h>
 
-#include "core/surface/cgal_mesh.h"
-#include "core/surface/restricted_delaunay.h"
-#include "core/text.h"
+#include "core/surface/cgal/cgal_mesh.h"
+#include "core/surface/cgal/restricted_delaunay.h"
+#include "core/util/text.h"
 
 namespace labelmesh::surface {
 namespace {
@@ -279,8 +281,8 @@ absl::StatusOr<TriangleMesh> mesh_level_set(const ScalarGrid& grid, const LevelS
   } catch (const BudgetSpent&) {
     return absl::ResourceExhaustedError(
         "level-set: the mesher did not settle within its budget of field evaluations");
-  } catch (const std::exception& e) {
-    return absl::InternalError(cat("level-set: ", e.what()));
+  } catch (...) {
+    return current_exception_status("level-set");
   }
 }
 

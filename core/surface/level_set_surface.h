@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // A closed surface where a sampled field crosses a level: CGAL's surface
 // mesher on the trilinear interpolation of a voxel grid. Run on a label's
 // (lightly smoothed) voxel mask just under one half, it gives the Marching Cubes
@@ -10,8 +11,8 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
-#include "core/run_context.h"
 #include "core/surface/triangle_mesh.h"
+#include "core/util/run_context.h"
 
 namespace labelmesh::surface {
 

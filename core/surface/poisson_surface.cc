@@ -1,6 +1,8 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // The only translation unit that instantiates CGAL's Poisson reconstruction and
 // surface mesher: it is slow to compile, so nothing else includes these headers.
 #include "core/surface/poisson_surface.h"
+#include "core/util/exception_status.h"
 
 #include <algorithm>
 #include <array>
@@ -17,15 +19,15 @@
 #include <CGAL/make_surface_mesh.h>
 #include <CGAL/property_map.h>
 
-#include "core/side_by_side.h"
-#include "core/stage_timer.h"
-#include "core/surface/cgal_mesh.h"
-#include "core/surface/hinted_poisson_evaluator.h"
-#include "core/surface/mesher_seeds.h"
-#include "core/surface/poisson_linear_system.h"
-#include "core/surface/restricted_delaunay.h"
-#include "core/surface/zero_level_oracle.h"
-#include "core/text.h"
+#include "core/surface/cgal/cgal_mesh.h"
+#include "core/surface/cgal/restricted_delaunay.h"
+#include "core/surface/poisson/hinted_poisson_evaluator.h"
+#include "core/surface/poisson/mesher_seeds.h"
+#include "core/surface/poisson/poisson_linear_system.h"
+#include "core/surface/poisson/zero_level_oracle.h"
+#include "core/util/side_by_side.h"
+#include "core/util/stage_timer.h"
+#include "core/util/text.h"
 
 namespace labelmesh::surface {
 namespace {
@@ -343,12 +345,6 @@ absl::StatusOr<TriangleMesh> reconstruct_in_halves(const std::vector<OrientedPoi
 
 }  // namespace
 
-absl::Status check_point_count(std::string_view field, uint64_t value) {
-  if (value == 0 || value >= kMinPointBudget) return absl::OkStatus();
-  return absl::InvalidArgumentError(
-      cat(field, ": ", value, " is neither 0 (off) nor at least ", kMinPointBudget));
-}
-
 absl::StatusOr<TriangleMesh> reconstruct_poisson_surface(
     const std::vector<geometry::Vec3>& points, const std::vector<geometry::Vec3>& normals,
     const PoissonParams& params, const RunContext& context, PoissonFigures& figures,
@@ -379,9 +375,9 @@ absl::StatusOr<TriangleMesh> reconstruct_poisson_surface(
     return reconstruct_whole(oriented, params, context, figures, beside_meshing);
   } catch (const Cancelled&) {
     return absl::CancelledError("the run was cancelled");
-  } catch (const std::exception& e) {
+  } catch (...) {
     // CGAL's failed preconditions and assertions, bad_alloc.
-    return absl::InternalError(cat("poisson: ", e.what()));
+    return current_exception_status("poisson");
   }
 }
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // Poisson surface reconstruction (paper §2.3, CGAL): a smooth closed surface
 // from oriented points, meshed by Delaunay refinement with a minimum angle.
 #pragma once
@@ -9,9 +10,9 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
-#include "core/geometry/vec3.h"
-#include "core/run_context.h"
 #include "core/surface/triangle_mesh.h"
+#include "core/util/run_context.h"
+#include "core/util/vec3.h"
 
 namespace labelmesh::surface {
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 #include "core/surface/smooth_surface.h"
 
 #include <cmath>
@@ -8,7 +9,7 @@
 #include <vtkWindowedSincPolyDataFilter.h>
 
 #include "core/surface/write_surface.h"
-#include "core/text.h"
+#include "core/util/text.h"
 
 namespace labelmesh::surface {
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // Low-pass smoothing of a staircase surface before Poisson reconstruction:
 // VTK's windowed-sinc filter (Taubin, Zhang & Golub, "Optimal surface
 // smoothing as filter design", 1996), which removes the voxel-scale ripple
@@ -5,8 +6,8 @@
 #pragma once
 
 #include "absl/status/statusor.h"
-#include "core/run_context.h"
 #include "core/surface/triangle_mesh.h"
+#include "core/util/run_context.h"
 
 namespace labelmesh::surface {
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 #include "core/surface/surface_checks.h"
 
 #include <algorithm>
@@ -13,9 +14,9 @@
 #include <CGAL/Polygon_mesh_processing/self_intersections.h>
 #include <CGAL/hilbert_sort.h>
 
-#include "core/geometry/vec3.h"
-#include "core/side_by_side.h"
-#include "core/surface/cgal_mesh.h"
+#include "core/surface/cgal/cgal_mesh.h"
+#include "core/util/side_by_side.h"
+#include "core/util/vec3.h"
 
 namespace labelmesh::surface {
 namespace {

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // Geometric checks of a finished surface with CGAL: self-intersections and
 // the distance to another surface (how far a reconstruction strays from the
 // Marching Cubes surface it came from).
@@ -8,8 +9,8 @@
 #include <memory>
 #include <optional>
 
-#include "core/run_context.h"
 #include "core/surface/triangle_mesh.h"
+#include "core/util/run_context.h"
 
 namespace labelmesh::surface {
 

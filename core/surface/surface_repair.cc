@@ -1,6 +1,8 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // CGAL Polygon_mesh_processing repair: every defect is found and fixed by
 // CGAL; this file only chooses the order and counts what changed.
 #include "core/surface/surface_repair.h"
+#include "core/util/exception_status.h"
 
 #include <algorithm>
 #include <array>
@@ -18,8 +20,8 @@
 #include <CGAL/Polygon_mesh_processing/shape_predicates.h>
 #include <CGAL/Polygon_mesh_processing/triangulate_hole.h>
 
-#include "core/surface/cgal_mesh.h"
-#include "core/text.h"
+#include "core/surface/cgal/cgal_mesh.h"
+#include "core/util/text.h"
 
 namespace labelmesh::surface {
 namespace {
@@ -98,10 +100,8 @@ absl::StatusOr<Mesh> mesh_from_soup(const TriangleMesh& input, RepairCounts& cou
   return mesh;
 }
 
-}  // namespace
-
-absl::StatusOr<TriangleMesh> repair_surface(const TriangleMesh& input, const RepairParams& params,
-                                            const RunContext& context, RepairCounts& counts) {
+absl::StatusOr<TriangleMesh> repair(const TriangleMesh& input, const RepairParams& params,
+                                    const RunContext& context, RepairCounts& counts) {
   counts = RepairCounts{};
   auto built = mesh_from_soup(input, counts);
   if (!built.ok()) return built.status();
@@ -150,6 +150,17 @@ absl::StatusOr<TriangleMesh> repair_surface(const TriangleMesh& input, const Rep
   PMP::remove_isolated_vertices(mesh);
   mesh.collect_garbage();
   return cgal::from_surface_mesh(mesh);
+}
+
+}  // namespace
+
+absl::StatusOr<TriangleMesh> repair_surface(const TriangleMesh& input, const RepairParams& params,
+                                            const RunContext& context, RepairCounts& counts) {
+  try {
+    return repair(input, params, context, counts);
+  } catch (...) {
+    return current_exception_status("repair");
+  }
 }
 
 }  // namespace labelmesh::surface

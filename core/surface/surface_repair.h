@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // Repair of a Marching Cubes surface (paper §2.2, "MC improved" in Table 2),
 // with CGAL Polygon_mesh_processing: the result is a closed, outward,
 // 2-manifold surface without degenerate or sharp triangles.
@@ -6,8 +7,8 @@
 #include <cstdint>
 
 #include "absl/status/statusor.h"
-#include "core/run_context.h"
 #include "core/surface/triangle_mesh.h"
+#include "core/util/run_context.h"
 
 namespace labelmesh::surface {
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 #include "core/surface/surface_statistics.h"
 
 #include <algorithm>
@@ -6,8 +7,8 @@
 #include <numbers>
 #include <numeric>
 
-#include "core/geometry/disjoint_sets.h"
-#include "core/geometry/vec3.h"
+#include "core/util/disjoint_sets.h"
+#include "core/util/vec3.h"
 
 namespace labelmesh::surface {
 namespace {

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // Statistics of a triangle surface: the paper's Table 2 (nodes, triangles,
 // min and max angle) plus the topology and geometry checks a mesher needs.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // A triangle surface in patient space: shared vertices, counter-clockwise
 // triangles seen from outside (normals point out of the material).
 #pragma once

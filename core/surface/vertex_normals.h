@@ -1,11 +1,12 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // Vertex normals of a triangle surface, the input of Poisson reconstruction
 // (paper §2.3: the average of the normals of the triangles around a vertex).
 #pragma once
 
 #include <vector>
 
-#include "core/geometry/vec3.h"
 #include "core/surface/triangle_mesh.h"
+#include "core/util/vec3.h"
 
 namespace labelmesh::surface {
 

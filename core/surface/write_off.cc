@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // OFF output through CGAL's polygon-soup writer. The only CGAL translation
 // unit of the surface writers, so CGAL's compile cost stays here.
 #include <CGAL/IO/OFF.h>
@@ -6,7 +7,8 @@
 #include <fstream>
 
 #include "core/surface/write_surface.h"
-#include "core/text.h"
+#include "core/util/exception_status.h"
+#include "core/util/text.h"
 
 namespace labelmesh::surface {
 
@@ -21,9 +23,13 @@ absl::Status write_off(const TriangleMesh& mesh, const std::string& path) {
   std::ofstream out(path);
   // 17 significant digits: doubles survive the round trip exactly.
   out.precision(17);
-  if (!out || !CGAL::IO::write_OFF(out, points, polygons)) {
-    return absl::InternalError(cat(path, ": could not write the surface"));
+  bool written = false;
+  try {
+    written = out && CGAL::IO::write_OFF(out, points, polygons);
+  } catch (...) {
+    return current_exception_status(path);
   }
+  if (!written) return absl::InternalError(cat(path, ": could not write the surface"));
   return absl::OkStatus();
 }
 

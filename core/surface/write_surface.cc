@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 #include "core/surface/write_surface.h"
 
 #include <vtkCellArray.h>
@@ -10,8 +11,8 @@
 #include <vtkSTLWriter.h>
 #include <vtkXMLPolyDataWriter.h>
 
-#include "core/text.h"
-#include "core/vtk_error_flag.h"
+#include "core/util/text.h"
+#include "core/util/vtk_error_flag.h"
 
 namespace labelmesh::surface {
 namespace {
@@ -30,36 +31,6 @@ absl::Status run_writer(Writer* writer, vtkPolyData* polydata, const std::string
 }
 
 }  // namespace
-
-std::optional<SurfaceFormat> surface_format_from_name(std::string_view name) {
-  for (SurfaceFormat format : all_surface_formats()) {
-    if (surface_format_name(format) == name) return format;
-  }
-  return std::nullopt;
-}
-
-std::string_view surface_format_name(SurfaceFormat format) {
-  switch (format) {
-    case SurfaceFormat::kStl:
-      return "stl";
-    case SurfaceFormat::kPly:
-      return "ply";
-    case SurfaceFormat::kObj:
-      return "obj";
-    case SurfaceFormat::kOff:
-      return "off";
-    case SurfaceFormat::kVtp:
-      return "vtp";
-  }
-  return "unknown";
-}
-
-const std::vector<SurfaceFormat>& all_surface_formats() {
-  static const std::vector<SurfaceFormat> kAll{SurfaceFormat::kStl, SurfaceFormat::kPly,
-                                               SurfaceFormat::kObj, SurfaceFormat::kOff,
-                                               SurfaceFormat::kVtp};
-  return kAll;
-}
 
 vtkSmartPointer<vtkPolyData> to_polydata(const TriangleMesh& mesh) {
   vtkNew<vtkPoints> points;

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // Surface mesh files: STL (binary), PLY (binary), OBJ, OFF and VTP.
 #pragma once
 
@@ -9,19 +10,12 @@
 #include <vtkSmartPointer.h>
 
 #include "absl/status/status.h"
+#include "core/surface/surface_format.h"
 #include "core/surface/triangle_mesh.h"
 
 class vtkPolyData;
 
 namespace labelmesh::surface {
-
-enum class SurfaceFormat { kStl, kPly, kObj, kOff, kVtp };
-
-// "stl", "ply", "obj", "off" or "vtp"; nullopt otherwise.
-std::optional<SurfaceFormat> surface_format_from_name(std::string_view name);
-// The file extension without the dot; also the format's name.
-std::string_view surface_format_name(SurfaceFormat format);
-const std::vector<SurfaceFormat>& all_surface_formats();
 
 // The mesh as VTK polygons (points in mm, triangles as given).
 vtkSmartPointer<vtkPolyData> to_polydata(const TriangleMesh& mesh);

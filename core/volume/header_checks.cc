@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 #include "core/volume/header_checks.h"
 
 #include <cerrno>
@@ -9,7 +10,7 @@
 #include <limits>
 #include <memory>
 
-#include "core/text.h"
+#include "core/util/text.h"
 #include "core/volume/payload_stream.h"
 
 namespace labelmesh::volume::internal {

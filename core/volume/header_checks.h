@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // Checks shared by the per-format header parsers: field errors that name the
 // file, overflow-safe dimension products, and bounded looks at payloads.
 #pragma once

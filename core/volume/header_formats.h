@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // One parser per file format; check_volume_header() picks among them.
 #pragma once
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // INRIMAGE-4 header checks. The header is "#INRIMAGE-4#{", KEY=VALUE lines,
 // newline padding to a multiple of 256 bytes, and "##}"; the voxels follow,
 // and .inr.gz compresses header and voxels together. INR has no anatomical
@@ -5,7 +6,7 @@
 // (CGAL's translation keys) when present.
 #include <cmath>
 
-#include "core/text.h"
+#include "core/util/text.h"
 #include "core/volume/header_checks.h"
 #include "core/volume/header_formats.h"
 #include "core/volume/text_header.h"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 #include "core/volume/label_components.h"
 
 #include <algorithm>
@@ -5,7 +6,7 @@
 #include <limits>
 #include <vector>
 
-#include "core/geometry/disjoint_sets.h"
+#include "core/util/disjoint_sets.h"
 #include "core/volume/voxel_access.h"
 
 namespace labelmesh::volume {

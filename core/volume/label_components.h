@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // Connected pieces of one label (26-connected voxels), so that each piece can
 // be reconstructed on its own and tiny islands can be dropped.
 #pragma once
@@ -10,7 +11,7 @@
 #include <vtkSmartPointer.h>
 
 #include "absl/status/statusor.h"
-#include "core/run_context.h"
+#include "core/util/run_context.h"
 #include "core/volume/label_statistics.h"
 #include "core/volume/label_volume.h"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // Voxel counts and index bounding boxes per label, in one pass over a volume.
 #pragma once
 

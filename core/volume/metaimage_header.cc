@@ -1,9 +1,10 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // MetaImage (.mha/.mhd) header checks. Keys follow MetaIO; TransformMatrix
 // lists the direction of voxel axis 0, then 1, then 2 (as ITK reads it), in
 // LPS, which is MetaImage's (ITK's) frame.
 #include <cmath>
 
-#include "core/text.h"
+#include "core/util/text.h"
 #include "core/volume/header_checks.h"
 #include "core/volume/header_formats.h"
 #include "core/volume/text_header.h"

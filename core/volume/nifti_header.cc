@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // NIfTI-1/2 header checks. Field offsets follow the NIfTI-1 (nifti1.h) and
 // NIfTI-2 (nifti2.h) layouts. The affine comes from the sform when
 // sform_code > 0, else the qform (quaternion + qfac), else pixdim alone
@@ -6,7 +7,7 @@
 #include <cmath>
 #include <cstring>
 
-#include "core/text.h"
+#include "core/util/text.h"
 #include "core/volume/header_checks.h"
 #include "core/volume/header_formats.h"
 

@@ -1,8 +1,9 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // NRRD (.nrrd attached, .nhdr detached) header checks, after the NRRD0004/5
 // format definition: "field: value" lines, a blank line before attached data.
 #include <cmath>
 
-#include "core/text.h"
+#include "core/util/text.h"
 #include "core/volume/header_checks.h"
 #include "core/volume/header_formats.h"
 #include "core/volume/text_header.h"

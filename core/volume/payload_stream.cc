@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 #include "core/volume/payload_stream.h"
 
 #include <zlib.h>
@@ -5,7 +6,7 @@
 #include <algorithm>
 #include <filesystem>
 
-#include "core/text.h"
+#include "core/util/text.h"
 #include "core/volume/header_checks.h"
 
 namespace labelmesh::volume::internal {

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // Sequential, bounded reading of voxel bytes stored raw, gzip or zlib
 // compressed, from some offset of a file. Used both to check that a payload
 // is long enough and to read it; it never decodes more than it is asked for,

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // Synthetic label volumes with known analytic geometry, for the demo and for
 // accuracy tests. Every voxel is labelled by the shape at its centre.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // The grid and rasteriser every phantom is drawn with.
 #pragma once
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 #include "core/volume/read_label_volume.h"
 
 #include <bit>
@@ -12,10 +13,10 @@
 #include <vtkPointData.h>
 #include <vtkXMLImageDataReader.h>
 
-#include "core/text.h"
+#include "core/util/text.h"
+#include "core/util/vtk_error_flag.h"
 #include "core/volume/header_checks.h"
 #include "core/volume/payload_stream.h"
-#include "core/vtk_error_flag.h"
 
 namespace labelmesh::volume {
 namespace {

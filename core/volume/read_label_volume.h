@@ -1,10 +1,11 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // Reads a label volume from any supported file, in patient (LPS) space.
 #pragma once
 
 #include <string>
 
 #include "absl/status/statusor.h"
-#include "core/run_context.h"
+#include "core/util/run_context.h"
 #include "core/volume/label_volume.h"
 #include "core/volume/volume_header.h"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // Planes of a label volume that repeat the plane before them. A segmentation
 // drawn on every third slice and resampled to thinner slices by nearest
 // neighbour holds runs of three equal slices: its surfaces step three voxels

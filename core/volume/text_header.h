@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // Line-oriented "key = value" / "key: value" headers (MetaImage, NRRD, INR).
 #pragma once
 

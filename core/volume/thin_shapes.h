@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // A multi-label phantom of the thin and small structures AI segmentations are
 // full of (ribs, vessels, cortex, stray voxels), each a label of its own, for
 // the never-crash and faithfulness tests of the surface pipeline.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // Our own validation of label-volume headers. It runs before any library
 // reader sees a file: Debian's VTK 9.1 bundles MetaIO and nifticlib versions
 // with published header-overflow bugs, and uploads are untrusted. Every field
@@ -10,7 +11,7 @@
 #include <string_view>
 
 #include "absl/status/statusor.h"
-#include "core/volume/label_volume.h"
+#include "core/volume/image_geometry.h"
 
 namespace labelmesh::volume {
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // Typed access to the voxels of a LabelVolume without repeating a type switch
 // in every algorithm. Label volumes in memory hold int8, uint8, int16, uint16
 // or int32 voxels (read_label_volume converts everything else to int32).

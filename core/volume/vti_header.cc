@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // VTK XML image data (.vti) header checks: the <ImageData> element's extent,
 // origin, spacing and direction, and the type of the first point-data array.
 // Array payloads (inline, appended, compressed) are then decoded by VTK's XML
@@ -6,7 +7,7 @@
 #include <cmath>
 #include <optional>
 
-#include "core/text.h"
+#include "core/util/text.h"
 #include "core/volume/header_checks.h"
 #include "core/volume/header_formats.h"
 

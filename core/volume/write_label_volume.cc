@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 #include "core/volume/write_label_volume.h"
 
 #include <zlib.h>
@@ -16,9 +17,9 @@
 #include <vtkPointData.h>
 #include <vtkXMLImageDataWriter.h>
 
-#include "core/text.h"
+#include "core/util/text.h"
+#include "core/util/vtk_error_flag.h"
 #include "core/volume/volume_header.h"
-#include "core/vtk_error_flag.h"
 
 namespace labelmesh::volume {
 namespace {

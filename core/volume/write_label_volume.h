@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // Writes a label volume in any format labelmesh reads, keeping its placement.
 #pragma once
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 #include "core/volume_mesh/improve_tet_mesh.h"
 
 #include <algorithm>
@@ -9,8 +10,8 @@
 #include <unordered_set>
 #include <vector>
 
-#include "core/geometry/vec3.h"
 #include "core/quality/element_quality.h"
+#include "core/util/vec3.h"
 
 namespace labelmesh::volume_mesh {
 namespace {

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // Mesh improvement after TetGen: local operations that raise the
 // worst tetrahedron quality Q without touching the boundary.
 #pragma once
@@ -5,7 +6,7 @@
 #include <cstddef>
 #include <cstdint>
 
-#include "core/run_context.h"
+#include "core/util/run_context.h"
 #include "core/volume_mesh/tet_mesh.h"
 
 namespace labelmesh::volume_mesh {

@@ -1,11 +1,12 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 #include "core/volume_mesh/tet_mesh.h"
 
 #include <algorithm>
 #include <tuple>
 
-#include "core/geometry/vec3.h"
 #include "core/quality/element_quality.h"
-#include "core/text.h"
+#include "core/util/text.h"
+#include "core/util/vec3.h"
 
 namespace labelmesh::volume_mesh {
 

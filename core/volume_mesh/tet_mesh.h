@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // A tetrahedral volume mesh in patient space: shared points, tetrahedra in
 // VTK's node ordering, and the label (region) each tetrahedron fills.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 #include "core/volume_mesh/tetrahedralize.h"
 
 #include <algorithm>
@@ -12,9 +13,9 @@
 #include <tuple>
 #include <vector>
 
-#include "core/geometry/disjoint_sets.h"
-#include "core/geometry/vec3.h"
-#include "core/text.h"
+#include "core/util/disjoint_sets.h"
+#include "core/util/text.h"
+#include "core/util/vec3.h"
 
 // TetGen's library interface: errors are thrown as ints instead of ending the process. The
 // library itself is built this way, so its inline functions must be seen the same way here.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // Quality tetrahedral meshes of the region a closed surface encloses, with TetGen 1.5: a
 // constrained Delaunay tetrahedralization refined by Shewchuk's Delaunay refinement. Reference:
 // H. Si, "TetGen: A Quality Tetrahedral Mesh Generator and a 3D Delaunay Triangulator,
@@ -9,8 +10,8 @@
 #include <cstdint>
 
 #include "absl/status/statusor.h"
-#include "core/run_context.h"
 #include "core/surface/triangle_mesh.h"
+#include "core/util/run_context.h"
 #include "core/volume_mesh/tet_mesh.h"
 
 namespace labelmesh::volume_mesh {

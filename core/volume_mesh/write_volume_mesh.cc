@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 #include "core/volume_mesh/write_volume_mesh.h"
 
 #include <algorithm>
@@ -21,8 +22,8 @@
 #include <vtkUnstructuredGrid.h>
 #include <vtkXMLUnstructuredGridWriter.h>
 
-#include "core/text.h"
-#include "core/vtk_error_flag.h"
+#include "core/util/text.h"
+#include "core/util/vtk_error_flag.h"
 
 namespace labelmesh::volume_mesh {
 namespace {
@@ -275,36 +276,6 @@ absl::Status write_tetgen(const TetMesh& mesh, const std::string& path) {
 }
 
 }  // namespace
-
-std::optional<VolumeFormat> volume_format_from_name(std::string_view name) {
-  for (VolumeFormat format : all_volume_formats()) {
-    if (volume_format_name(format) == name) return format;
-  }
-  return std::nullopt;
-}
-
-std::string_view volume_format_name(VolumeFormat format) {
-  switch (format) {
-    case VolumeFormat::kVtu:
-      return "vtu";
-    case VolumeFormat::kMsh:
-      return "msh";
-    case VolumeFormat::kMedit:
-      return "mesh";
-    case VolumeFormat::kAbaqus:
-      return "inp";
-    case VolumeFormat::kTetgen:
-      return "node";
-  }
-  return "unknown";
-}
-
-const std::vector<VolumeFormat>& all_volume_formats() {
-  static const std::vector<VolumeFormat> kAll{VolumeFormat::kVtu, VolumeFormat::kMsh,
-                                              VolumeFormat::kMedit, VolumeFormat::kAbaqus,
-                                              VolumeFormat::kTetgen};
-  return kAll;
-}
 
 absl::Status write_volume_mesh(const TetMesh& mesh, const std::vector<double>& cell_quality,
                                const std::string& path, VolumeFormat format) {

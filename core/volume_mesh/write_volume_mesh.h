@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // Tetrahedral mesh files for viewers and finite-element solvers: VTK XML unstructured grid,
 // Gmsh MSH 2.2, Medit, Abaqus/CalculiX input, and TetGen's .node/.ele pair.
 #pragma once
@@ -9,16 +10,9 @@
 
 #include "absl/status/status.h"
 #include "core/volume_mesh/tet_mesh.h"
+#include "core/volume_mesh/volume_format.h"
 
 namespace labelmesh::volume_mesh {
-
-enum class VolumeFormat { kVtu, kMsh, kMedit, kAbaqus, kTetgen };
-
-// "vtu", "msh", "mesh", "inp" or "node"; nullopt otherwise.
-std::optional<VolumeFormat> volume_format_from_name(std::string_view name);
-// The file extension without the dot; also the format's name.
-std::string_view volume_format_name(VolumeFormat format);
-const std::vector<VolumeFormat>& all_volume_formats();
 
 // Writes `mesh` to `path`. Coordinates are written in mm, in full precision. Every format keeps
 // the mesh's node ordering (VTK's, which Gmsh, Medit, TetGen and C3D4 share), so no element is

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // labelmesh_bench [FILE... | --cancellation]: per-stage seconds, voxels per second and peak
 // RSS for reading and Marching Cubes, beside the baselines they are held to:
 // a plain decompress + scan of the voxels, and VTK's discrete flying edges
@@ -25,7 +26,8 @@
 #include <vtkPolyData.h>
 
 #include "bench/mesh3_baseline.h"
-#include "core/pipeline.h"
+#include "core/pipeline/label_tet_meshes.h"
+#include "core/pipeline/pipeline.h"
 #include "core/surface/extract_surfaces.h"
 #include "core/surface/surface_statistics.h"
 #include "core/volume/label_statistics.h"
@@ -33,7 +35,6 @@
 #include "core/volume/phantom.h"
 #include "core/volume/read_label_volume.h"
 #include "core/volume/write_label_volume.h"
-#include "core/volume_meshes.h"
 
 namespace {
 

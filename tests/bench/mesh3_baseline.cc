@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // The only translation unit that instantiates Mesh_3 (slow to compile).
 #include "bench/mesh3_baseline.h"
 

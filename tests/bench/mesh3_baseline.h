@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // CGAL Mesh_3 on one label of a volume: the baseline the issue holds our
 // Poisson + TetGen + improvement pipeline to. Bench only.
 #pragma once

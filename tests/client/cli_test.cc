@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // The labelmesh executable: exit codes, files and the report, end to end.
 #include <google/protobuf/util/json_util.h>
 #include <gtest/gtest.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // Cross-checks of element_quality against VTK 9.1: vtkMeshQuality (Verdict) for tetrahedra, and
 // VTK's own cell definitions (face lists, isoparametric maps) for the corner-Jacobian sign
 // conventions of hexahedra, wedges and pyramids.

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: AGPL-3.0-or-later
 # End to end through the real executables: labelmeshd on a free loopback port,
 # `labelmesh submit` of the liver compared with `labelmesh mesh` of the same
 # file and options, the job commands and their exit codes, the metrics

@@ -1,5 +1,6 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // The service's contract, in-process: every RPC, its status codes, and what
-// the spool holds afterwards. Jobs run in real worker processes (labelmeshd --worker).
+// the spool holds afterwards. Jobs run in real worker processes (labelmesh-worker).
 #include <fcntl.h>
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -14,7 +15,9 @@
 #include "core/volume/phantom.h"
 #include "core/volume/write_label_volume.h"
 #include "server/event_pipe.h"
+#include "server/labelmesh_server.h"
 #include "server/metrics.h"
+#include "server/worker_process.h"
 #include "support/service_harness.h"
 
 namespace labelmesh::testing {
@@ -22,6 +25,10 @@ namespace {
 
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
+
+// A stand-in worker script's first line: labelmeshd checks its version.
+const std::string kAnswersVersion = absl::StrCat("[ \"$1\" = --version ] && { echo '",
+                                                 server::kWorkerVersionLine, "'; exit 0; }\n");
 
 fs::path write_phantom(const fs::path& dir, volume::PhantomShape shape, double scale = 1.0) {
   const fs::path path = dir / "phantom.nii.gz";
@@ -42,10 +49,6 @@ v1::MeshOptions repaired_options() {
   v1::MeshOptions options;
   options.set_surface(v1::SURFACE_METHOD_REPAIRED);
   return options;
-}
-
-bool ended(const v1::JobEvent& event) {
-  return event.has_finished() || event.has_failed() || event.has_cancelled();
 }
 
 class MeshingServiceTest : public ::testing::Test {
@@ -132,7 +135,9 @@ TEST_F(MeshingServiceTest, WholeJobFromUploadToFetchedArtifacts) {
     std::string bytes;
     int chunks = 0;
     while (reader->Read(&chunk)) {
-      if (chunks++ == 0) EXPECT_EQ(chunk.artifact().sha256(), artifact.sha256());
+      if (chunks++ == 0) {
+        EXPECT_EQ(chunk.artifact().sha256(), artifact.sha256());
+      }
       EXPECT_LE(chunk.data().size(), 1u << 20);
       bytes += chunk.data();
     }
@@ -389,9 +394,9 @@ TEST_F(MeshingServiceTest, AResultSentBeforeTheDeadlineStands) {
   }
   const fs::path lingering = dir_ / "lingering-worker.sh";
   // Called as `lingering-worker.sh --worker JOB_DIR`.
-  write_file(lingering,
-             absl::StrCat("#!/bin/sh\nmkdir -p \"$2/out\"\necho '{}' >\"$2/out/report.json\"\n",
-                          "cat '", events.string(), "' >&3\nexec sleep 30\n"));
+  write_file(lingering, absl::StrCat("#!/bin/sh\n", kAnswersVersion,
+                                     "mkdir -p \"$2/out\"\necho '{}' >\"$2/out/report.json\"\n",
+                                     "cat '", events.string(), "' >&3\nexec sleep 30\n"));
   fs::permissions(lingering, fs::perms::owner_all);
   config_.worker_executable = lingering.string();
   config_.job_timeout = absl::Seconds(1);
@@ -529,9 +534,27 @@ TEST_F(MeshingServiceTest, UnknownJobsAndArtifactsAreNotFound) {
   }
 }
 
+TEST_F(MeshingServiceTest, RefusesToStartWithAWorkerOfAnotherVersion) {
+  const fs::path other = dir_ / "other-version-worker.sh";
+  write_file(other, "#!/bin/sh\necho 'labelmesh-worker 0.0.0-other'\n");
+  fs::permissions(other, fs::perms::owner_all);
+  config_.worker_executable = other.string();
+  auto started = server::LabelmeshServer::start(config_);
+  ASSERT_FALSE(started.ok());
+  EXPECT_EQ(started.status().code(), absl::StatusCode::kFailedPrecondition);
+  EXPECT_TRUE(absl::StrContains(started.status().message(), "0.0.0-other"))
+      << started.status().message();
+
+  config_.worker_executable = (dir_ / "no-such-worker").string();
+  started = server::LabelmeshServer::start(config_);
+  ASSERT_FALSE(started.ok());
+  EXPECT_TRUE(absl::StrContains(started.status().message(), "cannot be run"))
+      << started.status().message();
+}
+
 TEST_F(MeshingServiceTest, CrashedWorkerFailsOnlyItsJob) {
   const fs::path crashing = dir_ / "crashing-worker.sh";
-  write_file(crashing, "#!/bin/sh\nkill -SEGV $$\n");
+  write_file(crashing, absl::StrCat("#!/bin/sh\n", kAnswersVersion, "kill -SEGV $$\n"));
   fs::permissions(crashing, fs::perms::owner_all);
   config_.worker_executable = crashing.string();
   ServiceHarness service(config_);

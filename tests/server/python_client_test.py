@@ -1,4 +1,5 @@
 #!/usr/bin/python3
+# SPDX-License-Identifier: AGPL-3.0-or-later
 """Proves the labelmesh gRPC API usable from Python: starts labelmeshd, runs a
 whole job on a sphere phantom (submit, watch, get, list, fetch), and checks two
 error statuses. Exits non-zero with a message on the first failed check."""

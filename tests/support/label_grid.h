@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // Small label volumes drawn voxel by voxel, for tests of exact counts.
 #pragma once
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // A labelmeshd in this process on a free loopback port, with a stub to call
 // it, for tests of the service's contract.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // A CGAL Poisson function solved from oriented points on a torus (ring radius
 // 10, tube radius 4, around z): negative inside the tube, positive outside.
 #pragma once
@@ -11,7 +12,7 @@
 
 #include <CGAL/property_map.h>
 
-#include "core/surface/hinted_poisson_evaluator.h"
+#include "core/surface/poisson/hinted_poisson_evaluator.h"
 
 namespace labelmesh::testing {
 

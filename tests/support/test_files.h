@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // Paths and scratch files for tests.
 #pragma once
 

@@ -1,6 +1,7 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // The surface mesher's evaluator of the Poisson function against CGAL's own
 // evaluation of the same solved function.
-#include "core/surface/hinted_poisson_evaluator.h"
+#include "core/surface/poisson/hinted_poisson_evaluator.h"
 
 #include <gtest/gtest.h>
 

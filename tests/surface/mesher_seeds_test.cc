@@ -1,6 +1,7 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // The surface mesher's seeds on a solved torus: on the zero level, spread
 // over all of it, no two near each other, and what the oracle hands the mesher.
-#include "core/surface/mesher_seeds.h"
+#include "core/surface/poisson/mesher_seeds.h"
 
 #include <gtest/gtest.h>
 

@@ -1,7 +1,8 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // The Poisson solve's own assembly against CGAL's: a torus solved through
 // CGAL's generic solve_poisson and through labelmesh's specialisation gives
 // the same function at every vertex of the same triangulation.
-#include "core/surface/poisson_linear_system.h"
+#include "core/surface/poisson/poisson_linear_system.h"
 
 #include <algorithm>
 #include <cmath>
@@ -15,7 +16,7 @@
 
 #include <CGAL/property_map.h>
 
-#include "core/surface/hinted_poisson_evaluator.h"
+#include "core/surface/poisson/hinted_poisson_evaluator.h"
 #include "tests/support/solved_torus.h"
 
 namespace labelmesh::testing {

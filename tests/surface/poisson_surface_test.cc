@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // Poisson surfaces through the whole pipeline: accuracy on phantoms with
 // known geometry, topology, determinism, cancellation and the liver.
 #include <gtest/gtest.h>
@@ -10,7 +11,7 @@
 #include <random>
 #include <thread>
 
-#include "core/pipeline.h"
+#include "core/pipeline/pipeline.h"
 #include "core/surface/poisson_surface.h"
 #include "core/surface/surface_checks.h"
 #include "core/surface/surface_statistics.h"

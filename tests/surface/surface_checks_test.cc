@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // Distances between surfaces with known answers: the samples must reach the
 // apex of a tent, the middle of a long edge and the inside of a triangle.
 #include "core/surface/surface_checks.h"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 #include "core/surface/surface_repair.h"
 
 #include <gtest/gtest.h>
@@ -9,7 +10,7 @@
 #include <functional>
 #include <set>
 
-#include "core/surface/cgal_mesh.h"
+#include "core/surface/cgal/cgal_mesh.h"
 #include "core/surface/extract_surfaces.h"
 #include "core/surface/surface_statistics.h"
 #include "core/volume/label_statistics.h"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // Each written file reads back, through readers we did not write, with the
 // same counts.
 #include "core/surface/write_surface.h"

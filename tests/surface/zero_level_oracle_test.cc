@@ -1,6 +1,7 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // The surface mesher's oracle for the solved Poisson function against CGAL's
 // own Poisson oracle on the same function.
-#include "core/surface/zero_level_oracle.h"
+#include "core/surface/poisson/zero_level_oracle.h"
 
 #include <gtest/gtest.h>
 

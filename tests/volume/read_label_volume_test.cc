@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 #include "core/volume/read_label_volume.h"
 
 #include <gtest/gtest.h>
@@ -6,7 +7,7 @@
 #include <cstdio>
 #include <map>
 
-#include "core/pipeline.h"
+#include "core/pipeline/pipeline.h"
 #include "core/volume/label_statistics.h"
 #include "core/volume/phantom.h"
 #include "core/volume/write_label_volume.h"

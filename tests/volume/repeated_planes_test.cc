@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // Runs of equal planes: a shape drawn on coarse slices and copied to finer
 // ones is found with its copy count per axis, and nothing else is.
 #include "core/volume/repeated_planes.h"

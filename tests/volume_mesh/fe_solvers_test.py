@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: AGPL-3.0-or-later
 """The liver's tetrahedral mesh in solvers nobody here wrote.
 
 `labelmesh mesh liver.inr.gz --labels 255 --volume tet --formats inp,msh`, then:

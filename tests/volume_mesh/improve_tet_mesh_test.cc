@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // The improvement pass on meshes built to need one operation each: a 3-2 flip,
 // a 2-3 flip, smoothing of an interior point, peeling a sliver off the
 // surface; and that otherwise the boundary and the region never change.
@@ -134,7 +135,9 @@ TEST(ImproveTetMesh, SmoothingLiftsTheWorstElementAndKeepsTheBoundary) {
   for (size_t t = 0; t < m.tetrahedra.size(); ++t) EXPECT_GT(signed_volume(m, t), 0);
   // Every point but the centre is on the cube's surface and stays put.
   for (uint32_t v = 0; v < boundary_before.size(); ++v) {
-    if (v != 13u) EXPECT_EQ(m.points[v], boundary_before[v]) << "point " << v;
+    if (v != 13u) {
+      EXPECT_EQ(m.points[v], boundary_before[v]) << "point " << v;
+    }
   }
 }
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // TetGen meshes of hand-built closed surfaces, checked against invariants: the tetrahedra fill
 // exactly the enclosed volume, all are positive, and with keep_boundary the mesh's boundary is
 // the input surface, triangle for triangle and with the same winding.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
 // Each written volume mesh reads back, through readers we did not write (VTK's XML reader and
 // meshio), with the same counts, labels and positive orientation; the Abaqus file is checked
 // line by line against C3D4's conventions.

@@ -1,0 +1,341 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+#include "core/pipeline/job_options.h"
+
+#include <cmath>
+
+#include "core/util/text.h"
+
+namespace labelmesh {
+namespace {
+
+v1::SurfaceMethod to_proto(SurfaceMethod method) {
+  switch (method) {
+    case SurfaceMethod::kMarchingCubes:
+      return v1::SURFACE_METHOD_MARCHING_CUBES;
+    case SurfaceMethod::kRepaired:
+      return v1::SURFACE_METHOD_REPAIRED;
+    case SurfaceMethod::kPoisson:
+      return v1::SURFACE_METHOD_POISSON;
+  }
+  return v1::SURFACE_METHOD_UNSPECIFIED;
+}
+
+v1::PointReduction to_proto(surface::PointReduction reduction) {
+  switch (reduction) {
+    case surface::PointReduction::kGrid:
+      return v1::POINT_REDUCTION_GRID;
+    case surface::PointReduction::kHierarchy:
+      return v1::POINT_REDUCTION_HIERARCHY;
+    case surface::PointReduction::kNone:
+      return v1::POINT_REDUCTION_NONE;
+  }
+  return v1::POINT_REDUCTION_UNSPECIFIED;
+}
+
+// A length in voxels must be finite and positive.
+absl::Status check_voxels(std::string_view field, double value) {
+  if (std::isfinite(value) && value > 0) return absl::OkStatus();
+  return absl::InvalidArgumentError(cat(field, ": ", value, " is not a positive number of voxels"));
+}
+
+// Lengths in mm beyond a metre are mistakes.
+constexpr double kMaxLengthMm = 1000;
+// No label is this many voxels thick.
+constexpr double kMaxThicknessVoxels = 100000;
+// One entry per label is plenty; the bound keeps a job record small.
+constexpr int kMaxLabelSizings = 1000;
+
+absl::Status check_millimetres(std::string_view field, double value) {
+  if (std::isfinite(value) && value > 0 && value <= kMaxLengthMm) return absl::OkStatus();
+  return absl::InvalidArgumentError(
+      cat(field, ": ", value, " is not a length in (0, ", kMaxLengthMm, "] mm"));
+}
+
+absl::Status read_guard_options(const v1::MeshOptions& options, GuardOptions& guard) {
+  auto percent = [](std::string_view field, double value) {
+    if (std::isfinite(value) && value > 0 && value <= 100) return absl::OkStatus();
+    return absl::InvalidArgumentError(cat(field, ": ", value, " is outside (0, 100] percent"));
+  };
+  if (options.has_volume_tolerance_percent()) {
+    guard.volume_percent = options.volume_tolerance_percent();
+    if (auto s = percent("volume_tolerance_percent", guard.volume_percent); !s.ok()) return s;
+  }
+  if (options.has_small_volume_tolerance_percent()) {
+    guard.small_volume_percent = options.small_volume_tolerance_percent();
+    if (auto s = percent("small_volume_tolerance_percent", guard.small_volume_percent); !s.ok())
+      return s;
+  }
+  if (options.has_hausdorff_tolerance_mm()) {
+    guard.hausdorff_mm = options.hausdorff_tolerance_mm();
+    // 0 asks for the default (the drawn spacing).
+    if (guard.hausdorff_mm != 0) {
+      if (auto s = check_millimetres("hausdorff_tolerance_mm", guard.hausdorff_mm); !s.ok())
+        return s;
+    }
+  }
+  if (options.has_fall_back()) guard.fall_back = options.fall_back();
+  if (options.has_strict()) guard.strict = options.strict();
+  return absl::OkStatus();
+}
+
+absl::Status read_poisson_options(const v1::MeshOptions& options, PoissonOptions& poisson) {
+  if (options.has_min_angle_deg()) {
+    poisson.min_angle_deg = options.min_angle_deg();
+    // CGAL's surface mesher terminates for angle bounds up to 30 degrees.
+    if (!(poisson.min_angle_deg > 0 && poisson.min_angle_deg <= 30)) {
+      return absl::InvalidArgumentError(
+          cat("min_angle_deg: ", poisson.min_angle_deg, " is outside (0, 30]"));
+    }
+  }
+  if (options.has_max_edge_voxels()) {
+    poisson.max_edge_voxels = options.max_edge_voxels();
+    if (auto s = check_voxels("max_edge_voxels", poisson.max_edge_voxels); !s.ok()) return s;
+  }
+  if (options.has_max_distance_voxels()) {
+    poisson.max_distance_voxels = options.max_distance_voxels();
+    if (auto s = check_voxels("max_distance_voxels", poisson.max_distance_voxels); !s.ok())
+      return s;
+  }
+  if (options.has_max_edge_mm()) {
+    poisson.max_edge_mm = options.max_edge_mm();
+    if (auto s = check_millimetres("max_edge_mm", poisson.max_edge_mm); !s.ok()) return s;
+  }
+  if (options.has_max_distance_mm()) {
+    poisson.max_distance_mm = options.max_distance_mm();
+    if (auto s = check_millimetres("max_distance_mm", poisson.max_distance_mm); !s.ok()) return s;
+  }
+  if (options.has_adapt_to_thickness()) poisson.adapt_to_thickness = options.adapt_to_thickness();
+  if (options.has_poisson_min_thickness_voxels()) {
+    poisson.min_thickness_voxels = options.poisson_min_thickness_voxels();
+    if (!(poisson.min_thickness_voxels >= 0 && poisson.min_thickness_voxels <= kMaxThicknessVoxels))
+      return absl::InvalidArgumentError(
+          cat("poisson_min_thickness_voxels: ", poisson.min_thickness_voxels, " is outside [0, ",
+              kMaxThicknessVoxels, "] voxels"));
+  }
+  if (options.label_sizing_size() > kMaxLabelSizings)
+    return absl::InvalidArgumentError(
+        cat("label_sizing: ", options.label_sizing_size(), " entries; at most ", kMaxLabelSizings));
+  for (const auto& entry : options.label_sizing()) {
+    if (entry.label() == 0)
+      return absl::InvalidArgumentError("label_sizing: label 0 is the background");
+    if (!(entry.max_edge_mm() >= 0 && entry.max_edge_mm() <= kMaxLengthMm) ||
+        !(entry.max_distance_mm() >= 0 && entry.max_distance_mm() <= kMaxLengthMm))
+      return absl::InvalidArgumentError(cat("label_sizing: label ", entry.label(),
+                                            ": lengths must be in [0, ", kMaxLengthMm, "] mm"));
+    poisson.label_sizing.push_back({entry.label(), entry.max_edge_mm(), entry.max_distance_mm()});
+  }
+  if (options.has_prune_strands()) poisson.prune_strands = options.prune_strands();
+  if (options.has_smoothing_iterations()) {
+    poisson.smoothing.iterations = options.smoothing_iterations();
+    if (poisson.smoothing.iterations < 0 || poisson.smoothing.iterations > 200) {
+      return absl::InvalidArgumentError(
+          cat("smoothing_iterations: ", poisson.smoothing.iterations, " is outside 0..200"));
+    }
+  }
+  if (options.has_smoothing_pass_band()) {
+    poisson.smoothing.pass_band = options.smoothing_pass_band();
+    if (!(poisson.smoothing.pass_band > 0 && poisson.smoothing.pass_band < 2)) {
+      return absl::InvalidArgumentError(
+          cat("smoothing_pass_band: ", poisson.smoothing.pass_band, " is outside (0, 2)"));
+    }
+  }
+
+  if (options.has_min_component_voxels())
+    poisson.min_component_voxels = options.min_component_voxels();
+  if (options.has_point_cell_voxels()) {
+    poisson.point_cell_voxels = options.point_cell_voxels();
+    if (auto s = check_voxels("point_cell_voxels", poisson.point_cell_voxels); !s.ok()) return s;
+  }
+  switch (options.normals()) {
+    case v1::NORMAL_WEIGHTING_UNSPECIFIED:
+    case v1::NORMAL_WEIGHTING_UNIFORM:
+      poisson.normals = surface::NormalWeighting::kUniform;
+      break;
+    case v1::NORMAL_WEIGHTING_AREA:
+      poisson.normals = surface::NormalWeighting::kArea;
+      break;
+    default:
+      return absl::InvalidArgumentError("normals: unknown weighting");
+  }
+  if (options.has_point_cluster_size()) {
+    poisson.point_cluster_size = options.point_cluster_size();
+    if (poisson.point_cluster_size < 1 || poisson.point_cluster_size > surface::kMaxClusterSize) {
+      return absl::InvalidArgumentError(cat("point_cluster_size: ", poisson.point_cluster_size,
+                                            " is outside 1..", surface::kMaxClusterSize));
+    }
+  }
+  if (options.has_max_points()) {
+    poisson.max_points = options.max_points();
+    if (auto s = surface::check_point_count("max_points", poisson.max_points); !s.ok()) return s;
+  }
+  if (options.has_split_points()) {
+    poisson.split_points = options.split_points();
+    if (auto s = surface::check_point_count("split_points", poisson.split_points); !s.ok())
+      return s;
+  }
+  switch (options.point_reduction()) {
+    case v1::POINT_REDUCTION_UNSPECIFIED:
+    case v1::POINT_REDUCTION_GRID:
+      poisson.point_reduction = surface::PointReduction::kGrid;
+      break;
+    case v1::POINT_REDUCTION_HIERARCHY:
+      poisson.point_reduction = surface::PointReduction::kHierarchy;
+      break;
+    case v1::POINT_REDUCTION_NONE:
+      poisson.point_reduction = surface::PointReduction::kNone;
+      break;
+    default:
+      return absl::InvalidArgumentError("point_reduction: unknown method");
+  }
+  return absl::OkStatus();
+}
+
+absl::Status read_volume_options(const v1::MeshOptions& options, MeshParams& params) {
+  switch (options.volume()) {
+    case v1::VOLUME_METHOD_UNSPECIFIED:
+    case v1::VOLUME_METHOD_NONE:
+      params.volume = VolumeMethod::kNone;
+      break;
+    case v1::VOLUME_METHOD_TETGEN:
+      params.volume = VolumeMethod::kTetgen;
+      break;
+    default:
+      return absl::InvalidArgumentError("volume: unknown volume method");
+  }
+  auto& tetgen = params.tetgen;
+  if (options.has_tet_radius_edge()) tetgen.radius_edge_ratio = options.tet_radius_edge();
+  if (options.has_tet_min_dihedral_deg()) tetgen.min_dihedral_deg = options.tet_min_dihedral_deg();
+  if (options.has_tet_max_volume_mm3()) tetgen.max_volume_mm3 = options.tet_max_volume_mm3();
+  if (options.has_tet_keep_boundary()) tetgen.keep_boundary = options.tet_keep_boundary();
+  if (options.has_tet_max_dihedral_deg()) tetgen.max_dihedral_deg = options.tet_max_dihedral_deg();
+  if (options.has_tet_improve_quality())
+    params.improve.target_quality = options.tet_improve_quality();
+  if (params.volume == VolumeMethod::kNone) return absl::OkStatus();
+  // The ranges are TetGen's, as tetrahedralize() checks them; a job should be
+  // refused here, before any surface work is done.
+  if (!(tetgen.radius_edge_ratio >= 1 && tetgen.radius_edge_ratio <= 100))
+    return absl::InvalidArgumentError(
+        cat("tet_radius_edge: ", tetgen.radius_edge_ratio, " is outside [1, 100]"));
+  if (!(tetgen.min_dihedral_deg >= 0 && tetgen.min_dihedral_deg <= 30))
+    return absl::InvalidArgumentError(
+        cat("tet_min_dihedral_deg: ", tetgen.min_dihedral_deg, " is outside [0, 30]"));
+  if (!(tetgen.max_dihedral_deg >= 90 && tetgen.max_dihedral_deg <= 179))
+    return absl::InvalidArgumentError(
+        cat("tet_max_dihedral_deg: ", tetgen.max_dihedral_deg, " is outside [90, 179]"));
+  if (!(params.improve.target_quality >= 0 && params.improve.target_quality < 1))
+    return absl::InvalidArgumentError(
+        cat("tet_improve_quality: ", params.improve.target_quality, " is outside [0, 1)"));
+  if (!(tetgen.max_volume_mm3 == 0 ||
+        (tetgen.max_volume_mm3 >= 1e-6 && tetgen.max_volume_mm3 <= 1e12)))
+    return absl::InvalidArgumentError(
+        cat("tet_max_volume_mm3: ", tetgen.max_volume_mm3, " is neither 0 nor in [1e-6, 1e12]"));
+  return absl::OkStatus();
+}
+
+}  // namespace
+
+v1::MeshOptions make_options(const MeshParams& params) {
+  v1::MeshOptions options;
+  for (int32_t label : params.labels) options.add_labels(label);
+  options.set_surface(to_proto(params.surface));
+  const PoissonOptions& poisson = params.poisson;
+  options.set_min_angle_deg(poisson.min_angle_deg);
+  options.set_max_edge_voxels(poisson.max_edge_voxels);
+  options.set_max_distance_voxels(poisson.max_distance_voxels);
+  options.set_min_component_voxels(poisson.min_component_voxels);
+  options.set_normals(poisson.normals == surface::NormalWeighting::kArea
+                          ? v1::NORMAL_WEIGHTING_AREA
+                          : v1::NORMAL_WEIGHTING_UNIFORM);
+  options.set_point_reduction(to_proto(poisson.point_reduction));
+  options.set_point_cell_voxels(poisson.point_cell_voxels);
+  options.set_point_cluster_size(poisson.point_cluster_size);
+  options.set_max_points(poisson.max_points);
+  options.set_split_points(poisson.split_points);
+  options.set_prune_strands(poisson.prune_strands);
+  options.set_smoothing_iterations(poisson.smoothing.iterations);
+  options.set_smoothing_pass_band(poisson.smoothing.pass_band);
+  if (poisson.max_edge_mm > 0) options.set_max_edge_mm(poisson.max_edge_mm);
+  if (poisson.max_distance_mm > 0) options.set_max_distance_mm(poisson.max_distance_mm);
+  options.set_adapt_to_thickness(poisson.adapt_to_thickness);
+  options.set_poisson_min_thickness_voxels(poisson.min_thickness_voxels);
+  for (const auto& sizing : poisson.label_sizing) {
+    auto* entry = options.add_label_sizing();
+    entry->set_label(sizing.label);
+    entry->set_max_edge_mm(sizing.max_edge_mm);
+    entry->set_max_distance_mm(sizing.max_distance_mm);
+  }
+  const GuardOptions& guard = params.guard;
+  options.set_volume_tolerance_percent(guard.volume_percent);
+  options.set_small_volume_tolerance_percent(guard.small_volume_percent);
+  options.set_hausdorff_tolerance_mm(guard.hausdorff_mm);
+  options.set_fall_back(guard.fall_back);
+  options.set_strict(guard.strict);
+
+  for (auto format : params.formats)
+    options.add_formats(std::string(surface::surface_format_name(format)));
+  if (params.volume == VolumeMethod::kTetgen) {
+    options.set_volume(v1::VOLUME_METHOD_TETGEN);
+    for (auto format : params.volume_formats)
+      options.add_formats(std::string(volume_mesh::volume_format_name(format)));
+  } else {
+    options.set_volume(v1::VOLUME_METHOD_NONE);
+  }
+  options.set_tet_radius_edge(params.tetgen.radius_edge_ratio);
+  options.set_tet_min_dihedral_deg(params.tetgen.min_dihedral_deg);
+  options.set_tet_max_volume_mm3(params.tetgen.max_volume_mm3);
+  options.set_tet_keep_boundary(params.tetgen.keep_boundary);
+  options.set_tet_max_dihedral_deg(params.tetgen.max_dihedral_deg);
+  options.set_tet_improve_quality(params.improve.target_quality);
+  options.set_max_voxels(params.limits.max_voxels);
+  return options;
+}
+
+absl::StatusOr<MeshParams> params_from_options(const v1::MeshOptions& options) {
+  MeshParams params;
+  params.labels.assign(options.labels().begin(), options.labels().end());
+  switch (options.surface()) {
+    case v1::SURFACE_METHOD_MARCHING_CUBES:
+      params.surface = SurfaceMethod::kMarchingCubes;
+      break;
+    case v1::SURFACE_METHOD_REPAIRED:
+      params.surface = SurfaceMethod::kRepaired;
+      break;
+    case v1::SURFACE_METHOD_UNSPECIFIED:
+    case v1::SURFACE_METHOD_POISSON:
+      params.surface = SurfaceMethod::kPoisson;
+      break;
+    default:
+      return absl::InvalidArgumentError("surface: unknown surface method");
+  }
+  if (auto s = read_poisson_options(options, params.poisson); !s.ok()) return s;
+  if (auto s = read_guard_options(options, params.guard); !s.ok()) return s;
+  if (auto s = read_volume_options(options, params); !s.ok()) return s;
+  if (!options.formats().empty()) {
+    // One list for both kinds: each name is either a surface or a volume format.
+    params.formats.clear();
+    std::vector<volume_mesh::VolumeFormat> volume_formats;
+    for (const auto& name : options.formats()) {
+      if (auto format = surface::surface_format_from_name(name)) {
+        params.formats.push_back(*format);
+      } else if (auto volume_format = volume_mesh::volume_format_from_name(name)) {
+        volume_formats.push_back(*volume_format);
+      } else {
+        return absl::InvalidArgumentError(
+            cat("formats: '", name,
+                "' is not one of stl, ply, obj, off, vtp (surfaces), vtu, msh, mesh, inp, node "
+                "(volumes)"));
+      }
+    }
+    if (!volume_formats.empty()) {
+      if (params.volume == VolumeMethod::kNone) {
+        return absl::InvalidArgumentError(
+            "formats: a volume format was asked for without a volume method (volume: tet)");
+      }
+      params.volume_formats = std::move(volume_formats);
+    }
+  }
+  if (options.max_voxels() > 0) params.limits.max_voxels = options.max_voxels();
+  return params;
+}
+
+}  // namespace labelmesh

@@ -1,0 +1,89 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+#include "core/pipeline/label_tet_meshes.h"
+
+#include <chrono>
+#include <new>
+
+#include "core/util/text.h"
+
+namespace labelmesh {
+namespace {
+
+quality::Tet corners(const volume_mesh::TetMesh& mesh, size_t t) {
+  const auto& tet = mesh.tetrahedra[t];
+  return {mesh.points[tet[0]], mesh.points[tet[1]], mesh.points[tet[2]], mesh.points[tet[3]]};
+}
+
+void measure(VolumeResult& result) {
+  result.quality.clear();
+  result.summary = {};
+  result.quality.reserve(result.mesh.tetrahedra.size());
+  for (size_t t = 0; t < result.mesh.tetrahedra.size(); ++t) {
+    const quality::Tet tet = corners(result.mesh, t);
+    const double q = quality::tetra_quality(tet);
+    result.quality.push_back(q);
+    result.summary.add(q);
+    result.summary.add_dihedral_range(quality::tetra_dihedral_range_deg(tet));
+  }
+}
+
+absl::StatusOr<VolumeResult> measure_and_join(const std::vector<LabelBoundary>& boundaries,
+                                              const volume_mesh::TetgenParams& params,
+                                              const RunContext& context) {
+  const auto start = std::chrono::steady_clock::now();
+  VolumeResult result;
+  for (const auto& boundary : boundaries) {
+    // TetGen's own -d check would say the same, less precisely and later.
+    if (boundary.self_intersections.value_or(0) > 0) {
+      return absl::FailedPreconditionError(
+          cat("label ", boundary.label, ": its surface has ", *boundary.self_intersections,
+              " pairs of crossing triangles; a volume mesh needs a surface that does not "
+              "intersect itself"));
+    }
+    volume_mesh::TetgenFigures figures;
+    auto tets =
+        volume_mesh::tetrahedralize(*boundary.surface, boundary.label, params, context, figures);
+    if (!tets.ok()) {
+      return absl::Status(tets.status().code(), cat("label ", boundary.label, ": ",
+                                                    std::string(tets.status().message())));
+    }
+    result.steiner_points += figures.steiner_points;
+    result.mesh.append(*tets);
+  }
+  measure(result);
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return result;
+}
+
+}  // namespace
+
+absl::StatusOr<VolumeResult> tetrahedralize_labels(const std::vector<LabelBoundary>& boundaries,
+                                                   const volume_mesh::TetgenParams& params,
+                                                   const RunContext& context) {
+  // No exception leaves the core: a mesh too large for memory is an error.
+  try {
+    return measure_and_join(boundaries, params, context);
+  } catch (const std::bad_alloc&) {
+    return absl::ResourceExhaustedError("tetgen: out of memory joining the volume meshes");
+  }
+}
+
+absl::Status improve_volume(VolumeResult& volume, const volume_mesh::ImproveParams& params,
+                            const RunContext& context) {
+  if (params.target_quality <= 0) return absl::OkStatus();
+  VolumeImprovement improvement;
+  improvement.tetgen_summary = volume.summary;
+  try {
+    if (auto s = volume_mesh::improve_tet_mesh(volume.mesh, params, context, improvement.figures);
+        !s.ok()) {
+      return s;
+    }
+    measure(volume);
+  } catch (const std::bad_alloc&) {
+    return absl::ResourceExhaustedError("tet improvement: out of memory");
+  }
+  volume.improvement = improvement;
+  return absl::OkStatus();
+}
+
+}  // namespace labelmesh

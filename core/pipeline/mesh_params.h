@@ -1,0 +1,136 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// What a caller asks of one meshing run: user intent only, with defaults.
+// Values derived from the input (tolerances from voxel size) never live here.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "core/surface/poisson_surface.h"
+#include "core/surface/smooth_surface.h"
+#include "core/surface/surface_format.h"
+#include "core/surface/vertex_normals.h"
+#include "core/volume/volume_header.h"
+#include "core/volume_mesh/improve_tet_mesh.h"
+#include "core/volume_mesh/tetrahedralize.h"
+#include "core/volume_mesh/volume_format.h"
+
+namespace labelmesh {
+
+enum class SurfaceMethod {
+  kMarchingCubes,  // VTK discrete flying edges; staircase surface (paper §2.2).
+  kRepaired,       // Marching Cubes repaired with CGAL ("MC improved", Table 2).
+  kPoisson,        // Repaired MC per component, then CGAL Poisson (paper §2.3).
+};
+
+// Poisson surface settings. Lengths are in voxels (multiples of the cube root
+// of the voxel volume), so the same defaults work at any resolution.
+// Surface sizing for one label, mm, overriding the defaults (0: keep them).
+struct LabelSizing {
+  int32_t label = 0;
+  double max_edge_mm = 0;
+  double max_distance_mm = 0;
+};
+
+struct PoissonOptions {
+  double min_angle_deg = 30;
+  // 8 voxels and half a voxel give the liver about 26,000 triangles in about
+  // 3 s of meshing; halving both doubles fidelity to curvature, triples time.
+  double max_edge_voxels = 8;
+  double max_distance_voxels = 0.5;
+  // The same in mm; when set (> 0) they replace the voxel figures.
+  double max_edge_mm = 0;
+  double max_distance_mm = 0;
+  // Each component's sizing shrinks to its thickness (3 x volume / area),
+  // so a rib or vessel gets edges as short as it is thin while a large organ
+  // keeps the defaults.
+  bool adapt_to_thickness = true;
+  // Poisson is tried first only on labels at least this thick (3 x volume /
+  // area of the repaired surface, in voxels); thinner ones go straight to the
+  // guard's meshed voxel mask. Across the shared multi-label volumes the
+  // first Poisson surface was within tolerance for 7 of 157 labels thinner
+  // than 15 voxels and 4 of 11 thicker ones, and it is most of their time.
+  // 0 tries Poisson on every label; without fall-back it always is.
+  double min_thickness_voxels = 15;
+  // Per-label sizing; it also overrides the adaptation.
+  std::vector<LabelSizing> label_sizing;
+  // Islands smaller than 4^3 voxels are segmentation noise in practice, and too
+  // small for Poisson to reconstruct as anything but a blob.
+  uint64_t min_component_voxels = 64;
+  // Strands one voxel thick are below what a smooth surface can follow at the
+  // voxel size: Poisson would shrink them to nothing, far from the voxels.
+  bool prune_strands = true;
+  // Windowed-sinc smoothing of the repaired surface before its points and
+  // normals go to Poisson: the staircase is voxel-scale noise, and Poisson
+  // fed with it reproduces part of it (sphere: 0.14 voxel RMS without, see
+  // docs/pipeline.md). Positions only; the repaired surface itself is reported as is.
+  surface::SmoothingParams smoothing;
+  surface::NormalWeighting normals = surface::NormalWeighting::kUniform;
+  // Grid: one point per voxel cube. Marching Cubes gives a little more than
+  // that, and coarser cells let the surface drift (2 voxels doubles the
+  // sphere's radial error). Hierarchy clusters of 3 are 3.4 s faster on the
+  // liver at the same Hausdorff distance, but leave the sphere's vertices
+  // 0.119 voxel RMS off, above the 0.1 target (docs/pipeline.md, "Point reduction").
+  surface::PointReduction point_reduction = surface::PointReduction::kGrid;
+  double point_cell_voxels = 1;
+  // Point budget of the grid reduction per component: a larger surface gets a
+  // coarser cell. The solve costs about 40 us a point on one core, so this
+  // bounds a component's solve near 10 s whatever the organ's size. The liver (242 k points at 1
+  // voxel) stays under it; smaller budgets trade Hausdorff distance for time (docs/pipeline.md,
+  // "Point reduction"). 0: no budget.
+  uint64_t max_points = 250'000;
+  // Components with more points than this are solved as two overlapping
+  // halves on two threads: the liver's solve takes 6 s instead of 11 (test
+  // build) for the same volume and mean distance (docs/pipeline.md, "Two halves").
+  // Below it one solve is quick anyway. 0: always one solve.
+  uint64_t split_points = 150'000;
+  uint32_t point_cluster_size = 3;
+};
+
+enum class VolumeMethod {
+  kNone,
+  // TetGen on each label's output surface (paper §2.4.2), one region per label.
+  kTetgen,
+};
+
+// The guard on what is delivered: each label's output surface is compared
+// with its Marching Cubes surface; outside the tolerance it is rebuilt finer,
+// then replaced by the label's smoothed voxel mask meshed at one half, and
+// what is delivered outside it anyway is listed in the report's warnings.
+struct GuardOptions {
+  // Largest |volume change|, percent of the Marching Cubes volume, for labels
+  // of at least kSmallLabelVoxels voxels, and for smaller ones.
+  double volume_percent = 3;
+  double small_volume_percent = 10;
+  // Largest Hausdorff distance, mm; 0: the largest spacing the segmentation
+  // was drawn at (input.drawn_spacing).
+  double hausdorff_mm = 0;
+  // Rebuild and fall back when outside the tolerance (false: only measure
+  // and warn).
+  bool fall_back = true;
+  // Any label delivered outside the tolerance, or not at all, fails the run.
+  bool strict = false;
+};
+
+struct MeshParams {
+  // Labels to mesh; empty means every non-zero label in the volume.
+  std::vector<int32_t> labels;
+  SurfaceMethod surface = SurfaceMethod::kPoisson;
+  PoissonOptions poisson;
+  GuardOptions guard;
+  // Surface files to write per label.
+  std::vector<surface::SurfaceFormat> formats{surface::SurfaceFormat::kStl,
+                                              surface::SurfaceFormat::kVtp};
+  VolumeMethod volume = VolumeMethod::kNone;
+  volume_mesh::TetgenParams tetgen;
+  volume_mesh::ImproveParams improve;
+  // Volume mesh files (when `volume` is not kNone).
+  std::vector<volume_mesh::VolumeFormat> volume_formats{volume_mesh::VolumeFormat::kVtu};
+  // Labels meshed at once (each label's own stages use up to two threads);
+  // 0: one per core. The output does not depend on it.
+  unsigned threads = 0;
+  // Size limits applied to the input before anything is allocated.
+  volume::ReadLimits limits;
+};
+
+}  // namespace labelmesh

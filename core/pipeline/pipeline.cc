@@ -1,0 +1,317 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+#include "core/pipeline/pipeline.h"
+#include "core/util/exception_status.h"
+
+#include <algorithm>
+#include <mutex>
+#include <thread>
+
+#include "core/pipeline/label_queue.h"
+#include "core/pipeline/label_surfaces.h"
+#include "core/surface/extract_surfaces.h"
+#include "core/util/side_by_side.h"
+#include "core/util/text.h"
+#include "core/volume/read_label_volume.h"
+#include "core/volume/repeated_planes.h"
+
+namespace labelmesh {
+namespace {
+
+// The input's format, placement, label counts and repeated planes.
+VolumeSummary summary_of(const volume::LabelVolume& volume) {
+  VolumeSummary summary{volume.format, volume.file_voxel_type, volume.geometry,
+                        volume::compute_label_statistics(volume)};
+  summary.repeated_planes = volume::find_repeated_planes(volume, summary.statistics);
+  return summary;
+}
+
+// The labels to mesh: those asked for (each must be present), or all.
+absl::StatusOr<std::vector<int32_t>> choose_labels(const std::string& path,
+                                                   const volume::VolumeStatistics& statistics,
+                                                   const std::vector<int32_t>& asked) {
+  std::vector<int32_t> labels;
+  if (asked.empty()) {
+    for (const auto& label : statistics.labels) labels.push_back(label.label);
+    if (labels.empty()) {
+      return absl::FailedPreconditionError(
+          cat(path, ": the volume holds only background (label 0); nothing to mesh"));
+    }
+    return labels;
+  }
+  for (int32_t label : asked) {
+    if (label == 0)
+      return absl::InvalidArgumentError("labels: 0 is the background and has no surface");
+    if (statistics.find(label) == nullptr) {
+      return absl::InvalidArgumentError(cat("labels: ", path, " has no voxel with label ", label));
+    }
+    if (std::find(labels.begin(), labels.end(), label) == labels.end()) labels.push_back(label);
+  }
+  return labels;
+}
+
+// One warning per label delivered outside its tolerance or not at all (its
+// stages failed, or nothing was left once small components and strands were
+// dropped).
+std::vector<LabelWarning> collect_warnings(const std::vector<SurfaceResult>& surfaces,
+                                           const MeshParams& params) {
+  std::vector<LabelWarning> warnings;
+  for (const auto& s : surfaces) {
+    if (s.stage == "marching_cubes") continue;
+    if (s.error) {
+      warnings.push_back({s.label, cat("not delivered: ", *s.error)});
+      continue;
+    }
+    if (s.components && s.components->kept == 0) {
+      warnings.push_back(
+          {s.label, cat("too small to mesh: no component of ", params.poisson.min_component_voxels,
+                        " voxels or more (min_component_voxels) once one-voxel strands are "
+                        "pruned; ",
+                        s.components->dropped, " smaller component(s), ",
+                        s.components->pruned_voxels, " voxels in strands")});
+      continue;
+    }
+    if (!s.is_output || !s.fidelity) continue;
+    const auto& f = *s.fidelity;
+    const auto& a = f.attempts[f.delivered];
+    if (!f.within_tolerance()) {
+      warnings.push_back(
+          {s.label, cat("outside tolerance: ", a.method, " surface, volume ",
+                        format_fixed(100 * a.volume_change, 1), " % (tolerance ",
+                        format_fixed(100 * f.tolerance.volume_fraction, 1), " %), Hausdorff ",
+                        format_fixed(a.hausdorff_mm, 2), " mm (tolerance ",
+                        format_fixed(f.tolerance.hausdorff_mm, 2), " mm)")});
+    }
+  }
+  return warnings;
+}
+
+// Labels with at least this many voxels are meshed one at a time (LabelQueue).
+constexpr uint64_t kLargeLabelVoxels = 100'000;
+
+// How many labels are meshed at once: the params' budget, else every core.
+unsigned label_threads(const MeshParams& params, size_t labels) {
+  unsigned threads = params.threads > 0 ? params.threads : std::thread::hardware_concurrency();
+  return static_cast<unsigned>(std::clamp<size_t>(threads, 1, std::max<size_t>(labels, 1)));
+}
+
+// The quality surfaces of every label in `labels`, several labels at once
+// (label_threads). Each label's surfaces and stage times are kept apart and
+// joined in label order, so the result does not depend on the thread count.
+// A label whose stages fail gets that error and the others go on; a stop, a
+// bad option, or a failure of a label asked for by name ends the run.
+absl::Status add_every_label_surface(const volume::LabelVolume& volume, const VolumeSummary& input,
+                                     const std::vector<int32_t>& labels, const MeshParams& params,
+                                     const RunContext& context,
+                                     std::vector<SurfaceResult>& surfaces,
+                                     std::vector<StageTiming>& stages) {
+  std::array<double, 3> drawn_spacing;
+  for (int axis = 0; axis < 3; ++axis)
+    drawn_spacing[axis] = volume.geometry.spacing[axis] * input.repeated_planes[axis];
+  const size_t count = labels.size();
+  std::vector<std::vector<SurfaceResult>> label_surfaces(count);
+  std::vector<std::vector<StageTiming>> label_stages(count);
+  std::vector<absl::Status> label_status(count);
+  // Progress callbacks expect one caller at a time.
+  std::mutex progress_mutex;
+  RunContext shared = context;
+  if (context.progress) {
+    shared.progress = [&](std::string_view stage, double fraction) {
+      std::lock_guard<std::mutex> lock(progress_mutex);
+      context.progress(stage, fraction);
+    };
+  }
+  std::vector<bool> large(count);
+  for (size_t i = 0; i < count; ++i)
+    large[i] = input.statistics.find(labels[i])->voxels >= kLargeLabelVoxels;
+  LabelQueue queue(large);
+  auto work = [&] {
+    while (const auto taken = queue.take()) {
+      const size_t i = *taken;
+      const auto* statistics = input.statistics.find(labels[i]);
+      const auto& guard = params.guard;
+      const SurfaceTolerance tolerance =
+          tolerance_for(statistics->voxels, drawn_spacing, guard.volume_percent,
+                        guard.small_volume_percent, guard.hausdorff_mm);
+      absl::Status status;
+      try {
+        status = add_label_surfaces(volume, *statistics, params, tolerance, shared,
+                                    label_surfaces[i], label_stages[i]);
+      } catch (const std::bad_alloc&) {
+        status = absl::ResourceExhaustedError(cat("label ", labels[i], ": out of memory"));
+      }
+      const bool label_error = !status.ok() && status.code() != absl::StatusCode::kCancelled &&
+                               status.code() != absl::StatusCode::kInvalidArgument &&
+                               params.labels.empty();
+      if (label_error) {
+        SurfaceResult failed;
+        failed.label = labels[i];
+        failed.stage = params.surface == SurfaceMethod::kPoisson ? "poisson" : "repaired";
+        failed.error = std::string(status.message());
+        label_surfaces[i] = {};
+        label_surfaces[i].push_back(std::move(failed));
+        status = absl::OkStatus();
+      }
+      label_status[i] = status;
+      if (!status.ok()) queue.end();
+      queue.done(i);
+    }
+  };
+  const unsigned threads = label_threads(params, count);
+  std::vector<std::thread> helpers;
+  for (unsigned t = 1; t < threads; ++t) helpers.emplace_back(work);
+  work();
+  for (auto& helper : helpers) helper.join();
+  for (size_t i = 0; i < count; ++i) {
+    if (!label_status[i].ok()) return label_status[i];
+    for (auto& surface : label_surfaces[i]) surfaces.push_back(std::move(surface));
+    for (const auto& stage : label_stages[i]) add_stage_time(stages, stage.name, stage.seconds);
+  }
+  return absl::OkStatus();
+}
+
+// TetGen on each label's output surface, then the improvement pass.
+absl::Status add_volume_mesh(const MeshParams& params, const volume::ImageGeometry& geometry,
+                             const RunContext& context, MeshResult& result) {
+  std::vector<LabelBoundary> boundaries;
+  for (const auto& surface : result.surfaces) {
+    if (surface.is_output)
+      boundaries.push_back({surface.label, &surface.mesh, surface.self_intersections});
+  }
+  absl::StatusOr<VolumeResult> tets;
+  {
+    StageTimer timer(result.stages, "tetgen");
+    context.report("tetgen", 0);
+    tets = tetrahedralize_labels(boundaries, params.tetgen, context);
+  }
+  if (!tets.ok()) return tets.status();
+  {
+    StageTimer timer(result.stages, "tet_improve");
+    context.report("tet_improve", 0);
+    const auto improve = improve_params_for(params, geometry);
+    if (auto s = improve_volume(*tets, improve, context); !s.ok()) return s;
+  }
+  result.volume = std::move(*tets);
+  return absl::OkStatus();
+}
+
+}  // namespace
+
+absl::StatusOr<VolumeSummary> summarise_volume(const std::string& path,
+                                               const volume::ReadLimits& limits,
+                                               const RunContext& context) {
+  auto volume = volume::read_label_volume(path, limits, context);
+  if (!volume.ok()) return volume.status();
+  return summary_of(*volume);
+}
+
+volume_mesh::ImproveParams improve_params_for(const MeshParams& params,
+                                              const volume::ImageGeometry& geometry) {
+  volume_mesh::ImproveParams improve = params.improve;
+  improve.max_volume_mm3 = params.tetgen.max_volume_mm3;
+  // Peeling may move a Poisson surface as far as its meshing may; other
+  // surfaces have no such tolerance and stay as they are.
+  if (params.surface == SurfaceMethod::kPoisson) {
+    improve.max_peel_depth_mm = params.poisson.max_distance_voxels * voxel_size_mm(geometry);
+  }
+  return improve;
+}
+
+namespace {
+
+absl::StatusOr<MeshResult> run_stages(const std::string& path, const MeshParams& params,
+                                      const RunContext& context) {
+  MeshResult result;
+  absl::StatusOr<volume::LabelVolume> volume;
+  {
+    StageTimer timer(result.stages, "read");
+    context.report("read", 0);
+    volume = volume::read_label_volume(path, params.limits, context);
+  }
+  if (!volume.ok()) return volume.status();
+  {
+    StageTimer timer(result.stages, "label_statistics");
+    result.input = summary_of(*volume);
+  }
+  auto labels = choose_labels(path, result.input.statistics, params.labels);
+  if (!labels.ok()) return labels.status();
+
+  absl::StatusOr<std::vector<surface::LabelSurface>> surfaces;
+  {
+    StageTimer timer(result.stages, "marching_cubes");
+    context.report("marching_cubes", 0);
+    surfaces = surface::extract_surfaces(*volume, result.input.statistics, *labels, context);
+  }
+  if (!surfaces.ok()) return surfaces.status();
+  // The Marching Cubes figures. When quality surfaces follow, the Marching
+  // Cubes meshes are only measured, on a second thread while the quality
+  // surfaces' first stages (components, repair) keep one core busy, and then
+  // dropped.
+  const bool quality = params.surface != SurfaceMethod::kMarchingCubes;
+  const bool tetrahedra = params.volume == VolumeMethod::kTetgen;
+  std::vector<StageTiming> statistics_stage;
+  auto measure_marching_cubes = [&] {
+    StageTimer timer(statistics_stage, "surface_statistics");
+    for (auto& extracted : *surfaces) {
+      // The caller checks for the stop once both threads are done.
+      if (context.stop_requested()) return;
+      SurfaceResult surface;
+      surface.label = extracted.label;
+      surface.stage = "marching_cubes";
+      surface.is_output = !quality;
+      surface.statistics = surface::compute_surface_statistics(extracted.mesh);
+      if (!quality) surface.mesh = std::move(extracted.mesh);
+      extracted.mesh = {};
+      result.surfaces.push_back(std::move(surface));
+    }
+  };
+  // Listed where it runs first, whatever finishes first.
+  result.stages.push_back({"surface_statistics", 0});
+  std::vector<SurfaceResult> quality_surfaces;
+  absl::Status quality_status;
+  if (!quality) {
+    measure_marching_cubes();
+  } else {
+    side_by_side(measure_marching_cubes, [&] {
+      quality_status = add_every_label_surface(*volume, result.input, *labels, params, context,
+                                               quality_surfaces, result.stages);
+    });
+  }
+  add_stage_time(result.stages, "surface_statistics", statistics_stage.front().seconds);
+  if (!quality_status.ok()) return quality_status;
+  if (auto s = context.check_stop(); !s.ok()) return s;
+  if (quality && std::none_of(quality_surfaces.begin(), quality_surfaces.end(),
+                              [](const SurfaceResult& s) { return s.is_output; })) {
+    return absl::FailedPreconditionError(
+        cat(path,
+            ": no label left a surface: every label's components are smaller than "
+            "min-component-voxels (",
+            params.poisson.min_component_voxels, ") or its stages failed; nothing to mesh"));
+  }
+  for (auto& surface : quality_surfaces) result.surfaces.push_back(std::move(surface));
+  result.warnings = collect_warnings(result.surfaces, params);
+  if (params.guard.strict && !result.warnings.empty()) {
+    const auto& first = result.warnings.front();
+    return absl::FailedPreconditionError(
+        cat(path, ": strict: ", result.warnings.size(),
+            " label(s) delivered outside tolerance or not at all; first, label ", first.label, ": ",
+            first.reason));
+  }
+
+  if (tetrahedra) {
+    if (auto s = add_volume_mesh(params, volume->geometry, context, result); !s.ok()) return s;
+  }
+  return result;
+}
+
+}  // namespace
+
+absl::StatusOr<MeshResult> run_pipeline(const std::string& path, const MeshParams& params,
+                                        const RunContext& context) {
+  try {
+    return run_stages(path, params, context);
+  } catch (...) {
+    return current_exception_status("pipeline");
+  }
+}
+
+}  // namespace labelmesh

@@ -1,0 +1,199 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+#include "core/pipeline/report.h"
+
+#include <google/protobuf/util/json_util.h>
+
+#include <cmath>
+
+#include "core/pipeline/job_options.h"
+#include "core/util/text.h"
+
+namespace labelmesh {
+namespace {
+
+v1::VolumeMeshSummary make_volume_summary(const VolumeResult& volume) {
+  v1::VolumeMeshSummary entry;
+  entry.set_mesher(volume.mesher);
+  entry.set_nodes(volume.mesh.points.size());
+  entry.set_tetrahedra(volume.mesh.tetrahedra.size());
+  entry.set_steiner_points(volume.steiner_points);
+  const auto& q = volume.summary;
+  if (q.count > 0) {
+    entry.set_tetra_quality_min(q.min);
+    entry.set_tetra_quality_mean(q.mean);
+    entry.set_min_dihedral_deg(q.min_dihedral_deg);
+    entry.set_max_dihedral_deg(q.max_dihedral_deg);
+  }
+  auto* categories = entry.mutable_categories();
+  categories->set_invalid(q.invalid);
+  categories->set_very_bad(q.very_bad);
+  categories->set_questionable(q.questionable);
+  categories->set_good(q.good);
+  entry.set_conforming(false);
+  entry.set_seconds(volume.seconds);
+  if (volume.improvement) {
+    const auto& before = volume.improvement->tetgen_summary;
+    const auto& figures = volume.improvement->figures;
+    auto* improvement = entry.mutable_improvement();
+    improvement->set_tetgen_quality_min(before.count > 0 ? before.min : 0);
+    improvement->set_tetgen_questionable(before.invalid + before.very_bad + before.questionable);
+    improvement->set_flips_2_3(figures.flips_2_3);
+    improvement->set_flips_3_2(figures.flips_3_2);
+    improvement->set_vertices_moved(figures.vertices_moved);
+    improvement->set_vertices_inserted(figures.vertices_inserted);
+    improvement->set_slivers_peeled(figures.slivers_peeled);
+    improvement->set_peeled_volume_mm3(figures.peeled_volume_mm3);
+    improvement->set_peel_depth_mm(figures.peel_depth_mm);
+    improvement->set_seconds(figures.seconds);
+  }
+  for (const auto& file : volume.files) entry.add_files(file);
+  return entry;
+}
+
+void add_quality_figures(const SurfaceResult& surface, v1::SurfaceSummary& entry) {
+  if (surface.self_intersections) entry.set_self_intersections(*surface.self_intersections);
+  if (surface.distance_to_marching_cubes) {
+    entry.set_hausdorff_mm(surface.distance_to_marching_cubes->hausdorff_mm);
+    entry.set_mean_distance_mm(surface.distance_to_marching_cubes->mean_mm);
+    for (double c : surface.distance_to_marching_cubes->hausdorff_at) entry.add_hausdorff_at(c);
+  }
+  if (surface.components) {
+    entry.set_components_kept(surface.components->kept);
+    entry.set_components_dropped(surface.components->dropped);
+    entry.set_dropped_voxels(surface.components->dropped_voxels);
+    entry.set_pruned_voxels(surface.components->pruned_voxels);
+    entry.set_cavities_filled(surface.components->filled_cavities);
+    entry.set_cavity_voxels_filled(surface.components->filled_voxels);
+  }
+  if (surface.repair) {
+    const auto& r = *surface.repair;
+    auto* repair = entry.mutable_repair();
+    repair->set_degenerate_triangles_removed(r.degenerate_triangles_removed);
+    repair->set_needles_before(r.needles_before);
+    repair->set_caps_before(r.caps_before);
+    repair->set_needles_after(r.needles_after);
+    repair->set_caps_after(r.caps_after);
+    repair->set_non_manifold_vertices_split(r.non_manifold_vertices_split);
+    repair->set_holes_filled(r.holes_filled);
+  }
+  if (surface.error) entry.set_error(*surface.error);
+  if (surface.fidelity) {
+    const auto& f = *surface.fidelity;
+    auto* fidelity = entry.mutable_fidelity();
+    fidelity->set_volume_tolerance_percent(100 * f.tolerance.volume_fraction);
+    fidelity->set_hausdorff_tolerance_mm(f.tolerance.hausdorff_mm);
+    fidelity->set_marching_cubes_volume_mm3(f.marching_cubes_volume_mm3);
+    fidelity->set_thickness_voxels(f.thickness_voxels);
+    fidelity->set_within_tolerance(f.within_tolerance());
+    if (f.delivered < f.attempts.size()) fidelity->set_delivered(f.attempts[f.delivered].method);
+    for (const auto& a : f.attempts) {
+      auto* attempt = fidelity->add_attempts();
+      attempt->set_method(a.method);
+      attempt->set_max_edge_mm(a.max_edge_mm);
+      attempt->set_max_distance_mm(a.max_distance_mm);
+      attempt->set_error(a.error);
+      attempt->set_volume_change_percent(100 * a.volume_change);
+      attempt->set_hausdorff_mm(a.hausdorff_mm);
+      attempt->set_mean_distance_mm(a.mean_distance_mm);
+      attempt->set_min_angle_deg(a.min_angle_deg);
+      attempt->set_max_angle_deg(a.max_angle_deg);
+      attempt->set_within_tolerance(a.within_tolerance);
+    }
+  }
+  if (surface.poisson) {
+    const auto& p = *surface.poisson;
+    auto* poisson = entry.mutable_poisson();
+    poisson->set_input_points(p.input_points);
+    poisson->set_used_points(p.used_points);
+    poisson->set_solver_iterations(static_cast<uint32_t>(p.solver_iterations));
+    poisson->set_solve_seconds(p.solve_seconds);
+    poisson->set_mesh_seconds(p.mesh_seconds);
+    poisson->set_point_cell_mm(p.point_cell_mm);
+    poisson->set_solved_in_halves(p.solved_in_halves);
+  }
+}
+
+}  // namespace
+
+v1::InputSummary make_input_summary(const VolumeSummary& summary) {
+  v1::InputSummary input;
+  const auto& g = summary.geometry;
+  input.set_format(std::string(volume::format_name(summary.format)));
+  for (int axis = 0; axis < 3; ++axis) {
+    input.add_dims(static_cast<uint32_t>(g.dims[axis]));
+    input.add_spacing(g.spacing[axis]);
+    input.add_origin(g.origin[axis] + 0.0);  // + 0.0 turns -0 into 0.
+  }
+  for (double d : g.direction) input.add_direction(d + 0.0);
+  input.set_convention(std::string(kPatientConvention));
+  input.set_voxel_type(summary.file_voxel_type);
+  const double voxel_volume = g.voxel_volume();
+  for (const auto& label : summary.statistics.labels) {
+    auto* entry = input.add_labels();
+    entry->set_label(label.label);
+    entry->set_voxels(label.voxels);
+    entry->set_volume_mm3(static_cast<double>(label.voxels) * voxel_volume);
+  }
+  input.set_background_voxels(summary.statistics.background_voxels);
+  for (int axis = 0; axis < 3; ++axis) {
+    input.add_repeated_planes(static_cast<uint32_t>(summary.repeated_planes[axis]));
+    input.add_drawn_spacing(g.spacing[axis] * summary.repeated_planes[axis]);
+  }
+  return input;
+}
+v1::Report make_report(const MeshResult& result, const MeshParams& params) {
+  v1::Report report;
+  report.set_labelmesh_version(LABELMESH_VERSION);
+  *report.mutable_options() = make_options(params);
+  *report.mutable_input() = make_input_summary(result.input);
+  for (const auto& surface : result.surfaces) {
+    const auto& s = surface.statistics;
+    auto* entry = report.add_surfaces();
+    entry->set_label(surface.label);
+    entry->set_stage(surface.stage);
+    entry->set_nodes(s.nodes);
+    entry->set_triangles(s.triangles);
+    entry->set_min_angle_deg(s.min_angle_deg);
+    entry->set_max_angle_deg(s.max_angle_deg);
+    entry->set_boundary_edges(s.boundary_edges);
+    entry->set_non_manifold_edges(s.non_manifold_edges);
+    entry->set_non_manifold_vertices(s.non_manifold_vertices);
+    entry->set_closed(s.closed);
+    entry->set_manifold(s.manifold);
+    entry->set_euler_characteristic(static_cast<int32_t>(s.euler_characteristic));
+    entry->set_components(s.components);
+    entry->set_volume_mm3(s.volume_mm3);
+    entry->set_area_mm2(s.area_mm2);
+    for (const auto& file : surface.files) entry->add_files(file);
+    entry->set_output(surface.is_output);
+    add_quality_figures(surface, *entry);
+  }
+  if (result.volume) *report.mutable_volume() = make_volume_summary(*result.volume);
+  for (const auto& warning : result.warnings) {
+    auto* entry = report.add_warnings();
+    entry->set_label(warning.label);
+    entry->set_reason(warning.reason);
+  }
+  for (const auto& stage : result.stages) {
+    auto* entry = report.add_stages();
+    entry->set_name(stage.name);
+    entry->set_seconds(stage.seconds);
+  }
+  return report;
+}
+
+std::string to_json(const google::protobuf::Message& message) {
+  google::protobuf::util::JsonPrintOptions options;
+  options.add_whitespace = true;
+  options.preserve_proto_field_names = true;
+  options.always_print_primitive_fields = true;
+  std::string json;
+  (void)google::protobuf::util::MessageToJsonString(message, &json, options);
+  return json;
+}
+
+std::string report_json(const MeshResult& result, const MeshParams& params) {
+  return to_json(make_report(result, params));
+}
+
+}  // namespace labelmesh

@@ -1,0 +1,21 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// Writing a run's results: the output surfaces, the volume mesh and the
+// report, in one output directory.
+#pragma once
+
+#include <string>
+
+#include "absl/status/status.h"
+#include "core/pipeline/mesh_params.h"
+#include "core/pipeline/mesh_result.h"
+#include "core/util/run_context.h"
+
+namespace labelmesh {
+
+// Writes surface-label<N>.<ext> per surface and format, volume.<ext> per
+// volume format, then report.json, in `out_dir` (created if missing). Fills
+// each result's `files`.
+absl::Status write_results(MeshResult& result, const MeshParams& params, const std::string& out_dir,
+                           const RunContext& context);
+
+}  // namespace labelmesh

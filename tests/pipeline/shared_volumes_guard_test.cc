@@ -1,0 +1,60 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// The delivery guard on the real multi-label segmentations in ../shared/data:
+// every label is delivered within its tolerance, as a closed 2-manifold with
+// 30-degree angles, or named in the warnings as too small to mesh. The brain
+// and the frog take minutes and live in the benchmark
+// (scripts/bench-labels.sh) instead; the DICOM slab is left out under the
+// sanitizers, which make it several minutes.
+#include <gtest/gtest.h>
+
+#include <set>
+#include <string>
+
+#include "core/pipeline/pipeline.h"
+#include "support/test_files.h"
+
+namespace labelmesh {
+namespace {
+
+class SharedVolumes : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(SharedVolumes, EveryLabelIsWithinToleranceOrTooSmall) {
+  auto result = run_pipeline(testing::shared_data(GetParam()), MeshParams{}, RunContext{});
+  ASSERT_TRUE(result.ok()) << result.status();
+  std::set<int32_t> too_small;
+  for (const auto& warning : result->warnings) {
+    EXPECT_NE(warning.reason.find("too small to mesh"), std::string::npos)
+        << "label " << warning.label << ": " << warning.reason;
+    EXPECT_NE(warning.reason.find("64 voxels"), std::string::npos) << warning.reason;
+    too_small.insert(warning.label);
+  }
+  std::set<int32_t> delivered;
+  for (const auto& s : result->surfaces) {
+    if (!s.is_output) continue;
+    SCOPED_TRACE("label " + std::to_string(s.label) + " (" + s.stage + ")");
+    ASSERT_TRUE(s.fidelity.has_value());
+    EXPECT_TRUE(s.fidelity->within_tolerance());
+    EXPECT_TRUE(s.statistics.closed);
+    EXPECT_TRUE(s.statistics.manifold);
+    EXPECT_GE(s.statistics.min_angle_deg, 29.99);
+    EXPECT_LE(s.statistics.max_angle_deg, 120.01);
+    delivered.insert(s.label);
+  }
+  // Every label of the file is one or the other, never both.
+  EXPECT_EQ(delivered.size() + too_small.size(), result->input.statistics.labels.size());
+  for (int32_t label : too_small) EXPECT_EQ(delivered.count(label), 0u) << label;
+}
+
+INSTANTIATE_TEST_SUITE_P(Files, SharedVolumes,
+                         ::testing::Values("totalseg_example_seg_fast_force_split.nii.gz",
+                                           "totalseg_example_seg_mr.nii.gz",
+                                           "MRIcrop-seg_converted.nii.gz",
+                                           "msd_prostate_mask_00.nii", "vb-seg.mha"
+#ifndef __SANITIZE_ADDRESS__
+                                           ,
+                                           "totalseg_example_seg_dicom.nii.gz"
+#endif
+                                           ));
+
+}  // namespace
+}  // namespace labelmesh
