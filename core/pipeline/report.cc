@@ -5,6 +5,7 @@
 
 #include <cmath>
 
+#include "core/pipeline/build_info.h"
 #include "core/pipeline/job_options.h"
 #include "core/util/text.h"
 
@@ -144,6 +145,7 @@ v1::InputSummary make_input_summary(const VolumeSummary& summary) {
 v1::Report make_report(const MeshResult& result, const MeshParams& params) {
   v1::Report report;
   report.set_labelmesh_version(LABELMESH_VERSION);
+  *report.mutable_build() = build_info();
   *report.mutable_options() = make_options(params);
   *report.mutable_input() = make_input_summary(result.input);
   for (const auto& surface : result.surfaces) {

@@ -1,6 +1,5 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 #include "core/pipeline/write_results.h"
-#include "core/util/exception_status.h"
 
 #include <algorithm>
 #include <filesystem>
@@ -8,6 +7,7 @@
 
 #include "core/pipeline/report.h"
 #include "core/surface/write_surface.h"
+#include "core/util/exception_status.h"
 #include "core/util/stage_timer.h"
 #include "core/util/text.h"
 #include "core/volume_mesh/write_volume_mesh.h"

@@ -3,7 +3,6 @@
 // crossings found by bisection. Its own translation unit: the mesher's headers
 // are slow to compile.
 #include "core/surface/level_set_surface.h"
-#include "core/util/exception_status.h"
 
 #include <algorithm>
 #include <cmath>
@@ -18,6 +17,7 @@
 
 #include "core/surface/cgal/cgal_mesh.h"
 #include "core/surface/cgal/restricted_delaunay.h"
+#include "core/util/exception_status.h"
 #include "core/util/text.h"
 
 namespace labelmesh::surface {

@@ -2,7 +2,6 @@
 // The only translation unit that instantiates CGAL's Poisson reconstruction and
 // surface mesher: it is slow to compile, so nothing else includes these headers.
 #include "core/surface/poisson_surface.h"
-#include "core/util/exception_status.h"
 
 #include <algorithm>
 #include <array>
@@ -25,6 +24,7 @@
 #include "core/surface/poisson/mesher_seeds.h"
 #include "core/surface/poisson/poisson_linear_system.h"
 #include "core/surface/poisson/zero_level_oracle.h"
+#include "core/util/exception_status.h"
 #include "core/util/side_by_side.h"
 #include "core/util/stage_timer.h"
 #include "core/util/text.h"

@@ -2,7 +2,6 @@
 // CGAL Polygon_mesh_processing repair: every defect is found and fixed by
 // CGAL; this file only chooses the order and counts what changed.
 #include "core/surface/surface_repair.h"
-#include "core/util/exception_status.h"
 
 #include <algorithm>
 #include <array>
@@ -21,6 +20,7 @@
 #include <CGAL/Polygon_mesh_processing/triangulate_hole.h>
 
 #include "core/surface/cgal/cgal_mesh.h"
+#include "core/util/exception_status.h"
 #include "core/util/text.h"
 
 namespace labelmesh::surface {

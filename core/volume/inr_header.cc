@@ -47,8 +47,9 @@ absl::StatusOr<VolumeHeader> check_inr_header(const std::string& path, bool gzip
     return field_error(path, "header",
                        cat("is ", header_size, " bytes; INR headers are a multiple of 256"));
   }
-  auto text = parse_text_header(path, std::string_view(*bytes).substr(0, end),
-                                {.separator = "=", .comment = "#", .last_key = ""}, end + 1);
+  auto text = parse_text_header(
+      path, std::string_view(*bytes).substr(0, end),
+      {.separator = "=", .comment = "#", .last_key = "", .skip_marker = ""}, end + 1);
   if (!text.ok()) return text.status();
   const TextHeader& h = *text;
 

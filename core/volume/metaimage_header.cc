@@ -62,9 +62,10 @@ absl::StatusOr<VolumeHeader> check_metaimage_header(const std::string& path,
                                                     const ReadLimits& limits) {
   auto bytes = read_prefix(path, limits.max_header_bytes, false);
   if (!bytes.ok()) return bytes.status();
-  auto text = parse_text_header(path, *bytes,
-                                {.separator = "=", .comment = "", .last_key = "ElementDataFile"},
-                                limits.max_header_bytes);
+  auto text = parse_text_header(
+      path, *bytes,
+      {.separator = "=", .comment = "", .last_key = "ElementDataFile", .skip_marker = ""},
+      limits.max_header_bytes);
   if (!text.ok()) return text.status();
   const TextHeader& h = *text;
 
