@@ -309,7 +309,7 @@ TEST(WriteVolumeMesh, AbaqusElementsArePositiveAndSurfacesLieOnTheBoundary) {
   size_t element_keywords = 0;
   while (std::getline(text, line)) {
     if (line.rfind("**", 0) == 0) continue;
-    if (line.rfind("*", 0) == 0) {
+    if (line.rfind('*', 0) == 0) {
       section = line.substr(0, line.find(','));
       const auto equals = line.rfind('=');
       name = equals == std::string::npos ? "" : line.substr(equals + 1);
