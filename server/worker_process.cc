@@ -8,6 +8,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
@@ -241,9 +242,10 @@ absl::Status check_worker_version(const std::string& executable) {
         absl::StrCat("worker ", executable,
                      ": cannot be run (install labelmesh-worker beside "
                      "labelmeshd, or name it with --worker-executable)"));
-  return absl::FailedPreconditionError(absl::StrCat("worker ", executable, ": --version printed '",
-                                                    line.substr(0, 80), "', expected '",
-                                                    kWorkerVersionLine, "'"));
+  return absl::FailedPreconditionError(
+      absl::StrCat("worker ", executable, ": --version printed '",
+                   line.substr(0, std::min<size_t>(line.find('\n'), 80)), "', expected '",
+                   kWorkerVersionLine, "'"));
 }
 
 }  // namespace labelmesh::server
