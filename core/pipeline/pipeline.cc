@@ -90,10 +90,11 @@ std::vector<LabelWarning> collect_warnings(const std::vector<SurfaceResult>& sur
 // Labels with at least this many voxels are meshed one at a time (LabelQueue).
 constexpr uint64_t kLargeLabelVoxels = 100'000;
 
-// Hands the heap's free pages back to the system. glibc keeps one arena per
-// thread, and what a large label freed in one thread's arena is not reused by
-// the next large label on another thread: without this the brain's peak
-// resident memory was two large labels' worth although only one ran at a time.
+// Hands the heap's free pages back to the system, after each large label.
+// glibc keeps one arena per thread, and what a large label freed in one
+// thread's arena is not reused by the next large label on another thread:
+// without this the brain's peak resident memory was two large labels' worth
+// although only one ran at a time. Small labels free too little to matter.
 void release_free_memory() {
 #ifdef __GLIBC__
   malloc_trim(0);
@@ -166,7 +167,7 @@ absl::Status add_every_label_surface(const volume::LabelVolume& volume, const Vo
       label_status[i] = status;
       if (!status.ok()) queue.end();
       queue.done(i);
-      release_free_memory();
+      if (large[i]) release_free_memory();
     }
   };
   const unsigned threads = label_threads(params, count);
