@@ -72,6 +72,7 @@ int run_watch(const JobFlags& flags) {
   auto job = follow_job(*connection, flags.job_id, FollowOptions{.json = flags.json});
   if (!job.ok()) return fail("watch", job.status());
   if (!flags.json) print_job_line(*job);
+  print_label_warnings("watch", job->report());
   return exit_code_for_job(*job);
 }
 
@@ -102,6 +103,13 @@ int run_fetch(const JobFlags& flags) {
   if (!flags.artifact.empty()) only = flags.artifact;
   auto written = fetch_artifacts(*connection, flags.job_id, flags.out_dir, only);
   if (!written.ok()) return fail("fetch", written.status());
+  // The files alone do not say which labels were left out: the report does.
+  auto stub = v1::MeshingService::NewStub(connection->channel());
+  auto context = connection->context(kCallTimeout);
+  v1::GetJobRequest request;
+  request.set_job_id(flags.job_id);
+  v1::Job job;
+  if (stub->GetJob(context.get(), request, &job).ok()) print_label_warnings("fetch", job.report());
   if (flags.json) {
     std::printf("{\"job_id\": \"%s\", \"files\": %d}\n", flags.job_id.c_str(), *written);
   } else {

@@ -10,9 +10,11 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <chrono>
 #include <cstring>
 #include <filesystem>
 #include <optional>
+#include <thread>
 #include <vector>
 
 #include "absl/status/status.h"
@@ -25,6 +27,18 @@ namespace labelmesh::server {
 namespace {
 
 constexpr int kChildEventFd = 3;
+
+// Reaps `pid` if it exits before `deadline`; otherwise kills and reaps it.
+// True if it exited by itself.
+bool exited_before(pid_t pid, std::chrono::steady_clock::time_point deadline, int& status) {
+  while (std::chrono::steady_clock::now() < deadline) {
+    if (waitpid(pid, &status, WNOHANG) == pid) return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  ::kill(pid, SIGKILL);
+  waitpid(pid, &status, 0);
+  return false;
+}
 
 struct ChildSetup {
   int event_write_fd;
@@ -211,7 +225,8 @@ std::string worker_executable(const ServerConfig& config) {
       .string();
 }
 
-absl::Status check_worker_version(const std::string& executable) {
+absl::Status check_worker_version(const std::string& executable,
+                                  std::chrono::milliseconds answer_time) {
   int out[2];
   if (pipe2(out, O_CLOEXEC) != 0) return absl::InternalError("cannot create a pipe");
   std::string path = executable, flag = "--version";
@@ -223,17 +238,38 @@ absl::Status check_worker_version(const std::string& executable) {
     _exit(127);
   }
   ::close(out[1]);
+  // A worker that hangs must not hang the server's start: it is killed once
+  // its time to answer is over.
+  const auto deadline = std::chrono::steady_clock::now() + answer_time;
   std::string printed;
+  bool answered = false;
   char buffer[256];
-  for (ssize_t n;
-       pid > 0 && printed.size() < 4096 && (n = ::read(out[0], buffer, sizeof buffer)) != 0;) {
+  while (pid > 0 && printed.size() < 4096) {
+    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
+        deadline - std::chrono::steady_clock::now());
+    pollfd readable{.fd = out[0], .events = POLLIN, .revents = 0};
+    const int ready = left.count() > 0 ? ::poll(&readable, 1, int(left.count())) : 0;
+    if (ready < 0 && errno == EINTR) continue;
+    if (ready <= 0) break;
+    const ssize_t n = ::read(out[0], buffer, sizeof buffer);
     if (n < 0 && errno == EINTR) continue;
-    if (n < 0) break;
+    if (n <= 0) {
+      answered = n == 0;
+      break;
+    }
     printed.append(buffer, size_t(n));
   }
   ::close(out[0]);
   int status = 0;
-  if (pid > 0) waitpid(pid, &status, 0);
+  // Whoever prints more than a version line is not our worker: no waiting.
+  const bool too_long = printed.size() >= 4096;
+  if (pid > 0 &&
+      !exited_before(pid, too_long ? std::chrono::steady_clock::now() : deadline, status) &&
+      !too_long)
+    answered = false;
+  if (pid > 0 && !answered && !too_long)
+    return absl::FailedPreconditionError(absl::StrCat(
+        "worker ", executable, ": did not answer --version within ", answer_time.count(), " ms"));
   const std::string line(absl::StripAsciiWhitespace(printed));
   if (pid > 0 && WIFEXITED(status) && WEXITSTATUS(status) == 0 && line == kWorkerVersionLine)
     return absl::OkStatus();

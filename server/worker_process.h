@@ -5,6 +5,7 @@
 // crash takes only its own job down.
 #pragma once
 
+#include <chrono>
 #include <cstdint>
 #include <functional>
 #include <string>
@@ -67,7 +68,9 @@ std::string worker_executable(const ServerConfig& config);
 
 // Runs `executable --version` and checks that it prints kWorkerVersionLine,
 // so a server never runs jobs on a worker of another version.
-// FAILED_PRECONDITION naming the executable otherwise.
-absl::Status check_worker_version(const std::string& executable);
+// FAILED_PRECONDITION naming the executable otherwise, also when it has not
+// exited within `answer_time` (it is then killed).
+absl::Status check_worker_version(const std::string& executable,
+                                  std::chrono::milliseconds answer_time = std::chrono::seconds(10));
 
 }  // namespace labelmesh::server

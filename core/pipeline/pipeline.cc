@@ -213,9 +213,13 @@ absl::Status add_volume_mesh(const MeshParams& params, const volume::ImageGeomet
 absl::StatusOr<VolumeSummary> summarise_volume(const std::string& path,
                                                const volume::ReadLimits& limits,
                                                const RunContext& context) {
-  auto volume = volume::read_label_volume(path, limits, context);
-  if (!volume.ok()) return volume.status();
-  return summary_of(*volume);
+  try {
+    auto volume = volume::read_label_volume(path, limits, context);
+    if (!volume.ok()) return volume.status();
+    return summary_of(*volume);
+  } catch (...) {
+    return current_exception_status(path);
+  }
 }
 
 volume_mesh::ImproveParams improve_params_for(const MeshParams& params,

@@ -90,8 +90,9 @@ grep -q '"state": "JOB_STATE_SUCCEEDED"' <<<"$status_json" || fail "status"
 listed=$("$labelmesh" list) || fail "list exited $?"
 grep -q "$job" <<<"$listed" || fail "list does not show the job"
 
-# Labels not delivered are named on stderr by submit and by status: the
-# thin-shapes phantom's one- and two-voxel labels are too small to mesh.
+# Labels not delivered are named on stderr by submit, status, watch and
+# fetch: the thin-shapes phantom's one- and two-voxel labels are too small to
+# mesh.
 "$labelmesh" phantom thin-shapes --out "$work/thin.nii.gz" >/dev/null
 "$labelmesh" submit "$work/thin.nii.gz" --surface repaired --out "$work/thin" \
   >"$work/thin.out" 2>"$work/thin.err" || fail "submit of the thin shapes exited $?"
@@ -101,6 +102,11 @@ grep -q "too small to mesh" "$work/thin.err" || fail "submit did not say which l
 thin_job=$(sed -n 's/^job \([0-9a-f]\{32\}\) finished.*/\1/p' "$work/thin.out")
 "$labelmesh" status "$thin_job" >/dev/null 2>"$work/thin-status.err" || fail "status exited $?"
 grep -q "too small to mesh" "$work/thin-status.err" || fail "status printed no warnings"
+"$labelmesh" watch "$thin_job" >/dev/null 2>"$work/thin-watch.err" || fail "watch exited $?"
+grep -q "too small to mesh" "$work/thin-watch.err" || fail "watch printed no warnings"
+"$labelmesh" fetch "$thin_job" --out "$work/thin-fetched" >/dev/null 2>"$work/thin-fetch.err" ||
+  fail "fetch exited $?"
+grep -q "too small to mesh" "$work/thin-fetch.err" || fail "fetch printed no warnings"
 
 # Exit codes: unknown job 3, cancel of an ended job 4, a volume that fails 3.
 set +e

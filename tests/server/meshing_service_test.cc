@@ -552,6 +552,19 @@ TEST_F(MeshingServiceTest, RefusesToStartWithAWorkerOfAnotherVersion) {
       << started.status().message();
 }
 
+TEST_F(MeshingServiceTest, AWorkerThatHangsAtVersionIsKilled) {
+  const fs::path hanging = dir_ / "hanging-worker.sh";
+  write_file(hanging, "#!/bin/sh\nexec sleep 60\n");
+  fs::permissions(hanging, fs::perms::owner_all);
+  const auto before = std::chrono::steady_clock::now();
+  const absl::Status status =
+      server::check_worker_version(hanging.string(), std::chrono::milliseconds(300));
+  const auto waited = std::chrono::steady_clock::now() - before;
+  EXPECT_EQ(status.code(), absl::StatusCode::kFailedPrecondition);
+  EXPECT_TRUE(absl::StrContains(status.message(), "did not answer --version")) << status.message();
+  EXPECT_LT(waited, std::chrono::seconds(30));
+}
+
 TEST_F(MeshingServiceTest, CrashedWorkerFailsOnlyItsJob) {
   const fs::path crashing = dir_ / "crashing-worker.sh";
   write_file(crashing, absl::StrCat("#!/bin/sh\n", kAnswersVersion, "kill -SEGV $$\n"));
