@@ -52,7 +52,7 @@ struct SurfaceResult {
   int32_t label = 0;
   // Stage that produced the surface: "marching_cubes", "repaired", or the
   // delivery guard's method ("poisson", "poisson_refined", "mask",
-  // "mask_refined").
+  // "mask_refined", "mask_finest").
   std::string stage;
   // True for the stage whose surface is the run's output.
   bool is_output = false;

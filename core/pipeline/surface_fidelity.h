@@ -21,7 +21,7 @@ struct SurfaceTolerance {
 
 // One surface the guard built and measured for a label.
 struct SurfaceAttempt {
-  // poisson, poisson_refined, mask, mask_refined or repaired.
+  // poisson, poisson_refined, mask, mask_refined, mask_finest or repaired.
   std::string method;
   // Sizing it was built with, mm (the largest over the label's components).
   double max_edge_mm = 0;

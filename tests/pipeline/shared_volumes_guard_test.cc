@@ -7,6 +7,7 @@
 // sanitizers, which make it several minutes.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <set>
 #include <string>
 
@@ -55,6 +56,27 @@ INSTANTIATE_TEST_SUITE_P(Files, SharedVolumes,
                                            "totalseg_example_seg_dicom.nii.gz"
 #endif
                                            ));
+
+// Brain label 8 has a groove that the mask surface bridges at its label's
+// sizing and at half of it; a quarter resolves it.
+TEST(SharedVolumesBrain, ANarrowGrooveGetsTheFinestMaskSurface) {
+  MeshParams params;
+  params.labels = {8};
+  auto result =
+      run_pipeline(testing::shared_data("iso2mesh_brain_seg_converted.nii.gz"), params, {});
+  ASSERT_TRUE(result.ok()) << result.status();
+  EXPECT_TRUE(result->warnings.empty());
+  const auto output = std::find_if(result->surfaces.begin(), result->surfaces.end(),
+                                   [](const SurfaceResult& s) { return s.is_output; });
+  ASSERT_NE(output, result->surfaces.end());
+  EXPECT_EQ(output->stage, "mask_finest");
+  ASSERT_TRUE(output->fidelity.has_value());
+  ASSERT_EQ(output->fidelity->attempts.size(), 3u);
+  EXPECT_GT(output->fidelity->attempts[1].hausdorff_mm, 1.0);
+  EXPECT_LE(output->fidelity->attempts[2].hausdorff_mm, 1.0);
+  EXPECT_TRUE(output->fidelity->within_tolerance());
+  EXPECT_GE(output->statistics.min_angle_deg, 29.99);
+}
 
 }  // namespace
 }  // namespace labelmesh
