@@ -63,11 +63,14 @@ const JobTable::Entry* JobTable::find(const std::string& job_id) const {
   return it == jobs_.end() ? nullptr : &it->second;
 }
 
-void JobTable::persist(const Entry& entry) {
-  if (auto status = spool_.save(entry.record); !status.ok()) {
-    spdlog::error("job {} record not saved: {}", entry.record.job().job_id(),
+absl::Status JobTable::persist(const v1::JobRecord& record) {
+  absl::Status status = spool_.save(record);
+  if (!status.ok()) {
+    metrics_.spool_write_failed();
+    spdlog::error("job {} record not saved: {}", record.job().job_id(),
                   std::string(status.message()));
   }
+  return status;
 }
 
 void JobTable::update_gauges() {
@@ -117,7 +120,7 @@ void JobTable::recover(absl::Duration result_ttl) {
     }
     Entry& entry = jobs_[id];
     entry.record = std::move(record);
-    if (!has_ended(entry.record.job().state())) persist(entry);
+    if (!has_ended(entry.record.job().state())) (void)persist(entry.record);
     add_event(entry, state_event(entry.record.job(), position_of(id)));
   }
   update_gauges();
@@ -167,7 +170,9 @@ std::optional<v1::JobRecord> JobTable::take_next() {
   job.set_state(v1::JOB_STATE_RUNNING);
   job.set_attempts(job.attempts() + 1);
   job.set_started_at(now);
-  persist(entry);
+  // Unsaved, the job still runs; on disk it stays queued and runs again
+  // after a restart.
+  (void)persist(entry.record);
   ++running_;
   v1::JobEvent event;
   event.mutable_started()->set_attempt(job.attempts());
@@ -199,18 +204,22 @@ void JobTable::publish(const std::string& job_id, v1::JobEvent event) {
   add_event(*entry, std::move(event));
 }
 
-void JobTable::end_job(Entry& entry, v1::JobState state, v1::JobEvent event) {
-  v1::Job& job = *entry.record.mutable_job();
+absl::Status JobTable::end_job(Entry& entry, v1::JobState state, v1::JobEvent event,
+                               Unsaved unsaved) {
+  v1::JobRecord ended = entry.record;
+  v1::Job& job = *ended.mutable_job();
   const bool was_running = job.state() == v1::JOB_STATE_RUNNING;
   job.set_state(state);
   job.set_finished_at(unix_now());
   job.clear_stage();
-  persist(entry);
+  if (auto status = persist(ended); !status.ok() && unsaved == Unsaved::kRefuse) return status;
+  entry.record = std::move(ended);
   if (was_running && running_ > 0) --running_;
   add_event(entry, std::move(event));
   update_gauges();
   static const char* const kOutcome[] = {"", "", "", "succeeded", "failed", "cancelled"};
   metrics_.job_ended(kOutcome[state]);
+  return absl::OkStatus();
 }
 
 void JobTable::succeed(const std::string& job_id, const v1::Report& report,
@@ -224,7 +233,7 @@ void JobTable::succeed(const std::string& job_id, const v1::Report& report,
   for (auto& artifact : artifacts) *entry->record.add_artifacts() = std::move(artifact);
   v1::JobEvent event;
   *event.mutable_finished()->mutable_report() = report;
-  end_job(*entry, v1::JOB_STATE_SUCCEEDED, std::move(event));
+  (void)end_job(*entry, v1::JOB_STATE_SUCCEEDED, std::move(event), Unsaved::kApply);
   spdlog::info("job {} succeeded in {:.3f} s", job_id,
                entry->record.job().finished_at() - entry->record.job().started_at());
 }
@@ -238,26 +247,32 @@ void JobTable::fail(const std::string& job_id, int code, const std::string& mess
   error.set_message(message);
   v1::JobEvent event;
   *event.mutable_failed() = error;
-  end_job(*entry, v1::JOB_STATE_FAILED, std::move(event));
+  (void)end_job(*entry, v1::JOB_STATE_FAILED, std::move(event), Unsaved::kApply);
   // The message may quote the volume's fields; the log keeps the code only.
   spdlog::warn("job {} failed with status code {}", job_id, code);
 }
 
-void JobTable::end_cancelled(Entry& entry) {
+absl::Status JobTable::end_cancelled(Entry& entry, Unsaved unsaved) {
+  const v1::JobError before = entry.record.job().error();
   v1::JobError& error = *entry.record.mutable_job()->mutable_error();
   error.set_code(static_cast<int>(absl::StatusCode::kCancelled));
   error.set_message("cancelled by a client");
   v1::JobEvent event;
   event.mutable_cancelled();
-  end_job(entry, v1::JOB_STATE_CANCELLED, std::move(event));
+  if (auto status = end_job(entry, v1::JOB_STATE_CANCELLED, std::move(event), unsaved);
+      !status.ok()) {
+    *entry.record.mutable_job()->mutable_error() = before;
+    return status;
+  }
   spdlog::info("job {} cancelled", entry.record.job().job_id());
+  return absl::OkStatus();
 }
 
 void JobTable::mark_cancelled(const std::string& job_id) {
   std::lock_guard lock(mutex_);
   Entry* entry = find(job_id);
   if (entry == nullptr || has_ended(entry->record.job().state())) return;
-  end_cancelled(*entry);
+  (void)end_cancelled(*entry, Unsaved::kApply);
 }
 
 void JobTable::requeue_interrupted(const std::string& job_id) {
@@ -265,7 +280,7 @@ void JobTable::requeue_interrupted(const std::string& job_id) {
   Entry* entry = find(job_id);
   if (entry == nullptr || entry->record.job().state() != v1::JOB_STATE_RUNNING) return;
   entry->record.mutable_job()->set_state(v1::JOB_STATE_QUEUED);
-  persist(*entry);
+  (void)persist(entry->record);
   if (running_ > 0) --running_;
   update_gauges();
   spdlog::info("job {} interrupted by shutdown; it runs again at the next start", job_id);
@@ -306,8 +321,10 @@ absl::StatusOr<v1::Job> JobTable::cancel(const std::string& job_id) {
   if (state == v1::JOB_STATE_RUNNING) {
     entry->cancel_requested = true;
   } else {
+    // The client hears "cancelled" only once the record says so on disk.
+    if (auto status = end_cancelled(*entry, Unsaved::kRefuse); !status.ok()) return status;
     queue_.erase(std::find(queue_.begin(), queue_.end(), job_id));
-    end_cancelled(*entry);
+    update_gauges();
   }
   return entry->record.job();
 }

@@ -51,7 +51,9 @@ class JobTable {
   // Newest first, without reports.
   std::vector<v1::Job> list() const;
   // A queued job is cancelled at once; a running one is flagged for its
-  // worker to stop. FAILED_PRECONDITION for a job that ended.
+  // worker to stop. FAILED_PRECONDITION for a job that ended; the spool's
+  // error (RESOURCE_EXHAUSTED when its disk is full) when the cancelled
+  // record cannot be saved, and the job stays queued.
   absl::StatusOr<v1::Job> cancel(const std::string& job_id);
   bool cancel_requested(const std::string& job_id) const;
   // FAILED_PRECONDITION unless the job succeeded.
@@ -85,9 +87,15 @@ class JobTable {
   const Entry* find(const std::string& job_id) const;
   // Appends an event (sequence and time set here) and wakes watchers.
   void add_event(Entry& entry, v1::JobEvent event);
-  void persist(const Entry& entry);
-  void end_job(Entry& entry, v1::JobState state, v1::JobEvent event);
-  void end_cancelled(Entry& entry);
+  // Saves to the spool; a failure is logged and counted, and returned.
+  absl::Status persist(const v1::JobRecord& record);
+  // What an end does when its record cannot be saved: a client's request is
+  // refused with the spool's error and changes nothing; an end the worker
+  // reached is applied in memory (on disk the job stays unended, so after a
+  // restart it runs again and nothing is lost).
+  enum class Unsaved { kRefuse, kApply };
+  absl::Status end_job(Entry& entry, v1::JobState state, v1::JobEvent event, Unsaved unsaved);
+  absl::Status end_cancelled(Entry& entry, Unsaved unsaved);
   uint32_t position_of(const std::string& job_id) const;
   void update_gauges();
 

@@ -93,7 +93,8 @@ absl::StatusOr<std::unique_ptr<LabelmeshServer>> LabelmeshServer::start(ServerCo
   }
   server->pool_ = std::make_unique<WorkerPool>(*server->table_, *server->spool_, c);
   server->pool_->start();
-  server->expirer_ = std::thread([s = server.get()] { s->expire_loop(); });
+  server->check_spool_space();
+  server->housekeeper_ = std::thread([s = server.get()] { s->housekeeping_loop(); });
   spdlog::info(
       "labelmeshd listening on {} (port {}), {} workers, queue capacity {}, TLS {}, auth {}",
       c.listen, server->port_, c.workers, c.queue_capacity, c.tls() ? "on" : "off",
@@ -101,12 +102,29 @@ absl::StatusOr<std::unique_ptr<LabelmeshServer>> LabelmeshServer::start(ServerCo
   return server;
 }
 
-void LabelmeshServer::expire_loop() {
+void LabelmeshServer::check_spool_space() {
+  auto free = spool_->free_bytes();
+  const bool under_reserve = !free.ok() || *free < config_.spool_reserve_bytes;
+  metrics_->set_spool_space(free.ok() ? *free : 0, under_reserve);
+  if (under_reserve != under_reserve_) {
+    if (under_reserve) {
+      spdlog::error("spool disk under its reserve ({} bytes free, reserve {}): not serving uploads",
+                    free.ok() ? *free : 0, config_.spool_reserve_bytes);
+    } else {
+      spdlog::info("spool disk above its reserve again: serving");
+    }
+    under_reserve_ = under_reserve;
+  }
+  server_->GetHealthCheckService()->SetServingStatus(!under_reserve);
+}
+
+void LabelmeshServer::housekeeping_loop() {
   const auto period =
-      std::min(absl::ToChronoMilliseconds(config_.result_ttl), std::chrono::milliseconds(60'000));
+      std::min(absl::ToChronoMilliseconds(config_.result_ttl), std::chrono::milliseconds(2'000));
   std::unique_lock lock(mutex_);
   while (!stopping_.wait_for(lock, period, [this] { return stopped_; })) {
     table_->expire(config_.result_ttl);
+    check_spool_space();
   }
 }
 
@@ -126,7 +144,7 @@ void LabelmeshServer::shutdown() {
   table_->close();
   server_->Shutdown(std::chrono::system_clock::now() + std::chrono::seconds(2));
   pool_->join();
-  if (expirer_.joinable()) expirer_.join();
+  if (housekeeper_.joinable()) housekeeper_.join();
   spdlog::info("labelmeshd stopped");
 }
 

@@ -39,7 +39,12 @@ class LabelmeshServer {
 
  private:
   LabelmeshServer() = default;
-  void expire_loop();
+  // Every few seconds: deletes expired jobs and checks the spool's free
+  // space against its reserve.
+  void housekeeping_loop();
+  // Health NOT_SERVING and the disk-pressure gauge while the spool's disk is
+  // under its reserve.
+  void check_spool_space();
 
   ServerConfig config_;
   std::unique_ptr<Metrics> metrics_;
@@ -50,7 +55,8 @@ class LabelmeshServer {
   std::unique_ptr<grpc::Server> server_;
   int port_ = 0;
 
-  std::thread expirer_;
+  std::thread housekeeper_;
+  bool under_reserve_ = false;
   std::mutex mutex_;
   std::condition_variable stopping_;
   bool stopped_ = false;

@@ -59,6 +59,10 @@ void add_server_flags(CLI::App& app, ServerConfig& c) {
   env(app.add_option("--max-upload-bytes", c.max_upload_bytes, "Largest upload")
           ->capture_default_str(),
       "LABELMESHD_MAX_UPLOAD_BYTES");
+  env(app.add_option("--spool-reserve-bytes", c.spool_reserve_bytes,
+                     "Free spool disk space kept for running jobs; uploads into it are refused")
+          ->capture_default_str(),
+      "LABELMESHD_SPOOL_RESERVE_BYTES");
   env(app.add_option("--max-voxels", c.max_voxels, "Largest volume, voxels")->capture_default_str(),
       "LABELMESHD_MAX_VOXELS");
   env(app.add_option("--max-concurrent-uploads", c.max_concurrent_uploads,

@@ -7,6 +7,7 @@
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 #include "core/pipeline/job_options.h"
+#include "server/durable_file.h"
 #include "server/sha256.h"
 #include "server/upload_checks.h"
 #include "spdlog/spdlog.h"
@@ -82,15 +83,32 @@ grpc::Status MeshingService::authenticate(const grpc::ServerContext& context) {
                       "missing or wrong bearer token (metadata 'authorization: Bearer <token>')");
 }
 
+absl::Status MeshingService::check_spool_space(uint64_t upload_bytes) const {
+  auto free = spool_.free_bytes();
+  if (!free.ok()) return free.status();
+  if (*free < config_.spool_reserve_bytes + upload_bytes) {
+    return absl::ResourceExhaustedError(
+        absl::StrCat("spool disk full: ", *free, " bytes free, an upload of ", upload_bytes,
+                     " bytes would leave less than the reserve of ", config_.spool_reserve_bytes,
+                     "; try again later"));
+  }
+  return absl::OkStatus();
+}
+
 grpc::Status MeshingService::receive_upload(grpc::ServerReader<v1::SubmitRequest>& reader,
                                             const v1::JobSpec& spec, const std::string& path) {
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  if (!out) return grpc::Status(grpc::StatusCode::INTERNAL, "spool: cannot store the upload");
   // Each refusal is counted here, by its reason, and only here.
   auto refuse = [this](const char* reason, const std::string& message) {
     metrics_.rejected(reason);
     return invalid(message);
   };
+  auto spool_failed = [this](const absl::Status& status) {
+    metrics_.rejected(status.code() == absl::StatusCode::kResourceExhausted ? "disk_full"
+                                                                            : "spool_error");
+    return to_grpc(status);
+  };
+  FileWriter out;
+  if (auto status = out.open(path); !status.ok()) return spool_failed(status);
   digest::Sha256 hash;
   uint64_t received = 0;
   v1::SubmitRequest message;
@@ -104,12 +122,11 @@ grpc::Status MeshingService::receive_upload(grpc::ServerReader<v1::SubmitRequest
       return refuse("bad_request", absl::StrCat("upload: more bytes than spec.size_bytes (",
                                                 spec.size_bytes(), ")"));
     }
-    out.write(chunk.data(), static_cast<std::streamsize>(chunk.size()));
+    if (auto status = out.append(chunk); !status.ok()) return spool_failed(status);
     hash.update(chunk);
     received += chunk.size();
   }
-  out.flush();
-  if (!out) return grpc::Status(grpc::StatusCode::INTERNAL, "spool: cannot write the upload");
+  if (auto status = out.finish(); !status.ok()) return spool_failed(status);
   if (received < spec.size_bytes()) {
     return refuse("bad_request", absl::StrCat("upload: truncated, ", received, " of ",
                                               spec.size_bytes(), " bytes received"));
@@ -150,6 +167,10 @@ grpc::Status MeshingService::Submit(grpc::ServerContext* context,
     return grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED,
                         "the job queue is full; try again later");
   }
+  if (auto status = check_spool_space(spec.size_bytes()); !status.ok()) {
+    metrics_.rejected("disk_full");
+    return to_grpc(status);
+  }
   // The job's voxel limit is the smaller of the client's and the server's.
   auto& options = *spec.mutable_options();
   const uint64_t voxel_limit = options.max_voxels() == 0
@@ -182,7 +203,9 @@ grpc::Status MeshingService::Submit(grpc::ServerContext* context,
   auto position = table_.accept(std::move(record), upload.path());
   if (!position.ok()) {
     if (position.status().code() == absl::StatusCode::kResourceExhausted) {
-      metrics_.rejected("queue_full");
+      metrics_.rejected(absl::StartsWith(position.status().message(), "spool disk full")
+                            ? "disk_full"
+                            : "queue_full");
     }
     return to_grpc(position.status());
   }

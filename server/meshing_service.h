@@ -42,6 +42,9 @@ class MeshingService final : public v1::MeshingService::Service {
   grpc::Status authenticate(const grpc::ServerContext& context);
   grpc::Status receive_upload(grpc::ServerReader<v1::SubmitRequest>& reader,
                               const v1::JobSpec& spec, const std::string& path);
+  // RESOURCE_EXHAUSTED "spool disk full" when an upload of this size would
+  // leave less than the reserve free.
+  absl::Status check_spool_space(uint64_t upload_bytes) const;
 
   JobTable& table_;
   const Spool& spool_;

@@ -25,6 +25,9 @@ struct Metrics::Families {
   prometheus::Family<Histogram>& stage_duration;
   prometheus::Family<prometheus::Counter>& rejections;
   prometheus::Family<prometheus::Counter>& upload_bytes;
+  prometheus::Family<prometheus::Gauge>& spool_free_bytes;
+  prometheus::Family<prometheus::Gauge>& spool_disk_pressure;
+  prometheus::Family<prometheus::Counter>& spool_write_failures;
 };
 
 namespace {
@@ -68,10 +71,24 @@ Metrics::Metrics(int queue_capacity) : registry_(std::make_shared<prometheus::Re
           .Name("labelmesh_upload_bytes_total")
           .Help("Bytes of accepted uploads")
           .Register(r),
+      prometheus::BuildGauge()
+          .Name("labelmesh_spool_free_bytes")
+          .Help("Bytes still free on the spool's file system")
+          .Register(r),
+      prometheus::BuildGauge()
+          .Name("labelmesh_spool_disk_pressure")
+          .Help("1 while the spool's free space is under its reserve: no uploads accepted")
+          .Register(r),
+      prometheus::BuildCounter()
+          .Name("labelmesh_spool_write_failures_total")
+          .Help("Job records the spool could not save")
+          .Register(r),
   });
   families_->queue_capacity.Add({}).Set(queue_capacity);
   families_->queue_depth.Add({}).Set(0);
   families_->running.Add({}).Set(0);
+  families_->spool_disk_pressure.Add({}).Set(0);
+  families_->spool_write_failures.Add({});
 }
 
 Metrics::~Metrics() = default;
@@ -122,5 +139,12 @@ void Metrics::rejected(const std::string& reason) {
 void Metrics::upload_bytes(uint64_t bytes) {
   families_->upload_bytes.Add({}).Increment(double(bytes));
 }
+
+void Metrics::set_spool_space(uint64_t free_bytes, bool under_reserve) {
+  families_->spool_free_bytes.Add({}).Set(double(free_bytes));
+  families_->spool_disk_pressure.Add({}).Set(under_reserve ? 1 : 0);
+}
+
+void Metrics::spool_write_failed() { families_->spool_write_failures.Add({}).Increment(); }
 
 }  // namespace labelmesh::server

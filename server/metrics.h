@@ -2,6 +2,7 @@
 // The server's Prometheus metrics, all named labelmesh_*, in base units.
 #pragma once
 
+#include <cstdint>
 #include <memory>
 #include <string>
 
@@ -31,9 +32,11 @@ class Metrics {
   void queue_wait(double seconds);
   void stage_finished(const std::string& stage, double seconds);
   // reason: queue_full, too_many_uploads, too_large, bad_request, bad_digest,
-  // bad_volume, unauthenticated.
+  // bad_volume, unauthenticated, disk_full, spool_error.
   void rejected(const std::string& reason);
   void upload_bytes(uint64_t bytes);
+  void set_spool_space(uint64_t free_bytes, bool under_reserve);
+  void spool_write_failed();
 
  private:
   struct Families;

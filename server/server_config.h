@@ -27,6 +27,10 @@ struct ServerConfig {
   absl::Duration shutdown_grace = absl::Seconds(30);
 
   uint64_t max_upload_bytes = uint64_t{2} << 30;
+  // Free space the spool's disk keeps: an upload that would eat into it is
+  // refused ("spool disk full") and health reports NOT_SERVING meanwhile, so
+  // that running jobs can still write their results and records.
+  uint64_t spool_reserve_bytes = uint64_t{512} << 20;
   uint64_t max_voxels = uint64_t{1} << 31;
   int max_concurrent_uploads = 8;
   // Largest gRPC message either way; upload and fetch chunks are 1 MiB.

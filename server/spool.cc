@@ -1,30 +1,24 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 #include "server/spool.h"
 
-#include <fcntl.h>
-#include <unistd.h>
+#include <sys/statvfs.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <filesystem>
 #include <fstream>
 #include <random>
 
 #include "absl/strings/str_cat.h"
+#include "server/durable_file.h"
 #include "server/sha256.h"
+#include "spdlog/spdlog.h"
 
 namespace labelmesh::server {
 namespace fs = std::filesystem;
 namespace {
 
 constexpr const char* kRecordName = "job.pb";
-
-// fsync a file or directory so a rename or write survives a power cut.
-void sync_path(const std::string& path) {
-  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-  if (fd < 0) return;
-  ::fsync(fd);
-  ::close(fd);
-}
 
 absl::Status io_error(const std::string& what, const std::error_code& error) {
   return absl::InternalError(absl::StrCat("spool: ", what, ": ", error.message()));
@@ -39,6 +33,8 @@ absl::StatusOr<Spool> Spool::open(const std::string& root) {
   fs::remove_all(fs::path(root) / "uploads", error);
   fs::create_directories(fs::path(root) / "uploads", error);
   if (error) return io_error(absl::StrCat("cannot create ", root, "/uploads"), error);
+  fs::create_directories(fs::path(root) / "quarantine", error);
+  if (error) return io_error(absl::StrCat("cannot create ", root, "/quarantine"), error);
   return Spool(fs::absolute(root).string());
 }
 
@@ -69,30 +65,28 @@ absl::Status Spool::create_job(const v1::JobRecord& record, const std::string& u
   if (error) return io_error(absl::StrCat("cannot create ", dir), error);
   fs::rename(upload_path, input_path(record), error);
   if (error) return io_error("cannot move the upload into its job", error);
-  if (auto status = save(record); !status.ok()) {
-    fs::remove_all(dir, error);
-    return status;
-  }
-  sync_path(absl::StrCat(root_, "/jobs"));
-  return absl::OkStatus();
+  absl::Status status = save(record);
+  if (status.ok()) status = sync_directory(absl::StrCat(root_, "/jobs"));
+  if (!status.ok()) fs::remove_all(dir, error);
+  return status;
 }
 
 absl::Status Spool::save(const v1::JobRecord& record) const {
   const std::string dir = job_dir(record.job().job_id());
   const std::string final_path = absl::StrCat(dir, "/", kRecordName);
   const std::string temporary = final_path + ".tmp";
-  {
-    std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
-    if (!out || !record.SerializeToOstream(&out)) {
-      return absl::InternalError(absl::StrCat("spool: cannot write ", temporary));
-    }
-  }
-  sync_path(temporary);
+  std::string bytes;
+  if (!record.SerializeToString(&bytes))
+    return absl::InternalError(absl::StrCat("spool: cannot serialise the record of ", dir));
+  // The old record stays until the new one is whole on disk.
   std::error_code error;
+  if (auto status = write_file_synced(temporary, bytes); !status.ok()) {
+    fs::remove(temporary, error);
+    return status;
+  }
   fs::rename(temporary, final_path, error);
   if (error) return io_error(absl::StrCat("cannot replace ", final_path), error);
-  sync_path(dir);
-  return absl::OkStatus();
+  return sync_directory(dir);
 }
 
 std::vector<v1::JobRecord> Spool::load_all() const {
@@ -100,18 +94,46 @@ std::vector<v1::JobRecord> Spool::load_all() const {
   std::error_code error;
   for (const auto& entry : fs::directory_iterator(fs::path(root_) / "jobs", error)) {
     const std::string name = entry.path().filename().string();
+    const fs::path record_path = entry.path() / kRecordName;
+    if (is_job_id(name) && !fs::exists(record_path, error)) {
+      // Never got an "accepted" reply: its record was not written yet.
+      fs::remove_all(entry.path(), error);
+      continue;
+    }
     v1::JobRecord record;
-    std::ifstream in(entry.path() / kRecordName, std::ios::binary);
-    const bool readable =
-        is_job_id(name) && in && record.ParseFromIstream(&in) && record.job().job_id() == name;
-    if (readable) {
+    std::ifstream in(record_path, std::ios::binary);
+    if (is_job_id(name) && in && record.ParseFromIstream(&in) && record.job().job_id() == name) {
       records.push_back(std::move(record));
     } else {
-      // A job directory without its record never got an "accepted" reply.
-      fs::remove_all(entry.path(), error);
+      quarantine(entry.path().string());
     }
   }
   return records;
+}
+
+void Spool::quarantine(const std::string& path) const {
+  // An unreadable record may still be somebody's accepted job: kept aside
+  // for a person to look at, never deleted. Only the directory's name is
+  // logged; the name of anything not a job id is not.
+  const std::string name = fs::path(path).filename().string();
+  const std::string target =
+      absl::StrCat(root_, "/quarantine/", is_job_id(name) ? name : "entry", "-", new_job_id());
+  std::error_code error;
+  fs::rename(path, target, error);
+  if (error) {
+    spdlog::error("spool: unreadable entry {} could not be quarantined: {}",
+                  is_job_id(name) ? name : "(not a job id)", error.message());
+  } else {
+    spdlog::error("spool: unreadable job record {} moved to {}",
+                  is_job_id(name) ? name : "(not a job id)", target);
+  }
+}
+
+absl::StatusOr<uint64_t> Spool::free_bytes() const {
+  struct statvfs figures {};
+  if (::statvfs(root_.c_str(), &figures) != 0)
+    return spool_io_error(absl::StrCat("cannot read the free space of ", root_), errno);
+  return uint64_t(figures.f_bavail) * figures.f_frsize;
 }
 
 void Spool::remove_job(const std::string& job_id) const {

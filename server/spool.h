@@ -7,6 +7,11 @@
 //   <root>/jobs/<id>/input<ext>   the uploaded volume
 //   <root>/jobs/<id>/out/         meshes and report.json of the last attempt
 //   <root>/jobs/<id>/worker.log   the worker's stderr
+//   <root>/quarantine/            job directories whose record could not be
+//                                 read, kept for a person to look at
+//
+// A write that fails leaves the previous record in place; a full disk is
+// RESOURCE_EXHAUSTED "spool disk full".
 #pragma once
 
 #include <string>
@@ -33,15 +38,19 @@ class Spool {
   absl::Status create_job(const v1::JobRecord& record, const std::string& upload_path) const;
   // Replaces job.pb atomically (temporary file, fsync, rename, fsync).
   absl::Status save(const v1::JobRecord& record) const;
-  // Every job directory with a readable record; others are removed.
+  // Every job directory with a readable record. One without a record (never
+  // accepted) is removed; one whose record is unreadable is quarantined.
   std::vector<v1::JobRecord> load_all() const;
   void remove_job(const std::string& job_id) const;
   // Empties out/ before an attempt.
   absl::Status reset_output(const std::string& job_id) const;
   // Every regular file under out/, with size and SHA-256, sorted by name.
   absl::StatusOr<std::vector<v1::Artifact>> collect_artifacts(const std::string& job_id) const;
+  // Bytes an unprivileged writer may still use on the spool's file system.
+  absl::StatusOr<uint64_t> free_bytes() const;
 
  private:
+  void quarantine(const std::string& path) const;
   explicit Spool(std::string root) : root_(std::move(root)) {}
   std::string root_;
 };

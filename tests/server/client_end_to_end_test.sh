@@ -25,7 +25,7 @@ unset LABELMESH_SERVER LABELMESH_TOKEN
 for v in $(env | grep -o '^LABELMESHD_[A-Z_]*' || true); do unset "$v"; done
 
 start_server() {  # extra flags...
-  "$labelmeshd" --spool-dir "$work/spool" --workers 2 "$@" 2>>"$work/server.log" &
+  "$labelmeshd" --spool-dir "$work/spool" --spool-reserve-bytes 16777216 --workers 2 "$@" 2>>"$work/server.log" &
   server_pid=$!
   for _ in $(seq 100); do
     "$labelmesh" health "${client_flags[@]}" >/dev/null 2>&1 && return 0

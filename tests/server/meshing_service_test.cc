@@ -30,24 +30,10 @@ using Clock = std::chrono::steady_clock;
 const std::string kAnswersVersion = absl::StrCat("[ \"$1\" = --version ] && { echo '",
                                                  server::kWorkerVersionLine, "'; exit 0; }\n");
 
-fs::path write_phantom(const fs::path& dir, volume::PhantomShape shape, double scale = 1.0) {
-  const fs::path path = dir / "phantom.nii.gz";
-  auto status =
-      volume::write_label_volume(volume::make_phantom(shape, scale).volume, path.string());
-  EXPECT_TRUE(status.ok()) << status;
-  return path;
-}
-
 // The liver's organ label (it also holds a few stray voxels of label 84).
 v1::MeshOptions liver_options() {
   v1::MeshOptions options;
   options.add_labels(255);
-  return options;
-}
-
-v1::MeshOptions repaired_options() {
-  v1::MeshOptions options;
-  options.set_surface(v1::SURFACE_METHOD_REPAIRED);
   return options;
 }
 

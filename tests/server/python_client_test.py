@@ -174,7 +174,8 @@ def main():
         with open(log_path, "wb") as log:
             server = subprocess.Popen(
                 [args.labelmeshd, "--listen", address, "--spool-dir", os.path.join(tmp, "spool"),
-                 "--workers", "1"], stdout=log, stderr=subprocess.STDOUT, env=env)
+                 "--spool-reserve-bytes", str(16 << 20), "--workers", "1"],
+                stdout=log, stderr=subprocess.STDOUT, env=env)
         failure = None
         try:
             with grpc.insecure_channel(address) as channel:

@@ -12,6 +12,10 @@
 #include <string>
 #include <vector>
 
+#include <gtest/gtest.h>
+
+#include "core/volume/phantom.h"
+#include "core/volume/write_label_volume.h"
 #include "labelmesh/v1/service.grpc.pb.h"
 #include "server/labelmesh_server.h"
 #include "server/sha256.h"
@@ -36,6 +40,23 @@ inline size_t count_files(const std::filesystem::path& dir) {
   return count;
 }
 
+// The phantom as dir/phantom.nii.gz.
+inline std::filesystem::path write_phantom(const std::filesystem::path& dir,
+                                           volume::PhantomShape shape, double scale = 1.0) {
+  const std::filesystem::path path = dir / "phantom.nii.gz";
+  auto status =
+      volume::write_label_volume(volume::make_phantom(shape, scale).volume, path.string());
+  EXPECT_TRUE(status.ok()) << status;
+  return path;
+}
+
+// The quickest job: the repaired surface, no Poisson.
+inline v1::MeshOptions repaired_options() {
+  v1::MeshOptions options;
+  options.set_surface(v1::SURFACE_METHOD_REPAIRED);
+  return options;
+}
+
 class ServiceHarness {
  public:
   // A server on `spool`, with the config the test tuned.
@@ -47,6 +68,8 @@ class ServiceHarness {
     config.queue_capacity = 8;
     config.shutdown_grace = absl::Seconds(5);
     config.worker_executable = LABELMESH_WORKER;
+    // Small, so that the tests run on a nearly full disk too.
+    config.spool_reserve_bytes = 1 << 20;
     return config;
   }
 

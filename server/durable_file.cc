@@ -1,0 +1,68 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+#include "server/durable_file.h"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+
+#include "absl/strings/str_cat.h"
+
+namespace labelmesh::server {
+
+absl::Status spool_io_error(const std::string& what, int error_number) {
+  if (error_number == ENOSPC || error_number == EDQUOT || error_number == EFBIG)
+    return absl::ResourceExhaustedError(
+        absl::StrCat("spool disk full: ", what, ": ", std::strerror(error_number)));
+  return absl::InternalError(absl::StrCat("spool: ", what, ": ", std::strerror(error_number)));
+}
+
+FileWriter::~FileWriter() {
+  if (fd_ >= 0) ::close(fd_);
+}
+
+absl::Status FileWriter::open(const std::string& path) {
+  path_ = path;
+  fd_ = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0600);
+  if (fd_ < 0) return spool_io_error(absl::StrCat("cannot create ", path), errno);
+  return absl::OkStatus();
+}
+
+absl::Status FileWriter::append(std::string_view bytes) {
+  while (!bytes.empty()) {
+    const ssize_t n = ::write(fd_, bytes.data(), bytes.size());
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) return spool_io_error(absl::StrCat("cannot write ", path_), errno);
+    bytes.remove_prefix(size_t(n));
+  }
+  return absl::OkStatus();
+}
+
+absl::Status FileWriter::finish() {
+  // Delayed allocation can report a full disk only here.
+  if (::fsync(fd_) != 0) return spool_io_error(absl::StrCat("cannot sync ", path_), errno);
+  const int fd = fd_;
+  fd_ = -1;
+  if (::close(fd) != 0) return spool_io_error(absl::StrCat("cannot close ", path_), errno);
+  return absl::OkStatus();
+}
+
+absl::Status write_file_synced(const std::string& path, std::string_view bytes) {
+  FileWriter file;
+  if (auto status = file.open(path); !status.ok()) return status;
+  if (auto status = file.append(bytes); !status.ok()) return status;
+  return file.finish();
+}
+
+absl::Status sync_directory(const std::string& path) {
+  const int fd = ::open(path.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (fd < 0) return spool_io_error(absl::StrCat("cannot open ", path), errno);
+  const int synced = ::fsync(fd);
+  const int error_number = errno;
+  ::close(fd);
+  if (synced != 0) return spool_io_error(absl::StrCat("cannot sync ", path), error_number);
+  return absl::OkStatus();
+}
+
+}  // namespace labelmesh::server

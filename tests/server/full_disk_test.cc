@@ -1,0 +1,138 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// The service on a spool disk that fills up: uploads are refused with "spool
+// disk full", health says NOT_SERVING, and no accepted job is lost, also
+// across a restart on the still full disk.
+#include <gtest/gtest.h>
+#include <sys/mount.h>
+
+#include <cerrno>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+
+#include "absl/strings/match.h"
+#include "core/volume/phantom.h"
+#include "grpc/health/v1/health.grpc.pb.h"
+#include "server/metrics.h"
+#include "support/service_harness.h"
+
+namespace labelmesh {
+namespace {
+namespace fs = std::filesystem;
+using testing::ServiceHarness;
+
+bool serving(ServiceHarness& service) {
+  auto channel = grpc::CreateChannel("127.0.0.1:" + std::to_string(service.server().port()),
+                                     grpc::InsecureChannelCredentials());
+  auto stub = grpc::health::v1::Health::NewStub(channel);
+  grpc::ClientContext context;
+  context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(10));
+  grpc::health::v1::HealthCheckResponse reply;
+  const grpc::Status status = stub->Check(&context, grpc::health::v1::HealthCheckRequest(), &reply);
+  return status.ok() && reply.status() == grpc::health::v1::HealthCheckResponse::SERVING;
+}
+
+size_t entries_in(const fs::path& dir) {
+  size_t count = 0;
+  std::error_code error;
+  for ([[maybe_unused]] const auto& entry : fs::directory_iterator(dir, error)) ++count;
+  return count;
+}
+
+bool has_metric(ServiceHarness& service, const std::string& line) {
+  return service.server().metrics().text().find(line) != std::string::npos;
+}
+
+class FullDiskTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = testing::scratch_dir(::testing::UnitTest::GetInstance()->current_test_info()->name());
+    spool_ = dir_ / "spool";
+    input_ = testing::write_phantom(dir_, volume::PhantomShape::kSphere);
+  }
+  void TearDown() override {
+    if (mounted_) ::umount2(spool_.c_str(), MNT_DETACH);
+  }
+
+  fs::path dir_, spool_, input_;
+  bool mounted_ = false;
+};
+
+TEST_F(FullDiskTest, UnderTheReserveUploadsAreRefusedAndHealthIsNotServing) {
+  auto config = ServiceHarness::config_for(spool_);
+  config.spool_reserve_bytes = uint64_t{1} << 60;  // More than any disk has free.
+  ServiceHarness service(config);
+  EXPECT_FALSE(serving(service));
+  v1::SubmitReply reply;
+  const grpc::Status refused = service.submit(input_, testing::repaired_options(), &reply);
+  EXPECT_EQ(refused.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
+  EXPECT_TRUE(absl::StartsWith(refused.error_message(), "spool disk full"))
+      << refused.error_message();
+  EXPECT_EQ(entries_in(spool_ / "jobs"), 0u);
+  EXPECT_EQ(entries_in(spool_ / "uploads"), 0u);
+  EXPECT_TRUE(has_metric(service, "labelmesh_rejections_total{reason=\"disk_full\"} 1"));
+  EXPECT_TRUE(has_metric(service, "labelmesh_spool_disk_pressure 1"));
+}
+
+// The drill: three queued jobs on a small tmpfs spool, the disk filled, every
+// job cancelled, then a restart on the still full disk.
+TEST_F(FullDiskTest, NoAcceptedJobIsLostWhenTheDiskFills) {
+  fs::create_directories(spool_);
+  if (::mount("tmpfs", spool_.c_str(), "tmpfs", 0, "size=8m") != 0) {
+    GTEST_SKIP() << "cannot mount a tmpfs (" << std::strerror(errno)
+                 << "; needs root): the full-disk drill is skipped";
+  }
+  mounted_ = true;
+  auto config = ServiceHarness::config_for(spool_);
+  config.workers = 0;  // The jobs stay queued.
+  config.spool_reserve_bytes = 0;
+  std::vector<std::string> jobs;
+  {
+    ServiceHarness service(config);
+    for (int i = 0; i < 3; ++i) {
+      v1::SubmitReply reply;
+      ASSERT_TRUE(service.submit(input_, testing::repaired_options(), &reply).ok());
+      jobs.push_back(reply.job_id());
+    }
+    // Fill the disk to the last byte.
+    {
+      std::ofstream filler(spool_ / "filler", std::ios::binary);
+      const std::string block(64 << 10, 'x');
+      while (filler.write(block.data(), std::streamsize(block.size())) && filler.flush()) {
+      }
+    }
+    std::ofstream(spool_ / "filler-small", std::ios::binary) << std::string(4096, 'x');
+    for (const auto& id : jobs) {
+      auto context = service.context();
+      v1::CancelRequest request;
+      request.set_job_id(id);
+      v1::Job job;
+      const grpc::Status status = service.stub().Cancel(context.get(), request, &job);
+      EXPECT_EQ(status.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED) << id;
+      EXPECT_TRUE(absl::StartsWith(status.error_message(), "spool disk full"))
+          << status.error_message();
+      EXPECT_EQ(service.get(id).state(), v1::JOB_STATE_QUEUED)
+          << "a cancel that was not saved took effect";
+    }
+    v1::SubmitReply reply;
+    const grpc::Status refused = service.submit(input_, testing::repaired_options(), &reply);
+    EXPECT_EQ(refused.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
+    EXPECT_TRUE(absl::StrContains(refused.error_message(), "spool disk full"))
+        << refused.error_message();
+    EXPECT_TRUE(has_metric(service, "labelmesh_spool_write_failures_total 3"));
+    service.shutdown();
+  }
+  // A restart on the full disk finds every job, still queued.
+  ServiceHarness again(config);
+  for (const auto& id : jobs) {
+    grpc::Status status;
+    const v1::Job job = again.get(id, &status);
+    ASSERT_TRUE(status.ok()) << id << " lost: " << status.error_message();
+    EXPECT_EQ(job.state(), v1::JOB_STATE_QUEUED);
+  }
+  EXPECT_EQ(entries_in(spool_ / "quarantine"), 0u);
+  again.shutdown();
+}
+
+}  // namespace
+}  // namespace labelmesh

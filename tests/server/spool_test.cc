@@ -1,0 +1,105 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// The spool under a full disk and with damaged records: a failed write keeps
+// the previous record, and an unreadable record is set aside, never deleted.
+#include "server/spool.h"
+
+#include <gtest/gtest.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <csignal>
+#include <filesystem>
+#include <fstream>
+
+#include "absl/strings/match.h"
+#include "support/test_files.h"
+
+namespace labelmesh {
+namespace {
+namespace fs = std::filesystem;
+using testing::scratch_dir;
+
+v1::JobRecord record_with(const std::string& job_id, v1::JobState state, size_t padding) {
+  v1::JobRecord record;
+  record.mutable_job()->set_job_id(job_id);
+  record.mutable_job()->set_state(state);
+  record.mutable_job()->set_created_at(1.0e9);
+  // Room for the write to fail in the middle of the record.
+  record.mutable_spec()->set_sha256(std::string(padding, 'a'));
+  return record;
+}
+
+size_t entries_in(const fs::path& dir) {
+  size_t count = 0;
+  for ([[maybe_unused]] const auto& entry : fs::directory_iterator(dir)) ++count;
+  return count;
+}
+
+// A full disk, short of a file system of our own: the file size limit makes
+// every write past it fail with EFBIG, as ENOSPC would.
+TEST(Spool, AFailedWriteKeepsThePreviousRecord) {
+  const fs::path root = scratch_dir("SpoolFailedWrite");
+  auto spool = server::Spool::open(root.string());
+  ASSERT_TRUE(spool.ok()) << spool.status();
+  const std::string id = server::new_job_id();
+  fs::create_directories(spool->job_dir(id));
+  ASSERT_TRUE(spool->save(record_with(id, v1::JOB_STATE_QUEUED, 10)).ok());
+
+  const pid_t child = fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    std::signal(SIGXFSZ, SIG_IGN);
+    const rlimit limit{64, 64};
+    setrlimit(RLIMIT_FSIZE, &limit);
+    const absl::Status status = spool->save(record_with(id, v1::JOB_STATE_CANCELLED, 2000));
+    const bool as_expected = status.code() == absl::StatusCode::kResourceExhausted &&
+                             absl::StartsWith(status.message(), "spool disk full");
+    _exit(as_expected ? 0 : 1);
+  }
+  int wait_status = 0;
+  ASSERT_EQ(waitpid(child, &wait_status, 0), child);
+  ASSERT_TRUE(WIFEXITED(wait_status));
+  EXPECT_EQ(WEXITSTATUS(wait_status), 0) << "save did not report a full disk";
+
+  const auto records = spool->load_all();
+  ASSERT_EQ(records.size(), 1u);
+  EXPECT_EQ(records[0].job().job_id(), id);
+  EXPECT_EQ(records[0].job().state(), v1::JOB_STATE_QUEUED);
+  EXPECT_FALSE(fs::exists(fs::path(spool->job_dir(id)) / "job.pb.tmp"));
+}
+
+TEST(Spool, UnreadableRecordsAreQuarantinedNotDeleted) {
+  const fs::path root = scratch_dir("SpoolQuarantine");
+  auto spool = server::Spool::open(root.string());
+  ASSERT_TRUE(spool.ok()) << spool.status();
+  const std::string good = server::new_job_id();
+  fs::create_directories(spool->job_dir(good));
+  ASSERT_TRUE(spool->save(record_with(good, v1::JOB_STATE_QUEUED, 10)).ok());
+  // A record cut to nothing, one that is not a record, one naming another
+  // job, and a directory that never got its record.
+  const std::string empty = server::new_job_id(), garbage = server::new_job_id(),
+                    other = server::new_job_id(), unrecorded = server::new_job_id();
+  for (const auto& id : {empty, garbage, other, unrecorded})
+    fs::create_directories(spool->job_dir(id));
+  std::ofstream(fs::path(spool->job_dir(empty)) / "job.pb");
+  std::ofstream(fs::path(spool->job_dir(garbage)) / "job.pb") << "\xff\xff\xff not a record";
+  ASSERT_TRUE(spool->save(record_with(good, v1::JOB_STATE_QUEUED, 10)).ok());
+  fs::copy_file(fs::path(spool->job_dir(good)) / "job.pb",
+                fs::path(spool->job_dir(other)) / "job.pb");
+  std::ofstream(fs::path(spool->job_dir(other)) / "input.nii") << "kept";
+
+  const auto records = spool->load_all();
+  ASSERT_EQ(records.size(), 1u);
+  EXPECT_EQ(records[0].job().job_id(), good);
+  EXPECT_EQ(entries_in(root / "quarantine"), 3u);
+  EXPECT_EQ(entries_in(root / "jobs"), 1u);
+  // What was set aside is whole.
+  size_t inputs_kept = 0;
+  for (const auto& entry : fs::directory_iterator(root / "quarantine"))
+    inputs_kept += fs::exists(entry.path() / "input.nii");
+  EXPECT_EQ(inputs_kept, 1u);
+}
+
+}  // namespace
+}  // namespace labelmesh
