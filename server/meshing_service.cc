@@ -179,15 +179,21 @@ grpc::Status MeshingService::Submit(grpc::ServerContext* context,
   options.set_max_voxels(voxel_limit);
   // The job keeps its options as the pipeline reads them, defaults filled in,
   // so that GetJob shows what the job runs with. check_spec parsed them.
-  options = make_options(*params_from_options(options));
+  const MeshParams params = *params_from_options(options);
+  options = make_options(params);
 
   const std::string job_id = new_job_id();
   const std::string extension = *upload_extension(spec.file_name());
   UploadFile upload(spool_.upload_path(job_id, extension));
   if (auto status = receive_upload(*reader, spec, upload.path()); !status.ok()) return status;
-  if (auto status = check_uploaded_volume(upload.path(), voxel_limit); !status.ok()) {
+  auto geometry = check_uploaded_volume(upload.path(), voxel_limit, config_.worker_memory_bytes);
+  if (!geometry.ok()) {
     metrics_.rejected("bad_volume");
-    return to_grpc(status);
+    return to_grpc(geometry.status());
+  }
+  if (auto status = check_sizing_for_grid(params.poisson, *geometry); !status.ok()) {
+    metrics_.rejected("bad_request");
+    return invalid(absl::StrCat("spec.options: ", status.message()));
   }
 
   v1::JobRecord record;

@@ -41,13 +41,29 @@ absl::Status check_spec(const v1::JobSpec& spec, const ServerConfig& config) {
   return absl::OkStatus();
 }
 
-absl::Status check_uploaded_volume(const std::string& path, uint64_t max_voxels) {
+absl::StatusOr<volume::ImageGeometry> check_uploaded_volume(const std::string& path,
+                                                            uint64_t max_voxels,
+                                                            uint64_t worker_memory_bytes) {
   volume::ReadLimits limits;
   limits.max_voxels = max_voxels;
   limits.allow_data_file = false;
-  absl::Status status = volume::check_volume_header(path, limits).status();
-  if (status.ok()) return status;
-  return absl::Status(status.code(), absl::StrReplaceAll(status.message(), {{path, "upload"}}));
+  auto as_upload = [&](const absl::Status& status) {
+    return absl::Status(status.code(), absl::StrReplaceAll(status.message(), {{path, "upload"}}));
+  };
+  auto header = volume::check_volume_header(path, limits);
+  if (!header.ok()) return as_upload(header.status());
+  // What a worker holds at the least: the voxels as stored, and one byte per
+  // voxel for a label's mask. A job above that fails in its worker anyway.
+  const uint64_t voxels = uint64_t(header->geometry.voxel_count());
+  const uint64_t least_bytes = header->data_bytes() + voxels;
+  if (worker_memory_bytes > 0 && least_bytes > worker_memory_bytes) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "upload: ", voxels, " voxels of ",
+        std::string(volume::scalar_type_name(header->scalar_type)), " need at least ", least_bytes,
+        " bytes in a worker; the server's worker limit is ", worker_memory_bytes, " bytes"));
+  }
+  if (auto status = volume::check_whole_payload(*header); !status.ok()) return as_upload(status);
+  return header->geometry;
 }
 
 }  // namespace labelmesh::server

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "absl/status/statusor.h"
+#include "core/volume/image_geometry.h"
 #include "labelmesh/v1/service.pb.h"
 #include "server/server_config.h"
 
@@ -18,9 +19,14 @@ absl::StatusOr<std::string> upload_extension(const std::string& file_name);
 // INVALID_ARGUMENT naming the spec field or option at fault.
 absl::Status check_spec(const v1::JobSpec& spec, const ServerConfig& config);
 
-// The header of the stored upload, with the job's voxel limit. The volume
-// must hold its voxels itself: a header naming another file is refused.
-// Messages name the file "upload".
-absl::Status check_uploaded_volume(const std::string& path, uint64_t max_voxels);
+// The stored upload, before it becomes a job: its header, with the job's
+// voxel limit; the least memory a worker needs for it, against the worker
+// limit (0: none); then every compressed byte, checksum included. The
+// volume must hold its voxels itself: a header naming another file is
+// refused. INVALID_ARGUMENT; messages name the file "upload".
+// Returns the header's geometry, for the checks of options against the grid.
+absl::StatusOr<volume::ImageGeometry> check_uploaded_volume(const std::string& path,
+                                                            uint64_t max_voxels,
+                                                            uint64_t worker_memory_bytes);
 
 }  // namespace labelmesh::server

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 #include "core/pipeline/job_options.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "core/util/text.h"
@@ -32,18 +33,29 @@ v1::PointReduction to_proto(surface::PointReduction reduction) {
   return v1::POINT_REDUCTION_UNSPECIFIED;
 }
 
-// A length in voxels must be finite and positive.
-absl::Status check_voxels(std::string_view field, double value) {
-  if (std::isfinite(value) && value > 0) return absl::OkStatus();
-  return absl::InvalidArgumentError(cat(field, ": ", value, " is not a positive number of voxels"));
+// Sizing finer than this, in voxels, the voxels cannot tell apart; finer
+// still only multiplies the points (a tenth of a voxel on a small sphere ran
+// a worker to its time limit at 1.2 GB).
+constexpr double kFinestEdgeVoxels = 0.5;
+constexpr double kFinestDistanceVoxels = 0.05;
+constexpr double kCoarsestVoxels = 1000;
+
+// A sizing length in voxels: finite and in [finest, kCoarsestVoxels].
+absl::Status check_voxels(std::string_view field, double value, double finest) {
+  if (std::isfinite(value) && value >= finest && value <= kCoarsestVoxels) return absl::OkStatus();
+  return absl::InvalidArgumentError(
+      cat(field, ": ", value, " is outside [", finest, ", ", kCoarsestVoxels, "] voxels"));
 }
 
 // Lengths in mm beyond a metre are mistakes.
 constexpr double kMaxLengthMm = 1000;
 // No label is this many voxels thick.
 constexpr double kMaxThicknessVoxels = 100000;
-// One entry per label is plenty; the bound keeps a job record small.
+// One entry per label is plenty; the bounds keep a job record small.
 constexpr int kMaxLabelSizings = 1000;
+constexpr int kMaxLabels = 10000;
+// Each format at most once, but a client may repeat itself a little.
+constexpr int kMaxFormatEntries = 32;
 
 absl::Status check_millimetres(std::string_view field, double value) {
   if (std::isfinite(value) && value > 0 && value <= kMaxLengthMm) return absl::OkStatus();
@@ -89,11 +101,15 @@ absl::Status read_poisson_options(const v1::MeshOptions& options, PoissonOptions
   }
   if (options.has_max_edge_voxels()) {
     poisson.max_edge_voxels = options.max_edge_voxels();
-    if (auto s = check_voxels("max_edge_voxels", poisson.max_edge_voxels); !s.ok()) return s;
+    if (auto s = check_voxels("max_edge_voxels", poisson.max_edge_voxels, kFinestEdgeVoxels);
+        !s.ok())
+      return s;
   }
   if (options.has_max_distance_voxels()) {
     poisson.max_distance_voxels = options.max_distance_voxels();
-    if (auto s = check_voxels("max_distance_voxels", poisson.max_distance_voxels); !s.ok())
+    if (auto s =
+            check_voxels("max_distance_voxels", poisson.max_distance_voxels, kFinestDistanceVoxels);
+        !s.ok())
       return s;
   }
   if (options.has_max_edge_mm()) {
@@ -118,6 +134,11 @@ absl::Status read_poisson_options(const v1::MeshOptions& options, PoissonOptions
   for (const auto& entry : options.label_sizing()) {
     if (entry.label() == 0)
       return absl::InvalidArgumentError("label_sizing: label 0 is the background");
+    for (const auto& earlier : poisson.label_sizing) {
+      if (earlier.label == entry.label())
+        return absl::InvalidArgumentError(
+            cat("label_sizing: label ", entry.label(), " is given more than once"));
+    }
     if (!(entry.max_edge_mm() >= 0 && entry.max_edge_mm() <= kMaxLengthMm) ||
         !(entry.max_distance_mm() >= 0 && entry.max_distance_mm() <= kMaxLengthMm))
       return absl::InvalidArgumentError(cat("label_sizing: label ", entry.label(),
@@ -144,7 +165,9 @@ absl::Status read_poisson_options(const v1::MeshOptions& options, PoissonOptions
     poisson.min_component_voxels = options.min_component_voxels();
   if (options.has_point_cell_voxels()) {
     poisson.point_cell_voxels = options.point_cell_voxels();
-    if (auto s = check_voxels("point_cell_voxels", poisson.point_cell_voxels); !s.ok()) return s;
+    // max_points bounds what a fine cell keeps.
+    if (auto s = check_voxels("point_cell_voxels", poisson.point_cell_voxels, 0.01); !s.ok())
+      return s;
   }
   switch (options.normals()) {
     case v1::NORMAL_WEIGHTING_UNSPECIFIED:
@@ -292,7 +315,14 @@ v1::MeshOptions make_options(const MeshParams& params) {
 
 absl::StatusOr<MeshParams> params_from_options(const v1::MeshOptions& options) {
   MeshParams params;
-  params.labels.assign(options.labels().begin(), options.labels().end());
+  if (options.labels_size() > kMaxLabels)
+    return absl::InvalidArgumentError(
+        cat("labels: ", options.labels_size(), " entries; at most ", kMaxLabels));
+  // Each label once, in the order first given.
+  for (int32_t label : options.labels()) {
+    if (std::find(params.labels.begin(), params.labels.end(), label) == params.labels.end())
+      params.labels.push_back(label);
+  }
   switch (options.surface()) {
     case v1::SURFACE_METHOD_MARCHING_CUBES:
       params.surface = SurfaceMethod::kMarchingCubes;
@@ -310,15 +340,22 @@ absl::StatusOr<MeshParams> params_from_options(const v1::MeshOptions& options) {
   if (auto s = read_poisson_options(options, params.poisson); !s.ok()) return s;
   if (auto s = read_guard_options(options, params.guard); !s.ok()) return s;
   if (auto s = read_volume_options(options, params); !s.ok()) return s;
+  if (options.formats_size() > kMaxFormatEntries)
+    return absl::InvalidArgumentError(
+        cat("formats: ", options.formats_size(), " entries; at most ", kMaxFormatEntries));
   if (!options.formats().empty()) {
-    // One list for both kinds: each name is either a surface or a volume format.
+    // One list for both kinds: each name is either a surface or a volume
+    // format, kept once in the order first given.
     params.formats.clear();
     std::vector<volume_mesh::VolumeFormat> volume_formats;
+    auto add_once = [](auto& list, auto format) {
+      if (std::find(list.begin(), list.end(), format) == list.end()) list.push_back(format);
+    };
     for (const auto& name : options.formats()) {
       if (auto format = surface::surface_format_from_name(name)) {
-        params.formats.push_back(*format);
+        add_once(params.formats, *format);
       } else if (auto volume_format = volume_mesh::volume_format_from_name(name)) {
-        volume_formats.push_back(*volume_format);
+        add_once(volume_formats, *volume_format);
       } else {
         return absl::InvalidArgumentError(
             cat("formats: '", name,
@@ -336,6 +373,27 @@ absl::StatusOr<MeshParams> params_from_options(const v1::MeshOptions& options) {
   }
   if (options.max_voxels() > 0) params.limits.max_voxels = options.max_voxels();
   return params;
+}
+
+absl::Status check_sizing_for_grid(const PoissonOptions& poisson,
+                                   const volume::ImageGeometry& geometry) {
+  const double voxel = std::cbrt(geometry.voxel_volume());
+  auto at_least = [&](std::string_view field, double mm, double finest_voxels) {
+    // A hair of slack: half of a 3 mm voxel is 1.5 mm, not a rounding below.
+    if (mm <= 0 || mm >= finest_voxels * voxel * (1 - 1e-9)) return absl::OkStatus();
+    return absl::InvalidArgumentError(cat(field, ": ", mm, " mm is finer than ", finest_voxels,
+                                          " voxel (", finest_voxels * voxel,
+                                          " mm on this grid), which the voxels cannot tell apart"));
+  };
+  if (auto s = at_least("max_edge_mm", poisson.max_edge_mm, kFinestEdgeVoxels); !s.ok()) return s;
+  if (auto s = at_least("max_distance_mm", poisson.max_distance_mm, kFinestDistanceVoxels); !s.ok())
+    return s;
+  for (const auto& sizing : poisson.label_sizing) {
+    const std::string field = cat("label_sizing: label ", sizing.label);
+    if (auto s = at_least(field, sizing.max_edge_mm, kFinestEdgeVoxels); !s.ok()) return s;
+    if (auto s = at_least(field, sizing.max_distance_mm, kFinestDistanceVoxels); !s.ok()) return s;
+  }
+  return absl::OkStatus();
 }
 
 }  // namespace labelmesh

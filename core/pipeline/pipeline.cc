@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 #include "core/pipeline/pipeline.h"
 
+#include "core/pipeline/job_options.h"
+
 #include <malloc.h>
 
 #include <algorithm>
@@ -246,6 +248,8 @@ absl::StatusOr<MeshResult> run_stages(const std::string& path, const MeshParams&
     volume = volume::read_label_volume(path, params.limits, context);
   }
   if (!volume.ok()) return volume.status();
+  if (auto s = check_sizing_for_grid(params.poisson, volume->geometry); !s.ok())
+    return absl::InvalidArgumentError(cat(path, ": ", std::string(s.message())));
   {
     StageTimer timer(result.stages, "label_statistics");
     result.input = summary_of(*volume);

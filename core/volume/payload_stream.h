@@ -34,6 +34,9 @@ class PayloadStream {
   absl::StatusOr<uint64_t> read(char* out, uint64_t n);
   // Like read() but discards the bytes.
   absl::StatusOr<uint64_t> skip(uint64_t n);
+  // True once a compressed stream has reached its end with its checksum and
+  // length verified by zlib and no bytes after it; always true for raw data.
+  bool ended_cleanly() const { return encoding_ == DataEncoding::kRaw || finished_; }
 
  private:
   PayloadStream() = default;

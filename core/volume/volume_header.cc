@@ -1,9 +1,12 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 #include "core/volume/volume_header.h"
 
+#include <algorithm>
+
 #include "core/util/text.h"
 #include "core/volume/header_checks.h"
 #include "core/volume/header_formats.h"
+#include "core/volume/payload_stream.h"
 
 namespace labelmesh::volume {
 
@@ -100,6 +103,36 @@ absl::StatusOr<VolumeHeader> check_volume_header(const std::string& path,
       return internal::check_vti_header(path, limits);
   }
   return absl::InternalError("unhandled image format");
+}
+
+absl::Status check_whole_payload(const VolumeHeader& header) {
+  if (header.encoding == DataEncoding::kRaw) return absl::OkStatus();
+  auto stream = internal::PayloadStream::open(header.data_path, header.file_offset, header.encoding,
+                                              header.compressed_bytes);
+  if (!stream.ok()) return stream.status();
+  const uint64_t needed = header.decoded_offset + header.data_bytes();
+  auto got = (*stream)->skip(needed);
+  if (!got.ok()) return got.status();
+  if (*got < needed) {
+    return internal::field_error(header.data_path, "voxel data",
+                                 cat("is truncated: the header needs ", needed,
+                                     " decoded bytes, the compressed stream holds ", *got));
+  }
+  // Whatever follows the voxels is decoded too, so that the stream's own
+  // check at its end is read; but a bomb of zeros after them is bounded.
+  const uint64_t most_after = std::max<uint64_t>(needed, uint64_t{64} << 20);
+  auto after = (*stream)->skip(most_after + 1);
+  if (!after.ok()) return after.status();
+  if (*after > most_after) {
+    return internal::field_error(
+        header.data_path, "compressed voxel data",
+        cat("holds more than ", most_after, " bytes after the ", needed, " the header needs"));
+  }
+  if (!(*stream)->ended_cleanly()) {
+    return internal::field_error(header.data_path, "compressed voxel data",
+                                 "ends before its end-of-stream marker and checksum");
+  }
+  return absl::OkStatus();
 }
 
 }  // namespace labelmesh::volume

@@ -78,4 +78,12 @@ std::optional<ImageFormat> format_from_path(std::string_view path);
 absl::StatusOr<VolumeHeader> check_volume_header(const std::string& path,
                                                  const ReadLimits& limits = {});
 
+// Decodes every voxel byte of a header that passed check_volume_header, to
+// the end of its compressed stream: a stream that is cut short, fails its
+// CRC or Adler-32, or has bytes after its end is INVALID_ARGUMENT naming
+// the file. The header checks look only as far as the voxels need (or at a
+// gzip file's size trailer); this finds the rest before a job is accepted.
+// Raw voxels carry no checksum; their length was checked with the header.
+absl::Status check_whole_payload(const VolumeHeader& header);
+
 }  // namespace labelmesh::volume

@@ -69,6 +69,25 @@ TEST(JobOptions, EveryOutOfRangeValueIsRefusedByName) {
       {"min_angle_deg", [](auto& o) { o.set_min_angle_deg(0); }},
       {"max_edge_voxels", [](auto& o) { o.set_max_edge_voxels(-1); }},
       {"max_distance_voxels", [](auto& o) { o.set_max_distance_voxels(0); }},
+      // Finer than the voxels can tell apart: only more points.
+      {"max_edge_voxels", [](auto& o) { o.set_max_edge_voxels(0.01); }},
+      {"max_distance_voxels", [](auto& o) { o.set_max_distance_voxels(0.001); }},
+      {"labels",
+       [](auto& o) {
+         for (int i = 1; i <= 10001; ++i) o.add_labels(i);
+       }},
+      {"formats",
+       [](auto& o) {
+         for (int i = 0; i < 250000; ++i) o.add_formats("off");
+       }},
+      {"label_sizing",
+       [](auto& o) {
+         for (int i = 0; i < 2; ++i) {
+           auto* sizing = o.add_label_sizing();
+           sizing->set_label(5);
+           sizing->set_max_edge_mm(2);
+         }
+       }},
       {"max_edge_mm", [](auto& o) { o.set_max_edge_mm(5000); }},
       {"max_distance_mm", [](auto& o) { o.set_max_distance_mm(-2); }},
       {"poisson_min_thickness_voxels", [](auto& o) { o.set_poisson_min_thickness_voxels(-1); }},
@@ -109,6 +128,39 @@ TEST(JobOptions, EveryOutOfRangeValueIsRefusedByName) {
     EXPECT_TRUE(absl::StrContains(params.status().message(), bad.field))
         << bad.field << ": " << params.status().message();
   }
+}
+
+TEST(JobOptions, RepeatedLabelsAndFormatsAreKeptOnceInOrder) {
+  v1::MeshOptions options;
+  for (int label : {7, 3, 7, 7, 3, 9}) options.add_labels(label);
+  for (const char* format : {"off", "stl", "off", "off", "stl"}) options.add_formats(format);
+  const auto params = params_from_options(options);
+  ASSERT_TRUE(params.ok()) << params.status();
+  EXPECT_EQ(params->labels, (std::vector<int32_t>{7, 3, 9}));
+  ASSERT_EQ(params->formats.size(), 2u);
+  EXPECT_EQ(params->formats[0], surface::SurfaceFormat::kOff);
+  EXPECT_EQ(params->formats[1], surface::SurfaceFormat::kStl);
+  EXPECT_EQ(make_options(*params).formats_size(), 2);
+}
+
+TEST(JobOptions, SizingInMillimetresIsCheckedAgainstTheGrid) {
+  volume::ImageGeometry geometry;
+  geometry.spacing = {3, 3, 3};
+  PoissonOptions poisson;
+  EXPECT_TRUE(check_sizing_for_grid(poisson, geometry).ok());
+  poisson.max_edge_mm = 1.5;  // half a 3 mm voxel: the finest allowed
+  poisson.max_distance_mm = 0.15;
+  EXPECT_TRUE(check_sizing_for_grid(poisson, geometry).ok());
+  poisson.max_edge_mm = 1.4;
+  auto status = check_sizing_for_grid(poisson, geometry);
+  EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_TRUE(absl::StrContains(status.message(), "max_edge_mm")) << status.message();
+  poisson.max_edge_mm = 0;
+  poisson.label_sizing.push_back({114, 2, 0.01});
+  status = check_sizing_for_grid(poisson, geometry);
+  EXPECT_TRUE(absl::StrContains(status.message(), "label 114")) << status.message();
+  geometry.spacing = {0.1, 0.1, 0.1};  // the same sizing on a fine grid is fine
+  EXPECT_TRUE(check_sizing_for_grid(poisson, geometry).ok());
 }
 
 }  // namespace

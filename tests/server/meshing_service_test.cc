@@ -280,6 +280,47 @@ TEST_F(MeshingServiceTest, BrokenUploadsAreRefusedAndLeaveNothing) {
   EXPECT_TRUE(service.submit_raw(good, bytes, &reply).ok());
 }
 
+// Refused at Submit, not later in a worker: a volume a worker cannot hold,
+// a gzip stream whose CRC is wrong under a size trailer that looks right,
+// sizing the voxels cannot tell apart, and a spec of 250,000 formats.
+TEST_F(MeshingServiceTest, UploadsThatCouldOnlyFailLaterAreRefusedAtSubmit) {
+  config_.worker_memory_bytes = 64 << 10;
+  ServiceHarness service(config_);
+  const fs::path sphere = write_phantom(dir_, volume::PhantomShape::kSphere);
+  v1::SubmitReply reply;
+  grpc::Status status = service.submit(sphere, repaired_options(), &reply);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_TRUE(absl::StrContains(status.error_message(), "worker limit")) << status.error_message();
+  service.shutdown();
+
+  config_.worker_memory_bytes = ServiceHarness::config_for(spool_).worker_memory_bytes;
+  ServiceHarness roomy(config_);
+  std::string damaged = read_bytes(sphere);
+  damaged[damaged.size() - 8] ^= 0x5a;  // the gzip CRC32, before ISIZE
+  const fs::path wrong_crc = dir_ / "wrong-crc.nii.gz";
+  write_file(wrong_crc, damaged);
+  status = roomy.submit(wrong_crc, repaired_options(), &reply);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_TRUE(absl::StrContains(status.error_message(), "upload: compressed voxel data"))
+      << status.error_message();
+
+  v1::MeshOptions fine = repaired_options();
+  fine.set_max_edge_mm(0.01);
+  status = roomy.submit(sphere, fine, &reply);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_TRUE(absl::StrContains(status.error_message(), "max_edge_mm")) << status.error_message();
+
+  v1::MeshOptions many = repaired_options();
+  for (int i = 0; i < 250000; ++i) many.add_formats("off");
+  status = roomy.submit(sphere, many, &reply);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_TRUE(absl::StrContains(status.error_message(), "formats")) << status.error_message();
+
+  EXPECT_EQ(job_dirs(), 0u);
+  EXPECT_EQ(uploads_left(), 0u);
+  EXPECT_TRUE(roomy.submit(sphere, repaired_options(), &reply).ok());
+}
+
 TEST_F(MeshingServiceTest, CancelStopsARunningJobWithinASecond) {
   ServiceHarness service(config_);
   v1::SubmitReply reply;

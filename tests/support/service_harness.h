@@ -23,13 +23,6 @@
 
 namespace labelmesh::testing {
 
-inline std::string read_bytes(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream bytes;
-  bytes << in.rdbuf();
-  return bytes.str();
-}
-
 // Files under `dir`, recursively (regular files only).
 inline size_t count_files(const std::filesystem::path& dir) {
   size_t count = 0;

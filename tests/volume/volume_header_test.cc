@@ -262,5 +262,40 @@ TEST(VolumeHeader, GzipBombIsBoundedByTheDeclaredSize) {
   EXPECT_EQ(header->data_bytes(), 8u);
 }
 
+// A gzip file whose size trailer claims enough data passes the header check
+// without a full inflate; check_whole_payload decodes it all and finds the
+// damage: a wrong CRC, and a stream cut at 60 % under a forged trailer.
+TEST(VolumeHeader, WholePayloadCheckFindsWhatTheSizeTrailerHides) {
+  const auto dir = testing::scratch_dir("whole-payload");
+  Nifti1Bytes nifti(40, 40, 40);
+  // Voxels that do not compress to nothing, so a cut lands among them.
+  for (size_t i = 0; i < nifti.voxels.size(); ++i) nifti.voxels[i] = uint8_t((i * 7919) % 251);
+  const std::string bytes = nifti.bytes();
+  const auto good = (dir / "good.nii.gz").string();
+  ASSERT_TRUE(testing::write_gzip(good, bytes));
+  auto header = check_volume_header(good);
+  ASSERT_TRUE(header.ok()) << header.status();
+  EXPECT_TRUE(check_whole_payload(*header).ok());
+
+  const std::string compressed = testing::read_bytes(good);
+  ASSERT_GT(compressed.size(), 100u);
+  std::string wrong_crc = compressed;
+  wrong_crc[wrong_crc.size() - 8] ^= 0x5a;  // CRC32 comes before ISIZE
+  const auto crc_path = (dir / "wrong-crc.nii.gz").string();
+  testing::write_file(crc_path, wrong_crc);
+  std::string cut = compressed.substr(0, compressed.size() * 6 / 10);
+  cut += compressed.substr(compressed.size() - 4);  // the original ISIZE
+  const auto cut_path = (dir / "cut.nii.gz").string();
+  testing::write_file(cut_path, cut);
+  for (const auto& path : {crc_path, cut_path}) {
+    SCOPED_TRACE(path);
+    auto damaged = check_volume_header(path);
+    ASSERT_TRUE(damaged.ok()) << "the header check alone was expected to pass";
+    const absl::Status whole = check_whole_payload(*damaged);
+    EXPECT_EQ(whole.code(), absl::StatusCode::kInvalidArgument);
+    EXPECT_NE(std::string(whole.message()).find(path), std::string::npos) << whole.message();
+  }
+}
+
 }  // namespace
 }  // namespace labelmesh::volume
