@@ -370,20 +370,27 @@ absl::StatusOr<JobTable::EventBatch> JobTable::events_since(const std::string& j
   return batch;
 }
 
-int JobTable::expire(absl::Duration result_ttl) {
+int JobTable::expire(absl::Duration result_ttl, size_t max_ended) {
   std::lock_guard lock(mutex_);
   const double cutoff = unix_now() - absl::ToDoubleSeconds(result_ttl);
+  // Ended jobs, oldest end first: past the TTL, or past the cap in number.
+  std::vector<std::pair<double, std::string>> ended;
+  for (const auto& [id, entry] : jobs_) {
+    const v1::Job& job = entry.record.job();
+    if (has_ended(job.state())) ended.emplace_back(job.finished_at(), id);
+  }
+  std::sort(ended.begin(), ended.end());
+  const size_t over_cap = ended.size() > max_ended ? ended.size() - max_ended : 0;
   int removed = 0;
-  for (auto it = jobs_.begin(); it != jobs_.end();) {
-    const v1::Job& job = it->second.record.job();
-    if (has_ended(job.state()) && job.finished_at() < cutoff) {
-      spool_.remove_job(it->first);
-      spdlog::info("job {} results expired and deleted", it->first);
-      it = jobs_.erase(it);
-      ++removed;
-    } else {
-      ++it;
-    }
+  for (size_t i = 0; i < ended.size(); ++i) {
+    const auto& [finished_at, id] = ended[i];
+    const bool expired = finished_at < cutoff;
+    if (!expired && i >= over_cap) continue;
+    spool_.remove_job(id);
+    spdlog::info("job {} results {} and deleted", id,
+                 expired ? "expired" : "past the cap on ended jobs");
+    jobs_.erase(id);
+    ++removed;
   }
   if (removed > 0) events_added_.notify_all();
   return removed;

@@ -69,8 +69,9 @@ class JobTable {
   absl::StatusOr<EventBatch> events_since(const std::string& job_id, uint64_t from,
                                           absl::Duration wait) const;
 
-  // Deletes jobs that ended more than `result_ttl` ago; returns how many.
-  int expire(absl::Duration result_ttl);
+  // Deletes jobs that ended more than `result_ttl` ago, and the oldest ended
+  // jobs beyond `max_ended`; returns how many.
+  int expire(absl::Duration result_ttl, size_t max_ended);
   // Wakes every waiter; take_next() returns nullopt from now on.
   void close();
   // Stops handing out jobs but still accepts them (drain before shutdown).

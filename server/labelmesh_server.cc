@@ -123,7 +123,7 @@ void LabelmeshServer::housekeeping_loop() {
       std::min(absl::ToChronoMilliseconds(config_.result_ttl), std::chrono::milliseconds(2'000));
   std::unique_lock lock(mutex_);
   while (!stopping_.wait_for(lock, period, [this] { return stopped_; })) {
-    table_->expire(config_.result_ttl);
+    table_->expire(config_.result_ttl, size_t(config_.max_ended_jobs));
     check_spool_space();
   }
 }

@@ -53,6 +53,10 @@ void add_server_flags(CLI::App& app, ServerConfig& c) {
       "LABELMESHD_JOB_TIMEOUT");
   env(add_duration(app, "--result-ttl", c.result_ttl, "How long results stay fetchable"),
       "LABELMESHD_RESULT_TTL");
+  env(app.add_option("--max-ended-jobs", c.max_ended_jobs,
+                     "Ended jobs kept at most; the oldest are deleted first")
+          ->capture_default_str(),
+      "LABELMESHD_MAX_ENDED_JOBS");
   env(add_duration(app, "--shutdown-grace", c.shutdown_grace,
                    "On SIGTERM, how long running jobs may finish; the rest run at next start"),
       "LABELMESHD_SHUTDOWN_GRACE");

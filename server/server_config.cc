@@ -26,6 +26,7 @@ absl::Status validate_config(const ServerConfig& c) {
   if (c.queue_capacity < 1) return bad("queue-capacity", "must be at least 1");
   if (c.job_timeout <= absl::ZeroDuration()) return bad("job-timeout", "must be positive");
   if (c.result_ttl <= absl::ZeroDuration()) return bad("result-ttl", "must be positive");
+  if (c.max_ended_jobs < 1) return bad("max-ended-jobs", "must be at least 1");
   if (c.shutdown_grace < absl::ZeroDuration()) return bad("shutdown-grace", "must not be negative");
   if (c.max_upload_bytes < 1) return bad("max-upload-bytes", "must be positive");
   if (c.max_voxels < 1) return bad("max-voxels", "must be positive");

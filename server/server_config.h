@@ -22,6 +22,8 @@ struct ServerConfig {
   int queue_capacity = 64;
   absl::Duration job_timeout = absl::Minutes(30);
   absl::Duration result_ttl = absl::Hours(24);
+  // Ended jobs kept at most; the oldest go first, before their TTL.
+  int max_ended_jobs = 1000;
   // On SIGTERM: how long running jobs may take to finish before they are
   // stopped and left queued for the next start.
   absl::Duration shutdown_grace = absl::Seconds(30);

@@ -514,6 +514,38 @@ TEST_F(MeshingServiceTest, ExpiredResultsAreDeletedAtStart) {
   EXPECT_EQ(job_dirs(), 0u);
 }
 
+TEST_F(MeshingServiceTest, EndedJobsBeyondTheCapAreDeletedOldestFirst) {
+  config_.workers = 0;
+  config_.max_ended_jobs = 2;
+  ServiceHarness service(config_);
+  std::vector<std::string> jobs;
+  for (int i = 0; i < 3; ++i) {
+    v1::SubmitReply reply;
+    ASSERT_TRUE(submit_sphere(service, &reply).ok());
+    auto context = service.context();
+    v1::CancelRequest cancel;
+    cancel.set_job_id(reply.job_id());
+    v1::Job job;
+    ASSERT_TRUE(service.stub().Cancel(context.get(), cancel, &job).ok());
+    jobs.push_back(reply.job_id());
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  // Housekeeping runs every two seconds.
+  grpc::Status oldest;
+  for (int tries = 0; tries < 100; ++tries) {
+    service.get(jobs[0], &oldest);
+    if (!oldest.ok()) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  EXPECT_EQ(oldest.error_code(), grpc::StatusCode::NOT_FOUND);
+  for (size_t i = 1; i < jobs.size(); ++i) {
+    grpc::Status kept;
+    EXPECT_EQ(service.get(jobs[i], &kept).state(), v1::JOB_STATE_CANCELLED);
+    EXPECT_TRUE(kept.ok()) << jobs[i];
+  }
+  EXPECT_EQ(job_dirs(), 2u);
+}
+
 TEST_F(MeshingServiceTest, CallsWithoutTheTokenAreUnauthenticated) {
   const fs::path token_file = dir_ / "token";
   write_file(token_file, "s3cret-token-0123456789\n");
