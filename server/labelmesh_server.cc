@@ -75,6 +75,7 @@ absl::StatusOr<std::unique_ptr<LabelmeshServer>> LabelmeshServer::start(ServerCo
   auto spool = Spool::open(c.spool_dir);
   if (!spool.ok()) return spool.status();
   server->spool_ = std::make_unique<Spool>(std::move(*spool));
+  kill_stale_workers(server->spool_->root());
   server->table_ = std::make_unique<JobTable>(*server->spool_, c.queue_capacity, *server->metrics_);
   server->table_->recover(c.result_ttl);
   server->service_ = std::make_unique<MeshingService>(*server->table_, *server->spool_, c,

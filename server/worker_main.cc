@@ -9,6 +9,7 @@
 #include <cstdlib>
 
 #include <fcntl.h>
+#include <sys/prctl.h>
 #include <filesystem>
 #include <fstream>
 #include <new>
@@ -147,5 +148,9 @@ int main(int argc, char** argv) {
                  "`labelmesh-worker --worker JOB_DIR` with an event pipe; it is not run by hand\n");
     return 2;
   }
+  // `ps -o comm` and top show which job this is: "lmw-" and the job id's
+  // first eleven digits (the kernel keeps 15 characters).
+  const std::string job = std::filesystem::path(argv[2]).filename().string();
+  prctl(PR_SET_NAME, ("lmw-" + job.substr(0, 11)).c_str());
   return labelmesh::server::run_worker(argv[2], 3);
 }

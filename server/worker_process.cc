@@ -4,6 +4,7 @@
 #include <fcntl.h>
 #include <poll.h>
 #include <signal.h>
+#include <sys/prctl.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -13,6 +14,8 @@
 #include <chrono>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <optional>
 #include <thread>
 #include <vector>
@@ -21,7 +24,9 @@
 #include "absl/strings/ascii.h"
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_split.h"
 #include "server/event_pipe.h"
+#include "spdlog/spdlog.h"
 
 namespace labelmesh::server {
 namespace {
@@ -41,6 +46,7 @@ bool exited_before(pid_t pid, std::chrono::steady_clock::time_point deadline, in
 }
 
 struct ChildSetup {
+  pid_t server_pid;
   int event_write_fd;
   int log_fd;
   int null_fd;
@@ -51,7 +57,18 @@ struct ChildSetup {
 
 // Between fork and exec only async-signal-safe calls are allowed.
 [[noreturn]] void exec_child(const ChildSetup& setup, char* const argv[]) {
+  // A worker dies with its server: no job runs on with nobody to hear it.
+  prctl(PR_SET_PDEATHSIG, SIGKILL);
+  if (getppid() != setup.server_pid) _exit(127);  // The server died already.
   setpgid(0, 0);  // Terminal signals go to the server, which decides.
+  // The server blocks SIGTERM and SIGINT for its sigwait; the worker must
+  // not inherit that, nor any signal the server ignores.
+  sigset_t none;
+  sigemptyset(&none);
+  sigprocmask(SIG_SETMASK, &none, nullptr);
+  struct sigaction default_action {};
+  default_action.sa_handler = SIG_DFL;
+  for (int number = 1; number < NSIG; ++number) sigaction(number, &default_action, nullptr);
   rlimit no_core{0, 0};
   setrlimit(RLIMIT_CORE, &no_core);
 #if !defined(__SANITIZE_ADDRESS__)
@@ -89,15 +106,28 @@ WorkerOutcome failed(absl::StatusCode code, std::string message) {
   return outcome;
 }
 
-// What a child that ended without a result died of.
-WorkerOutcome outcome_of_exit(int wait_status) {
+// What a child that ended without a result died of, from its wait status
+// and the CPU seconds it used against its limit.
+WorkerOutcome outcome_of_exit(int wait_status, double cpu_seconds_used, uint64_t cpu_limit) {
   if (WIFSIGNALED(wait_status)) {
     const int number = WTERMSIG(wait_status);
-    if (number == SIGXCPU || number == SIGKILL) {
+    // The kernel sends SIGXCPU at the soft CPU limit and SIGKILL at the hard.
+    const bool over_cpu = number == SIGXCPU || (number == SIGKILL && cpu_limit > 0 &&
+                                                cpu_seconds_used >= double(cpu_limit));
+    if (over_cpu) {
       return failed(absl::StatusCode::kResourceExhausted,
-                    absl::StrCat("the worker went over its CPU time or memory limit and was "
-                                 "killed (",
-                                 signal_description(number), ")"));
+                    absl::StrCat("the worker went over its CPU time limit of ", cpu_limit,
+                                 " s and was killed (", signal_description(number), ")"));
+    }
+    if (number == SIGKILL || number == SIGTERM) {
+      // labelmeshd's own stops (cancel, deadline, shutdown) are reported
+      // before this; this one came from outside.
+      return failed(absl::StatusCode::kInternal,
+                    absl::StrCat("the worker was killed from outside labelmeshd by ",
+                                 signal_description(number),
+                                 number == SIGKILL ? " (the kernel's out-of-memory killer, or an "
+                                                     "operator)"
+                                                   : ""));
     }
     return failed(absl::StatusCode::kInternal,
                   absl::StrCat("the worker crashed with ", signal_description(number)));
@@ -145,8 +175,8 @@ WorkerOutcome run_worker_process(const WorkerRun& run) {
   std::vector<char*> environment;
   for (auto& variable : variables) environment.push_back(variable.data());
   environment.push_back(nullptr);
-  const ChildSetup setup{pipe_fds[1], log_fd >= 0 ? log_fd : null_fd, null_fd, run.limits,
-                         environment.data()};
+  const ChildSetup setup{getpid(), pipe_fds[1], log_fd >= 0 ? log_fd : null_fd,
+                         null_fd,  run.limits,  environment.data()};
 
   const pid_t pid = fork();
   if (pid == 0) exec_child(setup, argv.data());
@@ -209,11 +239,14 @@ WorkerOutcome run_worker_process(const WorkerRun& run) {
   if (open || stopped) ::kill(pid, SIGKILL);
   ::close(pipe_fds[0]);
   int wait_status = 0;
-  while (waitpid(pid, &wait_status, 0) < 0 && errno == EINTR) {
+  rusage usage{};
+  while (wait4(pid, &wait_status, 0, &usage) < 0 && errno == EINTR) {
   }
+  const double cpu_seconds_used = double(usage.ru_utime.tv_sec + usage.ru_stime.tv_sec) +
+                                  1e-6 * double(usage.ru_utime.tv_usec + usage.ru_stime.tv_usec);
   if (stopped) return *stopped;
   if (result) return *result;
-  return outcome_of_exit(wait_status);
+  return outcome_of_exit(wait_status, cpu_seconds_used, run.limits.cpu_seconds);
 }
 
 std::string worker_executable(const ServerConfig& config) {
@@ -282,6 +315,30 @@ absl::Status check_worker_version(const std::string& executable,
       absl::StrCat("worker ", executable, ": --version printed '",
                    line.substr(0, std::min<size_t>(line.find('\n'), 80)), "', expected '",
                    kWorkerVersionLine, "'"));
+}
+
+int kill_stale_workers(const std::string& spool_root) {
+  const std::string jobs = absl::StrCat(spool_root, "/jobs/");
+  int killed = 0;
+  std::error_code error;
+  for (const auto& entry : std::filesystem::directory_iterator("/proc", error)) {
+    const std::string name = entry.path().filename().string();
+    if (name.empty() || !std::all_of(name.begin(), name.end(), ::isdigit)) continue;
+    std::ifstream in(entry.path() / "cmdline", std::ios::binary);
+    std::string cmdline((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    // argv: <worker> --worker <spool>/jobs/<id>, after an interpreter's own
+    // arguments when the worker is a script.
+    std::vector<std::string> argv = absl::StrSplit(cmdline, '\0');
+    bool stale = false;
+    for (size_t i = 1; i + 1 < argv.size() && !stale; ++i)
+      stale = argv[i] == kWorkerMode && absl::StartsWith(argv[i + 1], jobs);
+    if (!stale) continue;
+    const pid_t pid = static_cast<pid_t>(std::stol(name));
+    if (pid == getpid() || ::kill(pid, SIGKILL) != 0) continue;
+    spdlog::warn("killed worker {} left running by an earlier server on this spool", pid);
+    ++killed;
+  }
+  return killed;
 }
 
 }  // namespace labelmesh::server

@@ -66,6 +66,11 @@ WorkerOutcome run_worker_process(const WorkerRun& run);
 // the running executable.
 std::string worker_executable(const ServerConfig& config);
 
+// Kills the workers of an earlier server on the same spool that are still
+// running (a server killed before its workers could see it go), so that
+// none writes into a job this server runs again. Returns how many.
+int kill_stale_workers(const std::string& spool_root);
+
 // Runs `executable --version` and checks that it prints kWorkerVersionLine,
 // so a server never runs jobs on a worker of another version.
 // FAILED_PRECONDITION naming the executable otherwise, also when it has not
