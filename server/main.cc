@@ -63,6 +63,19 @@ void add_server_flags(CLI::App& app, ServerConfig& c) {
   env(app.add_option("--max-upload-bytes", c.max_upload_bytes, "Largest upload")
           ->capture_default_str(),
       "LABELMESHD_MAX_UPLOAD_BYTES");
+  env(app.add_option("--max-streams-per-client", c.max_streams_per_client,
+                     "Submit, Watch and Fetch streams one client host may hold open")
+          ->capture_default_str(),
+      "LABELMESHD_MAX_STREAMS_PER_CLIENT");
+  env(app.add_option("--max-streams", c.max_streams, "Streams all clients may hold open")
+          ->capture_default_str(),
+      "LABELMESHD_MAX_STREAMS");
+  env(add_duration(app, "--stream-idle-timeout", c.stream_idle_timeout,
+                   "A stream that makes no progress this long is cancelled"),
+      "LABELMESHD_STREAM_IDLE_TIMEOUT");
+  env(add_duration(app, "--transfer-deadline", c.transfer_deadline,
+                   "Longest an upload or a fetch may take"),
+      "LABELMESHD_TRANSFER_DEADLINE");
   env(app.add_option("--spool-reserve-bytes", c.spool_reserve_bytes,
                      "Free spool disk space kept for running jobs; uploads into it are refused")
           ->capture_default_str(),

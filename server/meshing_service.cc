@@ -31,6 +31,13 @@ grpc::Status check_job_id(const std::string& job_id) {
   return grpc::Status(grpc::StatusCode::NOT_FOUND, "no such job (ids are 32 hex digits)");
 }
 
+// The status of a stream the watchdog cancelled, else `otherwise`.
+grpc::Status stalled_or(const StreamWatchdog::Ticket& ticket, grpc::Status otherwise) {
+  const std::string reason = ticket.cancelled_because();
+  if (reason.empty()) return otherwise;
+  return grpc::Status(grpc::StatusCode::DEADLINE_EXCEEDED, reason);
+}
+
 // Counts an upload in flight for as long as it lives.
 class UploadSlot {
  public:
@@ -65,7 +72,20 @@ class UploadFile {
 
 MeshingService::MeshingService(JobTable& table, const Spool& spool, const ServerConfig& config,
                                Metrics& metrics, std::string token)
-    : table_(table), spool_(spool), config_(config), metrics_(metrics), token_(std::move(token)) {}
+    : table_(table),
+      spool_(spool),
+      config_(config),
+      metrics_(metrics),
+      token_(std::move(token)),
+      streams_(config.max_streams_per_client, config.max_streams) {}
+
+absl::StatusOr<std::unique_ptr<StreamCounts::Slot>> MeshingService::open_stream(
+    const grpc::ServerContext& context) {
+  auto slot = streams_.open(context.peer());
+  if (!slot.ok()) metrics_.rejected("too_many_streams");
+  return slot;
+}
+
 
 grpc::Status MeshingService::authenticate(const grpc::ServerContext& context) {
   if (token_.empty()) return grpc::Status::OK;
@@ -96,7 +116,8 @@ absl::Status MeshingService::check_spool_space(uint64_t upload_bytes) const {
 }
 
 grpc::Status MeshingService::receive_upload(grpc::ServerReader<v1::SubmitRequest>& reader,
-                                            const v1::JobSpec& spec, const std::string& path) {
+                                            const v1::JobSpec& spec, const std::string& path,
+                                            StreamWatchdog::Ticket& ticket) {
   // Each refusal is counted here, by its reason, and only here.
   auto refuse = [this](const char* reason, const std::string& message) {
     metrics_.rejected(reason);
@@ -113,6 +134,7 @@ grpc::Status MeshingService::receive_upload(grpc::ServerReader<v1::SubmitRequest
   uint64_t received = 0;
   v1::SubmitRequest message;
   while (reader.Read(&message)) {
+    ticket.touch();
     if (!message.has_chunk()) {
       return refuse("bad_request", "after the spec, every message must be a chunk");
     }
@@ -125,6 +147,10 @@ grpc::Status MeshingService::receive_upload(grpc::ServerReader<v1::SubmitRequest
     if (auto status = out.append(chunk); !status.ok()) return spool_failed(status);
     hash.update(chunk);
     received += chunk.size();
+  }
+  if (const std::string reason = ticket.cancelled_because(); !reason.empty()) {
+    metrics_.rejected("stalled");
+    return grpc::Status(grpc::StatusCode::DEADLINE_EXCEEDED, reason);
   }
   if (auto status = out.finish(); !status.ok()) return spool_failed(status);
   if (received < spec.size_bytes()) {
@@ -144,6 +170,11 @@ grpc::Status MeshingService::Submit(grpc::ServerContext* context,
   if (auto status = authenticate(*context); !status.ok()) return status;
   if (!accepting_)
     return grpc::Status(grpc::StatusCode::UNAVAILABLE, "the server is shutting down");
+  auto stream = open_stream(*context);
+  if (!stream.ok()) return to_grpc(stream.status());
+  // The spec is the first step: a client that sends nothing is dropped too.
+  auto ticket =
+      watchdog_.watch(context, config_.stream_idle_timeout, config_.transfer_deadline, "upload");
   UploadSlot slot(uploads_, config_.max_concurrent_uploads);
   if (!slot.acquired()) {
     metrics_.rejected("too_many_uploads");
@@ -154,8 +185,9 @@ grpc::Status MeshingService::Submit(grpc::ServerContext* context,
   v1::SubmitRequest first;
   if (!reader->Read(&first) || !first.has_spec()) {
     metrics_.rejected("bad_request");
-    return invalid("the first message must hold the job spec");
+    return stalled_or(*ticket, invalid("the first message must hold the job spec"));
   }
+  ticket->touch();
   v1::JobSpec spec = first.spec();
   if (auto status = check_spec(spec, config_); !status.ok()) {
     metrics_.rejected(absl::StartsWith(status.message(), "spec.size_bytes") ? "too_large"
@@ -185,7 +217,8 @@ grpc::Status MeshingService::Submit(grpc::ServerContext* context,
   const std::string job_id = new_job_id();
   const std::string extension = *upload_extension(spec.file_name());
   UploadFile upload(spool_.upload_path(job_id, extension));
-  if (auto status = receive_upload(*reader, spec, upload.path()); !status.ok()) return status;
+  if (auto status = receive_upload(*reader, spec, upload.path(), *ticket); !status.ok())
+    return status;
   auto geometry = check_uploaded_volume(upload.path(), voxel_limit, config_.worker_memory_bytes);
   if (!geometry.ok()) {
     metrics_.rejected("bad_volume");
@@ -225,12 +258,20 @@ grpc::Status MeshingService::Watch(grpc::ServerContext* context, const v1::Watch
                                    grpc::ServerWriter<v1::JobEvent>* writer) {
   if (auto status = authenticate(*context); !status.ok()) return status;
   if (auto status = check_job_id(request->job_id()); !status.ok()) return status;
+  auto stream = open_stream(*context);
+  if (!stream.ok()) return to_grpc(stream.status());
+  // Waiting for events is progress; a write the watcher does not read is not.
+  auto ticket =
+      watchdog_.watch(context, config_.stream_idle_timeout, absl::InfiniteDuration(), "watch");
   uint64_t next = 0;
   for (;;) {
+    ticket->touch();
     auto batch = table_.events_since(request->job_id(), next, absl::Milliseconds(500));
     if (!batch.ok()) return to_grpc(batch.status());
     for (const auto& event : batch->events) {
-      if (!writer->Write(event)) return grpc::Status(grpc::StatusCode::CANCELLED, "watcher left");
+      if (!writer->Write(event))
+        return stalled_or(*ticket, grpc::Status(grpc::StatusCode::CANCELLED, "watcher left"));
+      ticket->touch();
       next = event.sequence() + 1;
     }
     if (batch->ended) return grpc::Status::OK;
@@ -294,13 +335,19 @@ grpc::Status MeshingService::Fetch(grpc::ServerContext* context, const v1::Fetch
   std::ifstream in(absl::StrCat(spool_.output_dir(request->job_id()), "/", artifact->name()),
                    std::ios::binary);
   if (!in) return grpc::Status(grpc::StatusCode::NOT_FOUND, "the artifact expired or was removed");
+  auto stream = open_stream(*context);
+  if (!stream.ok()) return to_grpc(stream.status());
+  auto ticket =
+      watchdog_.watch(context, config_.stream_idle_timeout, config_.transfer_deadline, "fetch");
   v1::FetchChunk chunk;
   *chunk.mutable_artifact() = *artifact;
   std::string buffer(kChunkBytes, '\0');
   do {
     in.read(buffer.data(), static_cast<std::streamsize>(buffer.size()));
     chunk.set_data(buffer.data(), static_cast<size_t>(in.gcount()));
-    if (!writer->Write(chunk)) return grpc::Status(grpc::StatusCode::CANCELLED, "reader left");
+    if (!writer->Write(chunk))
+      return stalled_or(*ticket, grpc::Status(grpc::StatusCode::CANCELLED, "reader left"));
+    ticket->touch();
     chunk.clear_artifact();
   } while (in);
   return grpc::Status::OK;

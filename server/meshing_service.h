@@ -11,6 +11,7 @@
 #include "server/metrics.h"
 #include "server/server_config.h"
 #include "server/spool.h"
+#include "server/stream_limits.h"
 
 namespace labelmesh::server {
 
@@ -41,7 +42,11 @@ class MeshingService final : public v1::MeshingService::Service {
  private:
   grpc::Status authenticate(const grpc::ServerContext& context);
   grpc::Status receive_upload(grpc::ServerReader<v1::SubmitRequest>& reader,
-                              const v1::JobSpec& spec, const std::string& path);
+                              const v1::JobSpec& spec, const std::string& path,
+                              StreamWatchdog::Ticket& ticket);
+  // A place among the client's streams, or RESOURCE_EXHAUSTED (counted).
+  absl::StatusOr<std::unique_ptr<StreamCounts::Slot>> open_stream(
+      const grpc::ServerContext& context);
   // RESOURCE_EXHAUSTED "spool disk full" when an upload of this size would
   // leave less than the reserve free.
   absl::Status check_spool_space(uint64_t upload_bytes) const;
@@ -53,6 +58,8 @@ class MeshingService final : public v1::MeshingService::Service {
   const std::string token_;
   std::atomic<bool> accepting_{true};
   std::atomic<int> uploads_{0};
+  StreamCounts streams_;
+  StreamWatchdog watchdog_;
 };
 
 }  // namespace labelmesh::server

@@ -35,6 +35,15 @@ struct ServerConfig {
   uint64_t spool_reserve_bytes = uint64_t{512} << 20;
   uint64_t max_voxels = uint64_t{1} << 31;
   int max_concurrent_uploads = 8;
+  // Streams (Submit, Watch, Fetch) one client host and all clients may hold
+  // open at once.
+  int max_streams_per_client = 16;
+  int max_streams = 256;
+  // A stream that makes no progress this long is cancelled: an upload whose
+  // next chunk does not come, a fetch or watch whose reader stopped reading.
+  absl::Duration stream_idle_timeout = absl::Seconds(30);
+  // Longest an upload or a fetch may take in all.
+  absl::Duration transfer_deadline = absl::Minutes(30);
   // Largest gRPC message either way; upload and fetch chunks are 1 MiB.
   int max_message_bytes = 4 << 20;
 

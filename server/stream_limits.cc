@@ -1,0 +1,101 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+#include "server/stream_limits.h"
+
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
+#include "spdlog/spdlog.h"
+
+namespace labelmesh::server {
+
+std::string peer_host(const std::string& peer) {
+  const size_t colon = peer.rfind(':');
+  const size_t scheme = peer.find(':');
+  if (colon == std::string::npos || colon == scheme) return peer;
+  return peer.substr(0, colon);
+}
+
+StreamCounts::Slot::~Slot() {
+  std::lock_guard lock(counts_.mutex_);
+  if (--counts_.by_host_[host_] == 0) counts_.by_host_.erase(host_);
+  --counts_.open_;
+}
+
+absl::StatusOr<std::unique_ptr<StreamCounts::Slot>> StreamCounts::open(const std::string& peer) {
+  const std::string host = peer_host(peer);
+  std::lock_guard lock(mutex_);
+  if (open_ >= total_) {
+    return absl::ResourceExhaustedError(
+        absl::StrCat("the server holds its most streams (", total_, "); try again later"));
+  }
+  int& mine = by_host_[host];
+  if (mine >= per_client_) {
+    if (mine == 0) by_host_.erase(host);
+    return absl::ResourceExhaustedError(absl::StrCat("this client holds its most streams at once (",
+                                                     per_client_, "); close one first"));
+  }
+  ++mine;
+  ++open_;
+  return std::unique_ptr<Slot>(new Slot(*this, host));
+}
+
+StreamWatchdog::StreamWatchdog() : thread_([this] { loop(); }) {}
+
+StreamWatchdog::~StreamWatchdog() {
+  {
+    std::lock_guard lock(mutex_);
+    stopping_ = true;
+  }
+  wake_.notify_all();
+  thread_.join();
+}
+
+StreamWatchdog::Ticket::~Ticket() {
+  std::lock_guard lock(watchdog_.mutex_);
+  watchdog_.entries_.erase(id_);
+}
+
+void StreamWatchdog::Ticket::touch() {
+  std::lock_guard lock(watchdog_.mutex_);
+  auto it = watchdog_.entries_.find(id_);
+  if (it != watchdog_.entries_.end()) it->second.last_touch = absl::Now();
+}
+
+std::string StreamWatchdog::Ticket::cancelled_because() const {
+  std::lock_guard lock(watchdog_.mutex_);
+  auto it = watchdog_.entries_.find(id_);
+  return it == watchdog_.entries_.end() ? std::string() : it->second.cancelled_because;
+}
+
+std::unique_ptr<StreamWatchdog::Ticket> StreamWatchdog::watch(grpc::ServerContext* context,
+                                                              absl::Duration idle,
+                                                              absl::Duration total,
+                                                              std::string what) {
+  const absl::Time now = absl::Now();
+  std::lock_guard lock(mutex_);
+  const uint64_t id = next_id_++;
+  entries_[id] = Entry{context, idle, total, now + total, now, std::move(what), {}};
+  return std::unique_ptr<Ticket>(new Ticket(*this, id));
+}
+
+void StreamWatchdog::loop() {
+  std::unique_lock lock(mutex_);
+  while (!wake_.wait_for(lock, std::chrono::milliseconds(100), [this] { return stopping_; })) {
+    const absl::Time now = absl::Now();
+    for (auto& [id, entry] : entries_) {
+      if (!entry.cancelled_because.empty()) continue;
+      if (now - entry.last_touch > entry.idle) {
+        entry.cancelled_because =
+            absl::StrCat(entry.what, " stalled for more than ", absl::FormatDuration(entry.idle));
+      } else if (now > entry.deadline) {
+        entry.cancelled_because = absl::StrCat(entry.what, " ran past its deadline of ",
+                                               absl::FormatDuration(entry.total));
+      } else {
+        continue;
+      }
+      spdlog::warn("{}: cancelled", entry.cancelled_because);
+      entry.context->TryCancel();
+    }
+  }
+}
+
+}  // namespace labelmesh::server
