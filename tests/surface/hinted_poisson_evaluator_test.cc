@@ -5,7 +5,6 @@
 
 #include <gtest/gtest.h>
 
-#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <memory>
@@ -124,40 +123,6 @@ TEST(StopAwareKernel, AStopEndsASolveWithNoCallbackOfItsOwn) {
   EXPECT_TRUE(function->compute_implicit_function());
   EXPECT_LT(function->operator()(Point(10, 0, 0)), 0);  // inside the tube
   EXPECT_GT(function->operator()(Point(0, 0, 0)), 0);   // in the ring's hole
-}
-
-// The refinement's queue of cells to split: cells of equal quality leave in
-// the order they came, whatever their addresses; better quality first.
-TEST_F(HintedPoissonEvaluatorTest, RefinementQueueBreaksTiesByArrival) {
-  std::vector<RefinedCell> cells;
-  for (auto c = function_.tr().finite_cells_begin(); c != function_.tr().finite_cells_end(); ++c)
-    cells.push_back(c);
-  ASSERT_GE(cells.size(), 40u);
-  cells.resize(40);
-  // Arrival order against address order: descending addresses first.
-  std::sort(cells.begin(), cells.end(), [](RefinedCell a, RefinedCell b) { return &*a > &*b; });
-  CGAL::Double_map<RefinedCell, double> queue;
-  for (const auto& cell : cells) EXPECT_TRUE(queue.insert(cell, 1.0));
-  EXPECT_FALSE(queue.insert(cells[0], 0.5));  // already queued: unchanged
-  EXPECT_TRUE(queue.erase(cells[1]));
-  EXPECT_FALSE(queue.erase(cells[1]));
-  EXPECT_EQ(queue.size(), 39u);
-  std::vector<RefinedCell> order;
-  while (!queue.empty()) {
-    order.push_back(queue.front()->second);
-    queue.pop_front();
-  }
-  ASSERT_EQ(order.size(), 39u);
-  EXPECT_EQ(order[0], cells[0]);
-  for (size_t i = 1; i < order.size(); ++i) EXPECT_EQ(order[i], cells[i + 1]) << i;
-
-  // A cell of better (smaller) quality goes first, ties still by arrival.
-  queue.insert(cells[5], 2.0);
-  queue.insert(cells[6], 1.0);
-  queue.insert(cells[7], 1.0);
-  EXPECT_EQ(queue.front()->second, cells[6]);
-  queue.pop_front();
-  EXPECT_EQ(queue.front()->second, cells[7]);
 }
 
 }  // namespace

@@ -18,7 +18,6 @@
 
 #include "core/surface/cgal/cgal_mesh.h"
 #include "core/surface/poisson/poisson_kernel.h"
-#include "core/surface/poisson/refinement_queue.h"
 #include "core/util/run_context.h"
 
 namespace labelmesh::surface::poisson {

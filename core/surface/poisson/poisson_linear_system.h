@@ -21,7 +21,6 @@
 #include <Eigen/IterativeLinearSolvers>
 
 #include "core/surface/poisson/poisson_kernel.h"
-#include "core/surface/poisson/refinement_queue.h"
 #include "core/util/run_context.h"
 
 namespace labelmesh::surface::poisson {
