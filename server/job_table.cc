@@ -205,9 +205,10 @@ void JobTable::publish(const std::string& job_id, v1::JobEvent event) {
 }
 
 absl::Status JobTable::end_job(Entry& entry, v1::JobState state, v1::JobEvent event,
-                               Unsaved unsaved) {
+                               Unsaved unsaved, const v1::JobError* error) {
   v1::JobRecord ended = entry.record;
   v1::Job& job = *ended.mutable_job();
+  if (error != nullptr) *job.mutable_error() = *error;
   const bool was_running = job.state() == v1::JOB_STATE_RUNNING;
   job.set_state(state);
   job.set_finished_at(unix_now());
@@ -253,17 +254,14 @@ void JobTable::fail(const std::string& job_id, int code, const std::string& mess
 }
 
 absl::Status JobTable::end_cancelled(Entry& entry, Unsaved unsaved) {
-  const v1::JobError before = entry.record.job().error();
-  v1::JobError& error = *entry.record.mutable_job()->mutable_error();
+  v1::JobError error;
   error.set_code(static_cast<int>(absl::StatusCode::kCancelled));
   error.set_message("cancelled by a client");
   v1::JobEvent event;
   event.mutable_cancelled();
-  if (auto status = end_job(entry, v1::JOB_STATE_CANCELLED, std::move(event), unsaved);
-      !status.ok()) {
-    *entry.record.mutable_job()->mutable_error() = before;
+  if (auto status = end_job(entry, v1::JOB_STATE_CANCELLED, std::move(event), unsaved, &error);
+      !status.ok())
     return status;
-  }
   spdlog::info("job {} cancelled", entry.record.job().job_id());
   return absl::OkStatus();
 }

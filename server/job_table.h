@@ -93,9 +93,11 @@ class JobTable {
   // What an end does when its record cannot be saved: a client's request is
   // refused with the spool's error and changes nothing; an end the worker
   // reached is applied in memory (on disk the job stays unended, so after a
-  // restart it runs again and nothing is lost).
+  // restart it runs again and nothing is lost). `error`, if given, becomes
+  // the job's error with the same save.
   enum class Unsaved { kRefuse, kApply };
-  absl::Status end_job(Entry& entry, v1::JobState state, v1::JobEvent event, Unsaved unsaved);
+  absl::Status end_job(Entry& entry, v1::JobState state, v1::JobEvent event, Unsaved unsaved,
+                       const v1::JobError* error = nullptr);
   absl::Status end_cancelled(Entry& entry, Unsaved unsaved);
   uint32_t position_of(const std::string& job_id) const;
   void update_gauges();

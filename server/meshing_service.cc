@@ -86,7 +86,6 @@ absl::StatusOr<std::unique_ptr<StreamCounts::Slot>> MeshingService::open_stream(
   return slot;
 }
 
-
 grpc::Status MeshingService::authenticate(const grpc::ServerContext& context) {
   if (token_.empty()) return grpc::Status::OK;
   const auto& metadata = context.client_metadata();

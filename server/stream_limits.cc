@@ -27,9 +27,8 @@ absl::StatusOr<std::unique_ptr<StreamCounts::Slot>> StreamCounts::open(const std
     return absl::ResourceExhaustedError(
         absl::StrCat("the server holds its most streams (", total_, "); try again later"));
   }
-  int& mine = by_host_[host];
+  int& mine = by_host_[host];  // per_client_ >= 1: a new host never stops here
   if (mine >= per_client_) {
-    if (mine == 0) by_host_.erase(host);
     return absl::ResourceExhaustedError(absl::StrCat("this client holds its most streams at once (",
                                                      per_client_, "); close one first"));
   }

@@ -36,6 +36,12 @@ size_t entries_in(const fs::path& dir) {
   return count;
 }
 
+// A small queued job's directory and record.
+bool save_queued(const server::Spool& spool, const std::string& id) {
+  fs::create_directories(spool.job_dir(id));
+  return spool.save(record_with(id, v1::JOB_STATE_QUEUED, 10)).ok();
+}
+
 // A full disk, short of a file system of our own: the file size limit makes
 // every write past it fail with EFBIG, as ENOSPC would.
 TEST(Spool, AFailedWriteKeepsThePreviousRecord) {
@@ -43,8 +49,7 @@ TEST(Spool, AFailedWriteKeepsThePreviousRecord) {
   auto spool = server::Spool::open(root.string());
   ASSERT_TRUE(spool.ok()) << spool.status();
   const std::string id = server::new_job_id();
-  fs::create_directories(spool->job_dir(id));
-  ASSERT_TRUE(spool->save(record_with(id, v1::JOB_STATE_QUEUED, 10)).ok());
+  ASSERT_TRUE(save_queued(*spool, id));
 
   const pid_t child = fork();
   ASSERT_GE(child, 0);
@@ -74,8 +79,7 @@ TEST(Spool, UnreadableRecordsAreQuarantinedNotDeleted) {
   auto spool = server::Spool::open(root.string());
   ASSERT_TRUE(spool.ok()) << spool.status();
   const std::string good = server::new_job_id();
-  fs::create_directories(spool->job_dir(good));
-  ASSERT_TRUE(spool->save(record_with(good, v1::JOB_STATE_QUEUED, 10)).ok());
+  ASSERT_TRUE(save_queued(*spool, good));
   // A record cut to nothing, one that is not a record, one naming another
   // job, and a directory that never got its record.
   const std::string empty = server::new_job_id(), garbage = server::new_job_id(),
