@@ -22,6 +22,7 @@ CommandRunner add_watch_command(CLI::App& app);
 CommandRunner add_status_command(CLI::App& app);
 CommandRunner add_fetch_command(CLI::App& app);
 CommandRunner add_cancel_command(CLI::App& app);
+CommandRunner add_delete_command(CLI::App& app);
 CommandRunner add_list_command(CLI::App& app);
 CommandRunner add_health_command(CLI::App& app);
 

@@ -1,9 +1,11 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 // Commands about jobs on a labelmeshd server: watch, status, fetch, cancel,
-// list, health. Each takes --json and the connection flags.
+// delete, list, health. Each takes --json and the connection flags.
 #include <CLI/CLI.hpp>
 
 #include <ctime>
+
+#include "absl/status/status.h"
 
 #include "client/commands.h"
 #include "client/exit_codes.h"
@@ -23,6 +25,7 @@ struct JobFlags {
   std::string job_id;
   std::string out_dir;
   std::string artifact;
+  std::vector<std::string> states;
   ConnectionFlags connection;
   bool json = false;
 };
@@ -138,19 +141,57 @@ int run_cancel(const JobFlags& flags) {
   return kExitSuccess;
 }
 
+int run_delete(const JobFlags& flags) {
+  auto connection = ServerConnection::open(flags.connection);
+  if (!connection.ok()) return fail("delete", connection.status());
+  auto stub = v1::MeshingService::NewStub(connection->channel());
+  auto context = connection->context(kCallTimeout);
+  v1::DeleteJobRequest request;
+  request.set_job_id(flags.job_id);
+  v1::DeleteJobReply reply;
+  if (auto status = stub->DeleteJob(context.get(), request, &reply); !status.ok()) {
+    return fail("delete", from_grpc(status));
+  }
+  if (flags.json) {
+    std::printf("{\"job_id\": \"%s\", \"state\": \"%s\"}\n", flags.job_id.c_str(),
+                state_name(reply.state()).c_str());
+  } else {
+    std::printf("%s: deleted (was %s)\n", flags.job_id.c_str(), state_name(reply.state()).c_str());
+  }
+  return kExitSuccess;
+}
+
 int run_list(const JobFlags& flags) {
   auto connection = ServerConnection::open(flags.connection);
   if (!connection.ok()) return fail("list", connection.status());
   auto stub = v1::MeshingService::NewStub(connection->channel());
-  auto context = connection->context(kCallTimeout);
-  v1::ListJobsReply reply;
-  if (auto status = stub->ListJobs(context.get(), v1::ListJobsRequest(), &reply); !status.ok()) {
-    return fail("list", from_grpc(status));
+  v1::ListJobsRequest request;
+  for (const auto& name : flags.states) {
+    v1::JobState state;
+    std::string upper = "JOB_STATE_" + name;
+    for (char& c : upper) c = static_cast<char>(std::toupper(c));
+    if (!v1::JobState_Parse(upper, &state) || state == v1::JOB_STATE_UNSPECIFIED) {
+      return fail("list", absl::InvalidArgumentError(
+                              "--state: " + name +
+                              " is not one of queued, running, succeeded, failed, cancelled"));
+    }
+    request.add_states(state);
   }
+  // Every page, in order: the listing is the caller's jobs, newest first.
+  v1::ListJobsReply all;
+  do {
+    auto context = connection->context(kCallTimeout);
+    v1::ListJobsReply page;
+    if (auto status = stub->ListJobs(context.get(), request, &page); !status.ok()) {
+      return fail("list", from_grpc(status));
+    }
+    for (auto& job : *page.mutable_jobs()) *all.add_jobs() = std::move(job);
+    request.set_page_token(page.next_page_token());
+  } while (!request.page_token().empty());
   if (flags.json) {
-    std::printf("%s\n", to_json(reply).c_str());
+    std::printf("%s\n", to_json(all).c_str());
   } else {
-    for (const auto& job : reply.jobs()) print_job_line(job);
+    for (const auto& job : all.jobs()) print_job_line(job);
   }
   return kExitSuccess;
 }
@@ -204,9 +245,21 @@ CommandRunner add_cancel_command(CLI::App& app) {
   return [flags] { return run_cancel(*flags); };
 }
 
+CommandRunner add_delete_command(CLI::App& app) {
+  auto flags = std::make_shared<JobFlags>();
+  add_job_command(app, "delete",
+                  "Delete a job with its input and results (a running job is stopped first)",
+                  *flags, true);
+  return [flags] { return run_delete(*flags); };
+}
+
 CommandRunner add_list_command(CLI::App& app) {
   auto flags = std::make_shared<JobFlags>();
-  add_job_command(app, "list", "List the server's jobs, newest first", *flags, false);
+  CLI::App* list = add_job_command(
+      app, "list", "List your jobs (an admin's: everyone's), newest first", *flags, false);
+  list->add_option("--state", flags->states,
+                   "Only jobs in these states: queued, running, succeeded, failed, cancelled")
+      ->delimiter(',');
   return [flags] { return run_list(*flags); };
 }
 

@@ -19,7 +19,7 @@ int main(int argc, char** argv) {
   std::map<const CLI::App*, CommandRunner> runners;
   for (auto add : {add_info_command, add_mesh_command, add_phantom_command, add_submit_command,
                    add_watch_command, add_status_command, add_fetch_command, add_cancel_command,
-                   add_list_command, add_health_command}) {
+                   add_delete_command, add_list_command, add_health_command}) {
     const size_t before = app.get_subcommands({}).size();
     CommandRunner runner = add(app);
     runners[app.get_subcommands({}).at(before)] = std::move(runner);

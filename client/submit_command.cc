@@ -7,8 +7,11 @@
 #include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <random>
+#include <thread>
 
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
 #include "client/commands.h"
 #include "client/exit_codes.h"
 #include "client/job_follow.h"
@@ -32,7 +35,25 @@ struct SubmitFlags {
   ConnectionFlags connection;
   bool detach = false;
   bool json = false;
+  bool keep_input = false;
+  std::string request_id;
+  int retries = 3;
 };
+
+// A fresh request id: 32 random hex digits.
+std::string random_request_id() {
+  std::random_device random;
+  std::string id;
+  for (int i = 0; i < 4; ++i) id += absl::StrFormat("%08x", random());
+  return id;
+}
+
+// Worth another try with the same request id: the server went away or the
+// first try is still being received.
+bool retryable(const absl::Status& status) {
+  return status.code() == absl::StatusCode::kUnavailable ||
+         status.code() == absl::StatusCode::kAborted;
+}
 
 // The upload's percentage and rate on a terminal.
 void print_upload_progress(uint64_t sent, uint64_t total, double seconds) {
@@ -44,8 +65,9 @@ void print_upload_progress(uint64_t sent, uint64_t total, double seconds) {
   std::fflush(stderr);
 }
 
-absl::StatusOr<v1::SubmitReply> upload(const ServerConnection& connection,
-                                       const SubmitFlags& flags) {
+absl::StatusOr<v1::SubmitReply> upload_once(const ServerConnection& connection,
+                                            const SubmitFlags& flags,
+                                            const std::string& request_id) {
   auto digest = digest::sha256_file(flags.path);
   if (!digest.ok()) return digest.status();
   std::error_code error;
@@ -64,6 +86,8 @@ absl::StatusOr<v1::SubmitReply> upload(const ServerConnection& connection,
   spec.set_file_name(std::filesystem::path(flags.path).filename().string());
   spec.set_size_bytes(size);
   spec.set_sha256(*digest);
+  spec.set_keep_input(flags.keep_input);
+  spec.set_request_id(request_id);
   const auto start = std::chrono::steady_clock::now();
   bool open = writer->Write(request);
   std::ifstream in(flags.path, std::ios::binary);
@@ -83,6 +107,20 @@ absl::StatusOr<v1::SubmitReply> upload(const ServerConnection& connection,
   writer->WritesDone();
   if (auto status = writer->Finish(); !status.ok()) return from_grpc(status);
   return reply;
+}
+
+// Uploads, retrying with the same request id so that a retry never makes a
+// second job.
+absl::StatusOr<v1::SubmitReply> upload(const ServerConnection& connection,
+                                       const SubmitFlags& flags) {
+  const std::string request_id = flags.request_id.empty() ? random_request_id() : flags.request_id;
+  for (int attempt = 0;; ++attempt) {
+    auto reply = upload_once(connection, flags, request_id);
+    if (reply.ok() || !retryable(reply.status()) || attempt >= flags.retries) return reply;
+    std::fprintf(stderr, "labelmesh submit: %s; trying again\n",
+                 std::string(reply.status().message()).c_str());
+    std::this_thread::sleep_for(std::chrono::seconds(1 << attempt));
+  }
 }
 
 int run_submit(const SubmitFlags& flags) {
@@ -150,6 +188,16 @@ CommandRunner add_submit_command(CLI::App& app) {
   add_pipeline_flags(*submit, flags->pipeline);
   add_connection_flags(*submit, flags->connection);
   submit->add_flag("--detach", flags->detach, "Print the job id once accepted and return");
+  submit->add_flag("--keep-input", flags->keep_input,
+                   "Keep the uploaded volume on the server until the job is deleted or expires "
+                   "(by default it is deleted when the job ends)");
+  submit->add_option("--request-id", flags->request_id,
+                     "Id that makes the submit safe to repeat: the server answers a repeat with "
+                     "the same job (default: a random id for this run's retries)");
+  submit
+      ->add_option("--retries", flags->retries,
+                   "Tries again this many times while the server is unavailable")
+      ->capture_default_str();
   submit->add_flag("--json", flags->json,
                    "Print the report (or, with --detach, the job id) as JSON on stdout");
   submit->footer(kExitCodeHelp);

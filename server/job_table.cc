@@ -3,7 +3,9 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 
+#include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "spdlog/spdlog.h"
 
@@ -37,6 +39,36 @@ v1::JobEvent state_event(const v1::Job& job, uint32_t position) {
       event.mutable_queued()->set_position(position);
   }
   return event;
+}
+
+google::protobuf::Timestamp to_timestamp(double unix_seconds) {
+  google::protobuf::Timestamp stamp;
+  const double whole = std::floor(unix_seconds);
+  stamp.set_seconds(static_cast<int64_t>(whole));
+  stamp.set_nanos(std::min(999'999'999, static_cast<int>((unix_seconds - whole) * 1e9)));
+  return stamp;
+}
+
+// Where a page of ListJobs ends: the last job's creation time (microseconds)
+// and id, the order of the listing.
+using ListPosition = std::pair<int64_t, std::string>;
+
+ListPosition list_position(const v1::Job& job) {
+  return {static_cast<int64_t>(std::llround(job.created_at() * 1e6)), job.job_id()};
+}
+
+std::string page_token(const ListPosition& position) {
+  return absl::StrCat(position.first, "-", position.second);
+}
+
+std::optional<ListPosition> parse_page_token(std::string_view token) {
+  const size_t dash = token.find('-');
+  if (dash == std::string_view::npos) return std::nullopt;
+  int64_t micros = 0;
+  if (!absl::SimpleAtoi(std::string(token.substr(0, dash)), &micros)) return std::nullopt;
+  const std::string_view id = token.substr(dash + 1);
+  if (!is_job_id(id)) return std::nullopt;
+  return ListPosition{micros, std::string(id)};
 }
 
 }  // namespace
@@ -87,6 +119,7 @@ void JobTable::add_event(Entry& entry, v1::JobEvent event) {
   event.set_job_id(entry.record.job().job_id());
   event.set_sequence(next_sequence_++);
   event.set_time(unix_now());
+  *event.mutable_timestamp() = to_timestamp(event.time());
   if (event.has_progress() && entry.events.size() >= kMaxStoredEvents) return;
   entry.events.push_back(std::move(event));
   events_added_.notify_all();
@@ -109,6 +142,8 @@ void JobTable::recover(absl::Duration result_ttl) {
         ++expired;
         continue;
       }
+      // Ended before its input was deleted (a crash in between).
+      if (!record.spec().keep_input()) spool_.remove_input(record);
       ++kept;
     } else {
       // Queued, or running when the server stopped: runs again from the start.
@@ -213,7 +248,10 @@ absl::Status JobTable::end_job(Entry& entry, v1::JobState state, v1::JobEvent ev
   job.set_state(state);
   job.set_finished_at(unix_now());
   job.clear_stage();
-  if (auto status = persist(ended); !status.ok() && unsaved == Unsaved::kRefuse) return status;
+  const absl::Status saved = persist(ended);
+  if (!saved.ok() && unsaved == Unsaved::kRefuse) return saved;
+  // Unsaved, the job runs again after a restart and needs its input.
+  if (saved.ok() && !ended.spec().keep_input()) spool_.remove_input(ended);
   entry.record = std::move(ended);
   if (was_running && running_ > 0) --running_;
   add_event(entry, std::move(event));
@@ -237,6 +275,7 @@ void JobTable::succeed(const std::string& job_id, const v1::Report& report,
   (void)end_job(*entry, v1::JOB_STATE_SUCCEEDED, std::move(event), Unsaved::kApply);
   spdlog::info("job {} succeeded in {:.3f} s", job_id,
                entry->record.job().finished_at() - entry->record.job().started_at());
+  remove_if_requested(job_id);
 }
 
 void JobTable::fail(const std::string& job_id, int code, const std::string& message) {
@@ -251,6 +290,7 @@ void JobTable::fail(const std::string& job_id, int code, const std::string& mess
   (void)end_job(*entry, v1::JOB_STATE_FAILED, std::move(event), Unsaved::kApply);
   // The message may quote the volume's fields; the log keeps the code only.
   spdlog::warn("job {} failed with status code {}", job_id, code);
+  remove_if_requested(job_id);
 }
 
 absl::Status JobTable::end_cancelled(Entry& entry, Unsaved unsaved) {
@@ -271,12 +311,29 @@ void JobTable::mark_cancelled(const std::string& job_id) {
   Entry* entry = find(job_id);
   if (entry == nullptr || has_ended(entry->record.job().state())) return;
   (void)end_cancelled(*entry, Unsaved::kApply);
+  remove_if_requested(job_id);
+}
+
+bool JobTable::remove_if_requested(const std::string& job_id) {
+  Entry* entry = find(job_id);
+  if (entry == nullptr || !entry->remove_when_ended) return false;
+  spool_.remove_job(job_id);
+  jobs_.erase(job_id);
+  events_added_.notify_all();
+  spdlog::info("job {} deleted by a client once its worker stopped", job_id);
+  return true;
 }
 
 void JobTable::requeue_interrupted(const std::string& job_id) {
   std::lock_guard lock(mutex_);
   Entry* entry = find(job_id);
   if (entry == nullptr || entry->record.job().state() != v1::JOB_STATE_RUNNING) return;
+  if (entry->remove_when_ended) {
+    if (running_ > 0) --running_;
+    update_gauges();
+    remove_if_requested(job_id);
+    return;
+  }
   entry->record.mutable_job()->set_state(v1::JOB_STATE_QUEUED);
   (void)persist(entry->record);
   if (running_ > 0) --running_;
@@ -284,27 +341,97 @@ void JobTable::requeue_interrupted(const std::string& job_id) {
   spdlog::info("job {} interrupted by shutdown; it runs again at the next start", job_id);
 }
 
+v1::Job JobTable::view(const std::string& job_id, const v1::Job& stored) const {
+  v1::Job job = stored;
+  if (job.state() == v1::JOB_STATE_QUEUED) job.set_queue_position(position_of(job_id));
+  if (job.created_at() > 0) *job.mutable_created_time() = to_timestamp(job.created_at());
+  if (job.started_at() > 0) *job.mutable_started_time() = to_timestamp(job.started_at());
+  if (job.finished_at() > 0) *job.mutable_finished_time() = to_timestamp(job.finished_at());
+  return job;
+}
+
 absl::StatusOr<v1::Job> JobTable::get(const std::string& job_id) const {
   std::lock_guard lock(mutex_);
   const Entry* entry = find(job_id);
   if (entry == nullptr) return absl::NotFoundError(absl::StrCat("no job ", job_id));
-  v1::Job job = entry->record.job();
-  if (job.state() == v1::JOB_STATE_QUEUED) job.set_queue_position(position_of(job_id));
-  return job;
+  return view(job_id, entry->record.job());
 }
 
-std::vector<v1::Job> JobTable::list() const {
+absl::StatusOr<std::string> JobTable::owner(const std::string& job_id) const {
   std::lock_guard lock(mutex_);
-  std::vector<v1::Job> jobs;
-  for (const auto& [id, entry] : jobs_) {
-    v1::Job job = entry.record.job();
-    job.clear_report();
-    if (job.state() == v1::JOB_STATE_QUEUED) job.set_queue_position(position_of(id));
-    jobs.push_back(std::move(job));
+  const Entry* entry = find(job_id);
+  if (entry == nullptr) return absl::NotFoundError(absl::StrCat("no job ", job_id));
+  return entry->record.job().owner();
+}
+
+absl::StatusOr<JobTable::JobPage> JobTable::list(const JobQuery& query) const {
+  std::optional<ListPosition> after;
+  if (!query.page_token.empty()) {
+    after = parse_page_token(query.page_token);
+    if (!after) return absl::InvalidArgumentError("page_token: not one a reply gave");
   }
-  std::sort(jobs.begin(), jobs.end(),
-            [](const auto& a, const auto& b) { return a.created_at() > b.created_at(); });
-  return jobs;
+  auto wanted = [&query](const v1::Job& job) {
+    if (!query.owner.empty() && job.owner() != query.owner) return false;
+    return query.states.empty() ||
+           std::find(query.states.begin(), query.states.end(), job.state()) != query.states.end();
+  };
+  std::lock_guard lock(mutex_);
+  // Newest first; ties by id, so that every job has one place in the order.
+  std::vector<std::pair<ListPosition, const Entry*>> order;
+  for (const auto& [id, entry] : jobs_) {
+    const v1::Job& job = entry.record.job();
+    if (!wanted(job)) continue;
+    ListPosition position = list_position(job);
+    if (after && !(position < *after)) continue;
+    order.emplace_back(std::move(position), &entry);
+  }
+  std::sort(order.begin(), order.end(),
+            [](const auto& a, const auto& b) { return b.first < a.first; });
+  JobPage page;
+  for (const auto& [position, entry] : order) {
+    if (page.jobs.size() == query.page_size) {
+      page.next_page_token = page_token(list_position(page.jobs.back()));
+      break;
+    }
+    v1::Job job = view(entry->record.job().job_id(), entry->record.job());
+    job.clear_report();
+    page.jobs.push_back(std::move(job));
+  }
+  return page;
+}
+
+std::optional<JobTable::PriorRequest> JobTable::find_request(const std::string& owner,
+                                                             const std::string& request_id) const {
+  std::lock_guard lock(mutex_);
+  for (const auto& [id, entry] : jobs_) {
+    const v1::JobRecord& record = entry.record;
+    if (record.spec().request_id() != request_id || record.job().owner() != owner) continue;
+    const bool queued = record.job().state() == v1::JOB_STATE_QUEUED;
+    return PriorRequest{id, record.spec().sha256(), queued ? position_of(id) : 0};
+  }
+  return std::nullopt;
+}
+
+absl::StatusOr<v1::JobState> JobTable::remove(const std::string& job_id) {
+  std::lock_guard lock(mutex_);
+  Entry* entry = find(job_id);
+  if (entry == nullptr) return absl::NotFoundError(absl::StrCat("no job ", job_id));
+  const v1::JobState state = entry->record.job().state();
+  if (state == v1::JOB_STATE_RUNNING) {
+    // The worker still writes in the job's directory: it goes when it stops.
+    entry->cancel_requested = true;
+    entry->remove_when_ended = true;
+    return state;
+  }
+  if (state == v1::JOB_STATE_QUEUED) {
+    queue_.erase(std::find(queue_.begin(), queue_.end(), job_id));
+    update_gauges();
+  }
+  spool_.remove_job(job_id);
+  jobs_.erase(job_id);
+  events_added_.notify_all();
+  spdlog::info("job {} deleted by a client", job_id);
+  return state;
 }
 
 absl::StatusOr<v1::Job> JobTable::cancel(const std::string& job_id) {
@@ -324,7 +451,7 @@ absl::StatusOr<v1::Job> JobTable::cancel(const std::string& job_id) {
     queue_.erase(std::find(queue_.begin(), queue_.end(), job_id));
     update_gauges();
   }
-  return entry->record.job();
+  return view(job_id, entry->record.job());
 }
 
 bool JobTable::cancel_requested(const std::string& job_id) const {
@@ -368,7 +495,7 @@ absl::StatusOr<JobTable::EventBatch> JobTable::events_since(const std::string& j
   return batch;
 }
 
-int JobTable::expire(absl::Duration result_ttl, size_t max_ended) {
+std::vector<std::string> JobTable::expire(absl::Duration result_ttl, size_t max_ended) {
   std::lock_guard lock(mutex_);
   const double cutoff = unix_now() - absl::ToDoubleSeconds(result_ttl);
   // Ended jobs, oldest end first: past the TTL, or past the cap in number.
@@ -379,7 +506,7 @@ int JobTable::expire(absl::Duration result_ttl, size_t max_ended) {
   }
   std::sort(ended.begin(), ended.end());
   const size_t over_cap = ended.size() > max_ended ? ended.size() - max_ended : 0;
-  int removed = 0;
+  std::vector<std::string> removed;
   for (size_t i = 0; i < ended.size(); ++i) {
     const auto& [finished_at, id] = ended[i];
     const bool expired = finished_at < cutoff;
@@ -387,10 +514,10 @@ int JobTable::expire(absl::Duration result_ttl, size_t max_ended) {
     spool_.remove_job(id);
     spdlog::info("job {} results {} and deleted", id,
                  expired ? "expired" : "past the cap on ended jobs");
+    removed.push_back(id);
     jobs_.erase(id);
-    ++removed;
   }
-  if (removed > 0) events_added_.notify_all();
+  if (!removed.empty()) events_added_.notify_all();
   return removed;
 }
 

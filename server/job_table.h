@@ -48,8 +48,37 @@ class JobTable {
 
   // NOT_FOUND for an unknown id.
   absl::StatusOr<v1::Job> get(const std::string& job_id) const;
-  // Newest first, without reports.
-  std::vector<v1::Job> list() const;
+  // The identity that submitted the job; NOT_FOUND for an unknown id.
+  absl::StatusOr<std::string> owner(const std::string& job_id) const;
+
+  struct JobQuery {
+    // Only this owner's jobs; empty for every owner's.
+    std::string owner;
+    std::vector<v1::JobState> states;
+    size_t page_size = 100;
+    std::string page_token;
+  };
+  struct JobPage {
+    std::vector<v1::Job> jobs;
+    std::string next_page_token;
+  };
+  // Newest first, without reports. INVALID_ARGUMENT for a page token that
+  // no reply gave.
+  absl::StatusOr<JobPage> list(const JobQuery& query) const;
+
+  // The job `owner` submitted with `request_id`, if any.
+  struct PriorRequest {
+    std::string job_id;
+    std::string sha256;
+    uint32_t queue_position = 0;
+  };
+  std::optional<PriorRequest> find_request(const std::string& owner,
+                                           const std::string& request_id) const;
+
+  // Deletes a job with its input and results; a running job is stopped and
+  // deleted when its worker has gone. Returns the state it was in. The
+  // spool's error when a queued job's cancellation cannot be saved.
+  absl::StatusOr<v1::JobState> remove(const std::string& job_id);
   // A queued job is cancelled at once; a running one is flagged for its
   // worker to stop. FAILED_PRECONDITION for a job that ended; the spool's
   // error (RESOURCE_EXHAUSTED when its disk is full) when the cancelled
@@ -70,8 +99,8 @@ class JobTable {
                                           absl::Duration wait) const;
 
   // Deletes jobs that ended more than `result_ttl` ago, and the oldest ended
-  // jobs beyond `max_ended`; returns how many.
-  int expire(absl::Duration result_ttl, size_t max_ended);
+  // jobs beyond `max_ended`; returns their ids.
+  std::vector<std::string> expire(absl::Duration result_ttl, size_t max_ended);
   // Wakes every waiter; take_next() returns nullopt from now on.
   void close();
   // Stops handing out jobs but still accepts them (drain before shutdown).
@@ -82,6 +111,8 @@ class JobTable {
     v1::JobRecord record;
     std::vector<v1::JobEvent> events;
     bool cancel_requested = false;
+    // Deleted by a client while running: gone once its worker ends.
+    bool remove_when_ended = false;
   };
 
   Entry* find(const std::string& job_id);
@@ -99,6 +130,10 @@ class JobTable {
   absl::Status end_job(Entry& entry, v1::JobState state, v1::JobEvent event, Unsaved unsaved,
                        const v1::JobError* error = nullptr);
   absl::Status end_cancelled(Entry& entry, Unsaved unsaved);
+  // Deletes the job if a client asked while it ran. Returns true if it did.
+  bool remove_if_requested(const std::string& job_id);
+  // The job as clients see it: queue position and timestamps filled in.
+  v1::Job view(const std::string& job_id, const v1::Job& job) const;
   uint32_t position_of(const std::string& job_id) const;
   void update_gauges();
 

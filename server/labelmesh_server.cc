@@ -9,7 +9,8 @@
 #include <sstream>
 
 #include "absl/strings/str_cat.h"
-#include "absl/strings/strip.h"
+#include "server/audit_log.h"
+#include "server/client_identity.h"
 #include "server/job_table.h"
 #include "server/meshing_service.h"
 #include "server/metrics.h"
@@ -46,6 +47,23 @@ absl::StatusOr<std::shared_ptr<grpc::ServerCredentials>> credentials(const Serve
   return grpc::SslServerCredentials(options);
 }
 
+// Serves the reflection service on this server or not. Linking gRPC's
+// reflection library adds it to every server; this option takes it out.
+class ReflectionOption : public grpc::ServerBuilderOption {
+ public:
+  explicit ReflectionOption(bool served) : served_(served) {}
+  void UpdateArguments(grpc::ChannelArguments*) override {}
+  void UpdatePlugins(std::vector<std::unique_ptr<grpc::ServerBuilderPlugin>>* plugins) override {
+    const std::string name = grpc::reflection::ProtoServerReflectionPlugin().name();
+    std::erase_if(*plugins, [&name](const auto& plugin) { return plugin->name() == name; });
+    if (served_)
+      plugins->push_back(std::make_unique<grpc::reflection::ProtoServerReflectionPlugin>());
+  }
+
+ private:
+  const bool served_;
+};
+
 }  // namespace
 
 absl::StatusOr<std::unique_ptr<LabelmeshServer>> LabelmeshServer::start(ServerConfig config) {
@@ -55,35 +73,45 @@ absl::StatusOr<std::unique_ptr<LabelmeshServer>> LabelmeshServer::start(ServerCo
   server->config_ = std::move(config);
   const ServerConfig& c = server->config_;
 
-  std::string token;
-  if (!c.auth_token_file.empty()) {
-    auto text = read_text_file(c.auth_token_file, "auth-token-file");
-    if (!text.ok()) return text.status();
-    token = std::string(absl::StripAsciiWhitespace(*text));
-    if (token.size() < 16) {
-      return absl::InvalidArgumentError(
-          "--auth-token-file: the token must be 16 characters or more");
-    }
-  }
+  auto authenticator = ClientAuthenticator::from_config(c);
+  if (!authenticator.ok()) return authenticator.status();
+  server->authenticator_ = std::move(*authenticator);
   auto creds = credentials(c);
   if (!creds.ok()) return creds.status();
 
   server->metrics_ = std::make_unique<Metrics>(c.queue_capacity);
   if (!c.metrics_listen.empty()) {
-    if (auto status = server->metrics_->expose(c.metrics_listen); !status.ok()) return status;
+    // Behind tokens, /metrics asks for an admin's name and token (basic auth).
+    Metrics::BasicAuth authorize;
+    if (server->authenticator_->has_tokens()) {
+      authorize = [a = server->authenticator_.get()](const std::string& user,
+                                                     const std::string& password) {
+        return a->is_admin_token(user, password);
+      };
+    }
+    if (auto status = server->metrics_->expose(c.metrics_listen, std::move(authorize));
+        !status.ok())
+      return status;
   }
   auto spool = Spool::open(c.spool_dir);
   if (!spool.ok()) return spool.status();
   server->spool_ = std::make_unique<Spool>(std::move(*spool));
   kill_stale_workers(server->spool_->root());
+  auto audit =
+      AuditLog::open(c.audit_log.empty() ? server->spool_->root() + "/audit.log" : c.audit_log);
+  if (!audit.ok()) return audit.status();
+  server->audit_ = std::move(*audit);
   server->table_ = std::make_unique<JobTable>(*server->spool_, c.queue_capacity, *server->metrics_);
   server->table_->recover(c.result_ttl);
-  server->service_ = std::make_unique<MeshingService>(*server->table_, *server->spool_, c,
-                                                      *server->metrics_, std::move(token));
+  server->service_ =
+      std::make_unique<MeshingService>(*server->table_, *server->spool_, c, *server->metrics_,
+                                       *server->authenticator_, *server->audit_);
 
   grpc::EnableDefaultHealthCheckService(true);
-  grpc::reflection::InitProtoReflectionServerBuilderPlugin();
   grpc::ServerBuilder builder;
+  // Reflection cannot check a caller: it is served only where every caller
+  // is anonymous anyway. Health says only SERVING or not, for probes.
+  builder.SetOption(std::make_unique<ReflectionOption>(server->authenticator_->anonymous()));
   builder.AddListeningPort(c.listen, *creds, &server->port_);
   builder.RegisterService(server->service_.get());
   builder.SetMaxReceiveMessageSize(c.max_message_bytes);
@@ -97,9 +125,12 @@ absl::StatusOr<std::unique_ptr<LabelmeshServer>> LabelmeshServer::start(ServerCo
   server->check_spool_space();
   server->housekeeper_ = std::thread([s = server.get()] { s->housekeeping_loop(); });
   spdlog::info(
-      "labelmeshd listening on {} (port {}), {} workers, queue capacity {}, TLS {}, auth {}",
+      "labelmeshd listening on {} (port {}), {} workers, queue capacity {}, TLS {}, clients {}",
       c.listen, server->port_, c.workers, c.queue_capacity, c.tls() ? "on" : "off",
-      c.auth_token_file.empty() ? "off" : "on");
+      !c.clients_file.empty()      ? "by token from the clients file"
+      : !c.auth_token_file.empty() ? "by one shared token"
+      : !c.client_ca.empty()       ? "by certificate"
+                                   : "anonymous");
   return server;
 }
 
@@ -124,7 +155,9 @@ void LabelmeshServer::housekeeping_loop() {
       std::min(absl::ToChronoMilliseconds(config_.result_ttl), std::chrono::milliseconds(2'000));
   std::unique_lock lock(mutex_);
   while (!stopping_.wait_for(lock, period, [this] { return stopped_; })) {
-    table_->expire(config_.result_ttl, size_t(config_.max_ended_jobs));
+    for (const auto& id : table_->expire(config_.result_ttl, size_t(config_.max_ended_jobs))) {
+      audit_->record({.event = "expired", .job_id = id, .identity = "labelmeshd"});
+    }
     check_spool_space();
   }
 }

@@ -17,6 +17,8 @@ class Server;
 
 namespace labelmesh::server {
 
+class AuditLog;
+class ClientAuthenticator;
 class JobTable;
 class MeshingService;
 class Metrics;
@@ -47,6 +49,8 @@ class LabelmeshServer {
   void check_spool_space();
 
   ServerConfig config_;
+  std::unique_ptr<ClientAuthenticator> authenticator_;
+  std::unique_ptr<AuditLog> audit_;
   std::unique_ptr<Metrics> metrics_;
   std::unique_ptr<Spool> spool_;
   std::unique_ptr<JobTable> table_;

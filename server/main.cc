@@ -108,11 +108,32 @@ void add_server_flags(CLI::App& app, ServerConfig& c) {
                      "PEM CA: require client certificates it signed (mutual TLS)"),
       "LABELMESHD_CLIENT_CA");
   env(app.add_option("--auth-token-file", c.auth_token_file,
-                     "File holding the bearer token every call must present"),
+                     "File holding one bearer token shared by all clients (identity 'token')"),
       "LABELMESHD_AUTH_TOKEN_FILE");
+  env(app.add_option("--clients-file", c.clients_file,
+                     "Client identities, one 'NAME TOKEN [admin]' per line; each client sees "
+                     "only its own jobs, admins see all"),
+      "LABELMESHD_CLIENTS_FILE");
+  env(app.add_option("--admin-identity", c.admin_identities,
+                     "An identity (token name or client certificate CN) that sees every job; "
+                     "repeatable")
+          ->delimiter(','),
+      "LABELMESHD_ADMIN_IDENTITY");
   env(app.add_flag("--insecure", c.insecure,
                    "Allow a non-loopback --listen without TLS (trusted networks only)"),
       "LABELMESHD_INSECURE");
+  env(app.add_flag("--allow-anonymous", c.allow_anonymous,
+                   "Serve a non-loopback --listen or --metrics-listen without client "
+                   "authentication (trusted networks only)"),
+      "LABELMESHD_ALLOW_ANONYMOUS");
+  env(app.add_option("--auth-failures-before-backoff", c.auth_failures_before_backoff,
+                     "Failed authentications in a row after which a host is refused for a while")
+          ->capture_default_str(),
+      "LABELMESHD_AUTH_FAILURES_BEFORE_BACKOFF");
+  env(app.add_option("--audit-log", c.audit_log,
+                     "JSON lines, one per accepted, refused, deleted and expired job "
+                     "(default: audit.log in the spool)"),
+      "LABELMESHD_AUDIT_LOG");
 }
 
 // SIGTERM and SIGINT: blocked in every thread, then taken with sigwait by the

@@ -8,6 +8,7 @@
 #include "absl/strings/str_cat.h"
 #include "core/pipeline/job_options.h"
 #include "server/durable_file.h"
+#include "server/error_details.h"
 #include "server/sha256.h"
 #include "server/upload_checks.h"
 #include "spdlog/spdlog.h"
@@ -17,12 +18,30 @@ namespace {
 
 constexpr size_t kChunkBytes = 1 << 20;
 
-grpc::Status to_grpc(const absl::Status& status) {
-  return grpc::Status(static_cast<grpc::StatusCode>(status.code()), std::string(status.message()));
+grpc::Status invalid(const std::string& message) {
+  return to_grpc(absl::InvalidArgumentError(message));
 }
 
-grpc::Status invalid(const std::string& message) {
-  return grpc::Status(grpc::StatusCode::INVALID_ARGUMENT, message);
+const char* code_name(grpc::StatusCode code) {
+  static const char* const kNames[] = {"OK",
+                                       "CANCELLED",
+                                       "UNKNOWN",
+                                       "INVALID_ARGUMENT",
+                                       "DEADLINE_EXCEEDED",
+                                       "NOT_FOUND",
+                                       "ALREADY_EXISTS",
+                                       "PERMISSION_DENIED",
+                                       "RESOURCE_EXHAUSTED",
+                                       "FAILED_PRECONDITION",
+                                       "ABORTED",
+                                       "OUT_OF_RANGE",
+                                       "UNIMPLEMENTED",
+                                       "INTERNAL",
+                                       "UNAVAILABLE",
+                                       "DATA_LOSS",
+                                       "UNAUTHENTICATED"};
+  const int index = static_cast<int>(code);
+  return index >= 0 && index <= 16 ? kNames[index] : "UNKNOWN";
 }
 
 // An unknown or malformed id is NOT_FOUND; only well-formed ids reach paths.
@@ -52,6 +71,29 @@ class UploadSlot {
   bool acquired_;
 };
 
+// Holds a (owner, request_id) among the submits in progress.
+class RequestClaim {
+ public:
+  RequestClaim(std::mutex& mutex, std::set<std::pair<std::string, std::string>>& claims,
+               std::pair<std::string, std::string> key)
+      : mutex_(mutex), claims_(claims), key_(std::move(key)) {
+    std::lock_guard lock(mutex_);
+    claimed_ = key_.second.empty() || claims_.insert(key_).second;
+  }
+  ~RequestClaim() {
+    if (!claimed_ || key_.second.empty()) return;
+    std::lock_guard lock(mutex_);
+    claims_.erase(key_);
+  }
+  bool claimed() const { return claimed_; }
+
+ private:
+  std::mutex& mutex_;
+  std::set<std::pair<std::string, std::string>>& claims_;
+  std::pair<std::string, std::string> key_;
+  bool claimed_ = false;
+};
+
 // Deletes the upload file unless it was handed to a job.
 class UploadFile {
  public:
@@ -71,12 +113,14 @@ class UploadFile {
 }  // namespace
 
 MeshingService::MeshingService(JobTable& table, const Spool& spool, const ServerConfig& config,
-                               Metrics& metrics, std::string token)
+                               Metrics& metrics, ClientAuthenticator& authenticator,
+                               AuditLog& audit)
     : table_(table),
       spool_(spool),
       config_(config),
       metrics_(metrics),
-      token_(std::move(token)),
+      authenticator_(authenticator),
+      audit_(audit),
       streams_(config.max_streams_per_client, config.max_streams) {}
 
 absl::StatusOr<std::unique_ptr<StreamCounts::Slot>> MeshingService::open_stream(
@@ -86,20 +130,28 @@ absl::StatusOr<std::unique_ptr<StreamCounts::Slot>> MeshingService::open_stream(
   return slot;
 }
 
-grpc::Status MeshingService::authenticate(const grpc::ServerContext& context) {
-  if (token_.empty()) return grpc::Status::OK;
-  const auto& metadata = context.client_metadata();
-  auto it = metadata.find("authorization");
-  std::string presented;
-  if (it != metadata.end()) presented.assign(it->second.data(), it->second.size());
-  const std::string scheme = "Bearer ";
-  const bool ok =
-      presented.compare(0, scheme.size(), scheme) == 0 &&
-      digest::constant_time_equal(std::string_view(presented).substr(scheme.size()), token_);
-  if (ok) return grpc::Status::OK;
-  metrics_.rejected("unauthenticated");
-  return grpc::Status(grpc::StatusCode::UNAUTHENTICATED,
-                      "missing or wrong bearer token (metadata 'authorization: Bearer <token>')");
+absl::StatusOr<ClientIdentity> MeshingService::identify(const grpc::ServerContext& context,
+                                                        const char* call) {
+  auto identity = authenticator_.identify(context);
+  if (identity.ok()) return identity;
+  const bool backed_off = identity.status().code() == absl::StatusCode::kResourceExhausted;
+  metrics_.rejected(backed_off ? "auth_backoff" : "unauthenticated");
+  audit_.record({.event = "unauthenticated",
+                 .peer = peer_host(context.peer()),
+                 .call = call,
+                 .code = code_name(static_cast<grpc::StatusCode>(identity.status().code())),
+                 .reason = backed_off ? "auth_backoff" : "bad_credentials"});
+  return identity;
+}
+
+grpc::Status MeshingService::authorize(const ClientIdentity& identity,
+                                       const std::string& job_id) const {
+  if (auto status = check_job_id(job_id); !status.ok()) return status;
+  auto owner = table_.owner(job_id);
+  if (!owner.ok() || (!identity.admin && *owner != identity.name)) {
+    return grpc::Status(grpc::StatusCode::NOT_FOUND, absl::StrCat("no job ", job_id));
+  }
+  return grpc::Status::OK;
 }
 
 absl::Status MeshingService::check_spool_space(uint64_t upload_bytes) const {
@@ -116,15 +168,14 @@ absl::Status MeshingService::check_spool_space(uint64_t upload_bytes) const {
 
 grpc::Status MeshingService::receive_upload(grpc::ServerReader<v1::SubmitRequest>& reader,
                                             const v1::JobSpec& spec, const std::string& path,
-                                            StreamWatchdog::Ticket& ticket) {
+                                            StreamWatchdog::Ticket& ticket, std::string& reason) {
   // Each refusal is counted here, by its reason, and only here.
-  auto refuse = [this](const char* reason, const std::string& message) {
-    metrics_.rejected(reason);
+  auto refuse = [&](const char* why, const std::string& message) {
+    reason = why;
     return invalid(message);
   };
-  auto spool_failed = [this](const absl::Status& status) {
-    metrics_.rejected(status.code() == absl::StatusCode::kResourceExhausted ? "disk_full"
-                                                                            : "spool_error");
+  auto spool_failed = [&](const absl::Status& status) {
+    reason = status.code() == absl::StatusCode::kResourceExhausted ? "disk_full" : "spool_error";
     return to_grpc(status);
   };
   FileWriter out;
@@ -147,9 +198,9 @@ grpc::Status MeshingService::receive_upload(grpc::ServerReader<v1::SubmitRequest
     hash.update(chunk);
     received += chunk.size();
   }
-  if (const std::string reason = ticket.cancelled_because(); !reason.empty()) {
-    metrics_.rejected("stalled");
-    return grpc::Status(grpc::StatusCode::DEADLINE_EXCEEDED, reason);
+  if (const std::string stalled = ticket.cancelled_because(); !stalled.empty()) {
+    reason = "stalled";
+    return grpc::Status(grpc::StatusCode::DEADLINE_EXCEEDED, stalled);
   }
   if (auto status = out.finish(); !status.ok()) return spool_failed(status);
   if (received < spec.size_bytes()) {
@@ -159,47 +210,95 @@ grpc::Status MeshingService::receive_upload(grpc::ServerReader<v1::SubmitRequest
   if (hash.hex_digest() != spec.sha256()) {
     return refuse("bad_digest", "upload: SHA-256 of the bytes received does not match spec.sha256");
   }
-  metrics_.upload_bytes(received);
   return grpc::Status::OK;
 }
 
 grpc::Status MeshingService::Submit(grpc::ServerContext* context,
                                     grpc::ServerReader<v1::SubmitRequest>* reader,
                                     v1::SubmitReply* reply) {
-  if (auto status = authenticate(*context); !status.ok()) return status;
-  if (!accepting_)
+  auto identity = identify(*context, "Submit");
+  if (!identity.ok()) return to_grpc(identity.status());
+  std::string reason;
+  const grpc::Status status = submit(*context, *reader, *identity, *reply, reason);
+  AuditEntry entry{.job_id = reply->job_id(),
+                   .identity = identity->name,
+                   .peer = peer_host(context->peer()),
+                   .call = "Submit"};
+  if (status.ok()) {
+    entry.event = "accepted";
+    if (reply->existing()) entry.reason = "repeated_request";
+  } else {
+    if (reason.empty()) reason = "refused";
+    metrics_.rejected(reason);
+    entry.event = "refused";
+    entry.code = code_name(status.error_code());
+    entry.reason = reason;
+  }
+  audit_.record(entry);
+  return status;
+}
+
+grpc::Status MeshingService::submit(grpc::ServerContext& context,
+                                    grpc::ServerReader<v1::SubmitRequest>& reader,
+                                    const ClientIdentity& identity, v1::SubmitReply& reply,
+                                    std::string& reason) {
+  if (!accepting_) {
+    reason = "shutting_down";
     return grpc::Status(grpc::StatusCode::UNAVAILABLE, "the server is shutting down");
-  auto stream = open_stream(*context);
-  if (!stream.ok()) return to_grpc(stream.status());
+  }
+  auto stream = streams_.open(context.peer());
+  if (!stream.ok()) {
+    reason = "too_many_streams";
+    return to_grpc(stream.status());
+  }
   // The spec is the first step: a client that sends nothing is dropped too.
   auto ticket =
-      watchdog_.watch(context, config_.stream_idle_timeout, config_.transfer_deadline, "upload");
+      watchdog_.watch(&context, config_.stream_idle_timeout, config_.transfer_deadline, "upload");
   UploadSlot slot(uploads_, config_.max_concurrent_uploads);
   if (!slot.acquired()) {
-    metrics_.rejected("too_many_uploads");
+    reason = "too_many_uploads";
     return grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED,
                         absl::StrCat("too many uploads at once (limit ",
                                      config_.max_concurrent_uploads, "); try again later"));
   }
   v1::SubmitRequest first;
-  if (!reader->Read(&first) || !first.has_spec()) {
-    metrics_.rejected("bad_request");
+  if (!reader.Read(&first) || !first.has_spec()) {
+    reason = ticket->cancelled_because().empty() ? "bad_request" : "stalled";
     return stalled_or(*ticket, invalid("the first message must hold the job spec"));
   }
   ticket->touch();
   v1::JobSpec spec = first.spec();
   if (auto status = check_spec(spec, config_); !status.ok()) {
-    metrics_.rejected(absl::StartsWith(status.message(), "spec.size_bytes") ? "too_large"
-                                                                            : "bad_request");
+    reason = absl::StartsWith(status.message(), "spec.size_bytes") ? "too_large" : "bad_request";
     return to_grpc(status);
   }
+  // A retried Submit gets the job its first try made.
+  RequestClaim claim(requests_mutex_, requests_in_flight_, {identity.name, spec.request_id()});
+  if (!claim.claimed()) {
+    reason = "request_in_progress";
+    return grpc::Status(grpc::StatusCode::ABORTED,
+                        "a Submit with this request_id is still in progress; retry later");
+  }
+  if (!spec.request_id().empty()) {
+    if (auto prior = table_.find_request(identity.name, spec.request_id())) {
+      if (prior->sha256 != spec.sha256()) {
+        reason = "request_id_reused";
+        return grpc::Status(grpc::StatusCode::ALREADY_EXISTS,
+                            "spec.request_id: already used for an upload with another sha256");
+      }
+      reply.set_job_id(prior->job_id);
+      reply.set_queue_position(prior->queue_position);
+      reply.set_existing(true);
+      return grpc::Status::OK;
+    }
+  }
   if (table_.queue_full()) {
-    metrics_.rejected("queue_full");
+    reason = "queue_full";
     return grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED,
                         "the job queue is full; try again later");
   }
   if (auto status = check_spool_space(spec.size_bytes()); !status.ok()) {
-    metrics_.rejected("disk_full");
+    reason = "disk_full";
     return to_grpc(status);
   }
   // The job's voxel limit is the smaller of the client's and the server's.
@@ -216,15 +315,15 @@ grpc::Status MeshingService::Submit(grpc::ServerContext* context,
   const std::string job_id = new_job_id();
   const std::string extension = *upload_extension(spec.file_name());
   UploadFile upload(spool_.upload_path(job_id, extension));
-  if (auto status = receive_upload(*reader, spec, upload.path(), *ticket); !status.ok())
+  if (auto status = receive_upload(reader, spec, upload.path(), *ticket, reason); !status.ok())
     return status;
   auto geometry = check_uploaded_volume(upload.path(), voxel_limit, config_.worker_memory_bytes);
   if (!geometry.ok()) {
-    metrics_.rejected("bad_volume");
+    reason = "bad_volume";
     return to_grpc(geometry.status());
   }
   if (auto status = check_sizing_for_grid(params.poisson, *geometry); !status.ok()) {
-    metrics_.rejected("bad_request");
+    reason = "bad_request";
     return invalid(absl::StrCat("spec.options: ", status.message()));
   }
 
@@ -232,6 +331,7 @@ grpc::Status MeshingService::Submit(grpc::ServerContext* context,
   v1::Job& job = *record.mutable_job();
   job.set_job_id(job_id);
   job.set_created_at(unix_now());
+  job.set_owner(identity.name);
   *job.mutable_options() = spec.options();
   // Only the extension of the client's file name is kept: names can hold
   // patient identifiers.
@@ -241,22 +341,23 @@ grpc::Status MeshingService::Submit(grpc::ServerContext* context,
   auto position = table_.accept(std::move(record), upload.path());
   if (!position.ok()) {
     if (position.status().code() == absl::StatusCode::kResourceExhausted) {
-      metrics_.rejected(absl::StartsWith(position.status().message(), "spool disk full")
-                            ? "disk_full"
-                            : "queue_full");
+      reason = absl::StartsWith(position.status().message(), "spool disk full") ? "disk_full"
+                                                                                : "queue_full";
     }
     return to_grpc(position.status());
   }
   upload.keep();
-  reply->set_job_id(job_id);
-  reply->set_queue_position(*position);
+  reply.set_job_id(job_id);
+  reply.set_queue_position(*position);
+  metrics_.upload_bytes(spec.size_bytes());
   return grpc::Status::OK;
 }
 
 grpc::Status MeshingService::Watch(grpc::ServerContext* context, const v1::WatchRequest* request,
                                    grpc::ServerWriter<v1::JobEvent>* writer) {
-  if (auto status = authenticate(*context); !status.ok()) return status;
-  if (auto status = check_job_id(request->job_id()); !status.ok()) return status;
+  auto identity = identify(*context, "Watch");
+  if (!identity.ok()) return to_grpc(identity.status());
+  if (auto status = authorize(*identity, request->job_id()); !status.ok()) return status;
   auto stream = open_stream(*context);
   if (!stream.ok()) return to_grpc(stream.status());
   // Waiting for events is progress; a write the watcher does not read is not.
@@ -280,25 +381,38 @@ grpc::Status MeshingService::Watch(grpc::ServerContext* context, const v1::Watch
 
 grpc::Status MeshingService::GetJob(grpc::ServerContext* context, const v1::GetJobRequest* request,
                                     v1::Job* reply) {
-  if (auto status = authenticate(*context); !status.ok()) return status;
-  if (auto status = check_job_id(request->job_id()); !status.ok()) return status;
+  auto identity = identify(*context, "GetJob");
+  if (!identity.ok()) return to_grpc(identity.status());
+  if (auto status = authorize(*identity, request->job_id()); !status.ok()) return status;
   auto job = table_.get(request->job_id());
   if (!job.ok()) return to_grpc(job.status());
   *reply = std::move(*job);
   return grpc::Status::OK;
 }
 
-grpc::Status MeshingService::ListJobs(grpc::ServerContext* context, const v1::ListJobsRequest*,
+grpc::Status MeshingService::ListJobs(grpc::ServerContext* context,
+                                      const v1::ListJobsRequest* request,
                                       v1::ListJobsReply* reply) {
-  if (auto status = authenticate(*context); !status.ok()) return status;
-  for (auto& job : table_.list()) *reply->add_jobs() = std::move(job);
+  auto identity = identify(*context, "ListJobs");
+  if (!identity.ok()) return to_grpc(identity.status());
+  if (request->page_size() > 1000) return invalid("page_size: must be at most 1000");
+  JobTable::JobQuery query;
+  if (!identity->admin) query.owner = identity->name;
+  for (int state : request->states()) query.states.push_back(static_cast<v1::JobState>(state));
+  query.page_size = request->page_size() == 0 ? 100 : request->page_size();
+  query.page_token = request->page_token();
+  auto page = table_.list(query);
+  if (!page.ok()) return to_grpc(page.status());
+  for (auto& job : page->jobs) *reply->add_jobs() = std::move(job);
+  reply->set_next_page_token(page->next_page_token);
   return grpc::Status::OK;
 }
 
 grpc::Status MeshingService::Cancel(grpc::ServerContext* context, const v1::CancelRequest* request,
                                     v1::Job* reply) {
-  if (auto status = authenticate(*context); !status.ok()) return status;
-  if (auto status = check_job_id(request->job_id()); !status.ok()) return status;
+  auto identity = identify(*context, "Cancel");
+  if (!identity.ok()) return to_grpc(identity.status());
+  if (auto status = authorize(*identity, request->job_id()); !status.ok()) return status;
   auto job = table_.cancel(request->job_id());
   if (!job.ok()) return to_grpc(job.status());
   *reply = std::move(*job);
@@ -308,8 +422,9 @@ grpc::Status MeshingService::Cancel(grpc::ServerContext* context, const v1::Canc
 grpc::Status MeshingService::ListArtifacts(grpc::ServerContext* context,
                                            const v1::ListArtifactsRequest* request,
                                            v1::ListArtifactsReply* reply) {
-  if (auto status = authenticate(*context); !status.ok()) return status;
-  if (auto status = check_job_id(request->job_id()); !status.ok()) return status;
+  auto identity = identify(*context, "ListArtifacts");
+  if (!identity.ok()) return to_grpc(identity.status());
+  if (auto status = authorize(*identity, request->job_id()); !status.ok()) return status;
   auto artifacts = table_.artifacts(request->job_id());
   if (!artifacts.ok()) return to_grpc(artifacts.status());
   for (auto& artifact : *artifacts) *reply->add_artifacts() = std::move(artifact);
@@ -318,8 +433,9 @@ grpc::Status MeshingService::ListArtifacts(grpc::ServerContext* context,
 
 grpc::Status MeshingService::Fetch(grpc::ServerContext* context, const v1::FetchRequest* request,
                                    grpc::ServerWriter<v1::FetchChunk>* writer) {
-  if (auto status = authenticate(*context); !status.ok()) return status;
-  if (auto status = check_job_id(request->job_id()); !status.ok()) return status;
+  auto identity = identify(*context, "Fetch");
+  if (!identity.ok()) return to_grpc(identity.status());
+  if (auto status = authorize(*identity, request->job_id()); !status.ok()) return status;
   auto artifacts = table_.artifacts(request->job_id());
   if (!artifacts.ok()) return to_grpc(artifacts.status());
   // Only names the job recorded are served: nothing else in the spool is reachable.
@@ -349,6 +465,23 @@ grpc::Status MeshingService::Fetch(grpc::ServerContext* context, const v1::Fetch
     ticket->touch();
     chunk.clear_artifact();
   } while (in);
+  return grpc::Status::OK;
+}
+
+grpc::Status MeshingService::DeleteJob(grpc::ServerContext* context,
+                                       const v1::DeleteJobRequest* request,
+                                       v1::DeleteJobReply* reply) {
+  auto identity = identify(*context, "DeleteJob");
+  if (!identity.ok()) return to_grpc(identity.status());
+  if (auto status = authorize(*identity, request->job_id()); !status.ok()) return status;
+  auto state = table_.remove(request->job_id());
+  if (!state.ok()) return to_grpc(state.status());
+  audit_.record({.event = "deleted",
+                 .job_id = request->job_id(),
+                 .identity = identity->name,
+                 .peer = peer_host(context->peer()),
+                 .call = "DeleteJob"});
+  reply->set_state(*state);
   return grpc::Status::OK;
 }
 

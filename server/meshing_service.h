@@ -4,9 +4,13 @@
 #pragma once
 
 #include <atomic>
+#include <mutex>
+#include <set>
 #include <string>
 
 #include "labelmesh/v1/service.grpc.pb.h"
+#include "server/audit_log.h"
+#include "server/client_identity.h"
 #include "server/job_table.h"
 #include "server/metrics.h"
 #include "server/server_config.h"
@@ -17,9 +21,8 @@ namespace labelmesh::server {
 
 class MeshingService final : public v1::MeshingService::Service {
  public:
-  // `token` empty: no authentication.
   MeshingService(JobTable& table, const Spool& spool, const ServerConfig& config, Metrics& metrics,
-                 std::string token);
+                 ClientAuthenticator& authenticator, AuditLog& audit);
 
   // Refuses new uploads (UNAVAILABLE) from now on.
   void stop_accepting() { accepting_ = false; }
@@ -38,12 +41,21 @@ class MeshingService final : public v1::MeshingService::Service {
                              v1::ListArtifactsReply* reply) override;
   grpc::Status Fetch(grpc::ServerContext* context, const v1::FetchRequest* request,
                      grpc::ServerWriter<v1::FetchChunk>* writer) override;
+  grpc::Status DeleteJob(grpc::ServerContext* context, const v1::DeleteJobRequest* request,
+                         v1::DeleteJobReply* reply) override;
 
  private:
-  grpc::Status authenticate(const grpc::ServerContext& context);
+  // The caller's identity; a failure is counted and audited.
+  absl::StatusOr<ClientIdentity> identify(const grpc::ServerContext& context, const char* call);
+  // NOT_FOUND unless the id is well formed, the job exists and the caller
+  // owns it or is an admin: other clients' jobs are not even named.
+  grpc::Status authorize(const ClientIdentity& identity, const std::string& job_id) const;
+  // Submit without its audit line; `reason` says why it refused.
+  grpc::Status submit(grpc::ServerContext& context, grpc::ServerReader<v1::SubmitRequest>& reader,
+                      const ClientIdentity& identity, v1::SubmitReply& reply, std::string& reason);
   grpc::Status receive_upload(grpc::ServerReader<v1::SubmitRequest>& reader,
                               const v1::JobSpec& spec, const std::string& path,
-                              StreamWatchdog::Ticket& ticket);
+                              StreamWatchdog::Ticket& ticket, std::string& reason);
   // A place among the client's streams, or RESOURCE_EXHAUSTED (counted).
   absl::StatusOr<std::unique_ptr<StreamCounts::Slot>> open_stream(
       const grpc::ServerContext& context);
@@ -55,7 +67,12 @@ class MeshingService final : public v1::MeshingService::Service {
   const Spool& spool_;
   const ServerConfig& config_;
   Metrics& metrics_;
-  const std::string token_;
+  ClientAuthenticator& authenticator_;
+  AuditLog& audit_;
+  // Submits in progress by (owner, request_id), so that a retry that races
+  // its first try waits instead of making a second job.
+  std::mutex requests_mutex_;
+  std::set<std::pair<std::string, std::string>> requests_in_flight_;
   std::atomic<bool> accepting_{true};
   std::atomic<int> uploads_{0};
   StreamCounts streams_;

@@ -93,7 +93,7 @@ Metrics::Metrics(int queue_capacity) : registry_(std::make_shared<prometheus::Re
 
 Metrics::~Metrics() = default;
 
-absl::Status Metrics::expose(const std::string& address) {
+absl::Status Metrics::expose(const std::string& address, BasicAuth authorize) {
   try {
     static CivetCallbacks callbacks = [] {
       CivetCallbacks c{};
@@ -108,8 +108,15 @@ absl::Status Metrics::expose(const std::string& address) {
     return absl::InvalidArgumentError(
         absl::StrCat("--metrics-listen: cannot serve on ", address, ": ", e.what()));
   }
+  if (authorize) exposer_->RegisterAuth(std::move(authorize), "labelmesh metrics");
   exposer_->RegisterCollectable(registry_);
   return absl::OkStatus();
+}
+
+int Metrics::port() const {
+  if (!exposer_) return 0;
+  const auto ports = exposer_->GetListeningPorts();
+  return ports.empty() ? 0 : ports.front();
 }
 
 std::string Metrics::text() const {

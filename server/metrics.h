@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 
@@ -20,8 +21,13 @@ class Metrics {
   explicit Metrics(int queue_capacity);
   ~Metrics();
 
-  // Serves /metrics on `address`. Errors: INVALID_ARGUMENT when it cannot bind.
-  absl::Status expose(const std::string& address);
+  // Checks an HTTP basic-auth user and password.
+  using BasicAuth = std::function<bool(const std::string& user, const std::string& password)>;
+  // Serves /metrics on `address`, behind basic authentication when
+  // `authorize` is set. Errors: INVALID_ARGUMENT when it cannot bind.
+  absl::Status expose(const std::string& address, BasicAuth authorize = nullptr);
+  // The port /metrics is served on (0 before expose()).
+  int port() const;
   // The text exposition format of every metric (what /metrics returns).
   std::string text() const;
 

@@ -1,21 +1,37 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 #include "server/server_config.h"
 
+#include <arpa/inet.h>
+#include <netinet/in.h>
+
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
+#include "absl/strings/strip.h"
 
 namespace labelmesh::server {
 
 bool is_loopback_address(const std::string& address) {
   if (absl::StartsWith(address, "unix:")) return true;
-  std::string host = address;
-  if (absl::StartsWith(host, "ipv4:")) host = host.substr(5);
-  if (absl::StartsWith(host, "ipv6:")) host = host.substr(5);
-  if (absl::StartsWith(host, "[")) {
-    return absl::StartsWith(host, "[::1]");
+  absl::string_view rest = address;
+  if (!absl::ConsumePrefix(&rest, "ipv4:")) absl::ConsumePrefix(&rest, "ipv6:");
+  std::string host;
+  if (absl::ConsumePrefix(&rest, "[")) {
+    const size_t close = rest.find(']');
+    if (close == absl::string_view::npos) return false;
+    host = std::string(rest.substr(0, close));
+  } else {
+    const size_t colon = rest.rfind(':');
+    host = std::string(rest.substr(0, colon));
   }
-  host = host.substr(0, host.rfind(':'));
-  return host == "localhost" || absl::StartsWith(host, "127.");
+  if (host == "localhost") return true;
+  in_addr v4{};
+  if (inet_pton(AF_INET, host.c_str(), &v4) == 1) return (ntohl(v4.s_addr) >> 24) == 127;
+  in6_addr v6{};
+  if (inet_pton(AF_INET6, host.c_str(), &v6) == 1) {
+    if (IN6_IS_ADDR_LOOPBACK(&v6)) return true;
+    return IN6_IS_ADDR_V4MAPPED(&v6) && v6.s6_addr[12] == 127;
+  }
+  return false;
 }
 
 absl::Status validate_config(const ServerConfig& c) {
@@ -48,6 +64,22 @@ absl::Status validate_config(const ServerConfig& c) {
   if (!c.tls() && !c.insecure && !is_loopback_address(c.listen)) {
     return bad("listen", "a non-loopback address needs TLS (--tls-cert, --tls-key) or --insecure");
   }
+  if (!c.authenticates_clients() && !c.allow_anonymous && !is_loopback_address(c.listen)) {
+    return bad("listen",
+               "a non-loopback address needs client authentication (--clients-file, "
+               "--auth-token-file or --client-ca) or --allow-anonymous");
+  }
+  const bool metrics_authenticated = !c.auth_token_file.empty() || !c.clients_file.empty();
+  if (!c.metrics_listen.empty() && !metrics_authenticated && !c.allow_anonymous &&
+      !is_loopback_address(c.metrics_listen)) {
+    return bad("metrics-listen",
+               "a non-loopback address needs admin tokens (--clients-file or --auth-token-file) "
+               "for its basic authentication, or --allow-anonymous");
+  }
+  if (c.auth_failures_before_backoff < 1)
+    return bad("auth-failures-before-backoff", "must be at least 1");
+  if (c.auth_first_backoff <= absl::ZeroDuration() || c.auth_longest_backoff < c.auth_first_backoff)
+    return bad("auth-first-backoff", "must be positive and at most --auth-longest-backoff");
   return absl::OkStatus();
 }
 

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include "absl/status/status.h"
 #include "absl/time/time.h"
@@ -56,23 +57,46 @@ struct ServerConfig {
   std::string tls_key;
   // Requires clients to present a certificate signed by this CA (mutual TLS).
   std::string client_ca;
-  // One line holding the bearer token every call must carry.
+  // One line holding a bearer token shared by all clients (identity "token").
   std::string auth_token_file;
+  // One client per line, `NAME TOKEN [admin]`: each client its own token.
+  std::string clients_file;
+  // Identities (token names or client certificate common names) that may see
+  // and act on every client's jobs.
+  std::vector<std::string> admin_identities;
   // Allow a non-loopback listen address without TLS.
   bool insecure = false;
+  // Serve a non-loopback address (gRPC or metrics) without client
+  // authentication.
+  bool allow_anonymous = false;
+  // A host that fails authentication this many times in a row is refused for
+  // `auth_first_backoff`, doubling with each further failure.
+  int auth_failures_before_backoff = 5;
+  absl::Duration auth_first_backoff = absl::Seconds(1);
+  absl::Duration auth_longest_backoff = absl::Minutes(5);
+  // JSON lines, one per accepted, refused and deleted job; empty for
+  // <spool>/audit.log.
+  std::string audit_log;
 
   // The worker started as `<it> --worker JOB_DIR`; empty for labelmesh-worker
   // beside this process's own executable. Its --version must match ours.
   std::string worker_executable;
 
   bool tls() const { return !tls_cert.empty(); }
+  // Clients prove who they are: tokens or client certificates.
+  bool authenticates_clients() const {
+    return !auth_token_file.empty() || !clients_file.empty() || !client_ca.empty();
+  }
 };
 
-// INVALID_ARGUMENT naming the flag at fault: ranges, TLS files in pairs, and a
-// non-loopback address without TLS or --insecure.
+// INVALID_ARGUMENT naming the flag at fault: ranges, TLS files in pairs, a
+// non-loopback address without TLS or --insecure, and a non-loopback address
+// (gRPC or metrics) without client authentication or --allow-anonymous.
 absl::Status validate_config(const ServerConfig& config);
 
-// True for 127.0.0.0/8, ::1, localhost and unix: addresses.
+// True for addresses whose host is 127.0.0.0/8, ::1 (also as
+// ::ffff:127.x.y.z) or `localhost`, and for unix: sockets. Accepts
+// host:port, [v6]:port and gRPC's ipv4:/ipv6: prefixes.
 bool is_loopback_address(const std::string& address);
 
 }  // namespace labelmesh::server

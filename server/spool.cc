@@ -141,6 +141,11 @@ void Spool::remove_job(const std::string& job_id) const {
   fs::remove_all(job_dir(job_id), error);
 }
 
+void Spool::remove_input(const v1::JobRecord& record) const {
+  std::error_code error;
+  fs::remove(input_path(record), error);
+}
+
 absl::Status Spool::reset_output(const std::string& job_id) const {
   std::error_code error;
   fs::remove_all(output_dir(job_id), error);

@@ -4,7 +4,8 @@
 //
 //   <root>/uploads/<id><ext>      an upload being received (wiped at start)
 //   <root>/jobs/<id>/job.pb       the JobRecord, replaced atomically
-//   <root>/jobs/<id>/input<ext>   the uploaded volume
+//   <root>/jobs/<id>/input<ext>   the uploaded volume, until the job ends
+//                                 (unless the client asked to keep it)
 //   <root>/jobs/<id>/out/         meshes and report.json of the last attempt
 //   <root>/jobs/<id>/worker.log   the worker's stderr
 //   <root>/quarantine/            job directories whose record could not be
@@ -42,6 +43,8 @@ class Spool {
   // accepted) is removed; one whose record is unreadable is quarantined.
   std::vector<v1::JobRecord> load_all() const;
   void remove_job(const std::string& job_id) const;
+  // Deletes the job's input (once it ended, unless the client kept it).
+  void remove_input(const v1::JobRecord& record) const;
   // Empties out/ before an attempt.
   absl::Status reset_output(const std::string& job_id) const;
   // Every regular file under out/, with size and SHA-256, sorted by name.

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 #include "server/upload_checks.h"
 
+#include <algorithm>
+
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_replace.h"
@@ -34,6 +36,12 @@ absl::Status check_spec(const v1::JobSpec& spec, const ServerConfig& config) {
   }
   if (!digest::is_sha256_hex(spec.sha256())) {
     return absl::InvalidArgumentError("spec.sha256: must be 64 lowercase hex digits");
+  }
+  if (spec.request_id().size() > 128 ||
+      !std::all_of(spec.request_id().begin(), spec.request_id().end(),
+                   [](char c) { return c >= 0x21 && c <= 0x7e; })) {
+    return absl::InvalidArgumentError(
+        "spec.request_id: must be at most 128 printable ASCII characters, no spaces");
   }
   if (auto params = params_from_options(spec.options()); !params.ok()) {
     return absl::InvalidArgumentError(absl::StrCat("spec.options: ", params.status().message()));

@@ -1,0 +1,194 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+#include "server/client_identity.h"
+
+#include <fstream>
+
+#include "absl/strings/ascii.h"
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_split.h"
+#include "server/sha256.h"
+#include "server/stream_limits.h"
+
+namespace labelmesh::server {
+namespace {
+
+// Hosts remembered at most; beyond it, hosts not backed off are forgotten.
+constexpr size_t kMaxTrackedHosts = 10'000;
+
+bool is_identity_name(std::string_view name) {
+  if (name.empty() || name.size() > 64) return false;
+  for (char c : name) {
+    if (!absl::ascii_isalnum(static_cast<unsigned char>(c)) && c != '.' && c != '_' && c != '@' &&
+        c != '-')
+      return false;
+  }
+  return true;
+}
+
+bool is_token_text(std::string_view token) {
+  if (token.size() < 16 || token.size() > 256) return false;
+  for (char c : token) {
+    if (c < 0x21 || c > 0x7e) return false;
+  }
+  return true;
+}
+
+absl::StatusOr<std::string> read_single_token(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return absl::InvalidArgumentError(absl::StrCat("--auth-token-file: cannot read ", path));
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::string token(absl::StripAsciiWhitespace(text));
+  if (!is_token_text(token)) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "--auth-token-file: ", path, ": the token must be 16 to 256 printable characters"));
+  }
+  return token;
+}
+
+}  // namespace
+
+absl::StatusOr<std::vector<TokenHolder>> read_clients_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return absl::InvalidArgumentError(absl::StrCat("--clients-file: cannot read ", path));
+  std::vector<TokenHolder> holders;
+  std::set<std::string> names, tokens;
+  std::string line;
+  for (int number = 1; std::getline(in, line); ++number) {
+    auto bad = [&](const std::string& why) {
+      // Never quotes the line: it holds a secret.
+      return absl::InvalidArgumentError(
+          absl::StrCat("--clients-file: ", path, " line ", number, ": ", why));
+    };
+    absl::string_view text = absl::StripAsciiWhitespace(line);
+    if (text.empty() || text.front() == '#') continue;
+    std::vector<absl::string_view> fields = absl::StrSplit(text, ' ', absl::SkipWhitespace());
+    if (fields.size() < 2 || fields.size() > 3) return bad("expected NAME TOKEN [admin]");
+    TokenHolder holder{std::string(fields[0]), std::string(fields[1]), false};
+    if (!is_identity_name(holder.name)) return bad("the name must be 1-64 of A-Z a-z 0-9 . _ @ -");
+    if (!is_token_text(holder.token))
+      return bad("the token must be 16 to 256 printable characters");
+    if (fields.size() == 3) {
+      if (fields[2] != "admin") return bad("the third field can only be 'admin'");
+      holder.admin = true;
+    }
+    if (!names.insert(holder.name).second) return bad("a name listed twice");
+    if (!tokens.insert(holder.token).second) return bad("a token given to two clients");
+    holders.push_back(std::move(holder));
+  }
+  if (holders.empty())
+    return absl::InvalidArgumentError(absl::StrCat("--clients-file: ", path, " lists no client"));
+  return holders;
+}
+
+absl::Status AuthBackoff::check(const std::string& host, absl::Time now) {
+  std::lock_guard lock(mutex_);
+  auto it = hosts_.find(host);
+  if (it == hosts_.end() || it->second.blocked_until <= now) return absl::OkStatus();
+  return absl::ResourceExhaustedError(absl::StrCat(
+      "too many failed authentications from this host; try again in ",
+      absl::FormatDuration(absl::Ceil(it->second.blocked_until - now, absl::Seconds(1)))));
+}
+
+void AuthBackoff::failed(const std::string& host, absl::Time now) {
+  std::lock_guard lock(mutex_);
+  if (hosts_.size() >= kMaxTrackedHosts && hosts_.find(host) == hosts_.end()) {
+    std::erase_if(hosts_, [now](const auto& entry) { return entry.second.blocked_until <= now; });
+    if (hosts_.size() >= kMaxTrackedHosts) return;
+  }
+  Host& entry = hosts_[host];
+  ++entry.failures;
+  const int over = entry.failures - allowed_failures_;
+  if (over < 0) return;
+  absl::Duration backoff = first_backoff_;
+  for (int i = 0; i < over && backoff < longest_backoff_; ++i) backoff *= 2;
+  entry.blocked_until = now + std::min(backoff, longest_backoff_);
+}
+
+void AuthBackoff::succeeded(const std::string& host) {
+  std::lock_guard lock(mutex_);
+  hosts_.erase(host);
+}
+
+absl::StatusOr<std::unique_ptr<ClientAuthenticator>> ClientAuthenticator::from_config(
+    const ServerConfig& config) {
+  std::vector<TokenHolder> tokens;
+  if (!config.clients_file.empty()) {
+    auto holders = read_clients_file(config.clients_file);
+    if (!holders.ok()) return holders.status();
+    tokens = std::move(*holders);
+  }
+  if (!config.auth_token_file.empty()) {
+    auto token = read_single_token(config.auth_token_file);
+    if (!token.ok()) return token.status();
+    tokens.push_back({"token", std::move(*token), false});
+  }
+  std::set<std::string> admins(config.admin_identities.begin(), config.admin_identities.end());
+  for (const auto& holder : tokens) {
+    if (holder.admin) admins.insert(holder.name);
+  }
+  return std::unique_ptr<ClientAuthenticator>(new ClientAuthenticator(
+      std::move(tokens), !config.client_ca.empty(), std::move(admins), config));
+}
+
+ClientAuthenticator::ClientAuthenticator(std::vector<TokenHolder> tokens, bool mutual_tls,
+                                         std::set<std::string> admins, const ServerConfig& config)
+    : tokens_(std::move(tokens)),
+      mutual_tls_(mutual_tls),
+      admins_(std::move(admins)),
+      backoff_(config.auth_failures_before_backoff, config.auth_first_backoff,
+               config.auth_longest_backoff) {}
+
+const TokenHolder* ClientAuthenticator::find_token(std::string_view presented) const {
+  // Every token is compared, in constant time, so the time taken tells nothing.
+  const TokenHolder* found = nullptr;
+  for (const auto& holder : tokens_) {
+    if (digest::constant_time_equal(presented, holder.token)) found = &holder;
+  }
+  return found;
+}
+
+bool ClientAuthenticator::is_admin_token(const std::string& name, const std::string& token) const {
+  const TokenHolder* holder = find_token(token);
+  return holder != nullptr && holder->name == name && admins_.count(name) > 0;
+}
+
+absl::StatusOr<ClientIdentity> ClientAuthenticator::identify(const grpc::ServerContext& context) {
+  if (anonymous()) return ClientIdentity{kAnonymous, false};
+  const std::string host = peer_host(context.peer());
+  const absl::Time now = absl::Now();
+  if (auto status = backoff_.check(host, now); !status.ok()) return status;
+  std::string name;
+  if (has_tokens()) {
+    const auto& metadata = context.client_metadata();
+    auto it = metadata.find("authorization");
+    std::string_view presented;
+    if (it != metadata.end()) presented = std::string_view(it->second.data(), it->second.size());
+    constexpr std::string_view kScheme = "Bearer ";
+    const TokenHolder* holder = nullptr;
+    if (presented.substr(0, kScheme.size()) == kScheme) {
+      holder = find_token(presented.substr(kScheme.size()));
+    }
+    if (holder == nullptr) {
+      backoff_.failed(host, now);
+      return absl::UnauthenticatedError(
+          "missing or wrong bearer token (metadata 'authorization: Bearer <token>')");
+    }
+    name = holder->name;
+  } else {
+    // Mutual TLS: the transport verified the certificate; its CN names the client.
+    const auto auth = context.auth_context();
+    const auto names = auth ? auth->FindPropertyValues(GRPC_X509_CN_PROPERTY_NAME)
+                            : std::vector<grpc::string_ref>{};
+    if (names.empty() || !is_identity_name(std::string_view(names[0].data(), names[0].size()))) {
+      backoff_.failed(host, now);
+      return absl::UnauthenticatedError(
+          "the client certificate has no common name usable as an identity "
+          "(1-64 of A-Z a-z 0-9 . _ @ -)");
+    }
+    name.assign(names[0].data(), names[0].size());
+  }
+  backoff_.succeeded(host);
+  return ClientIdentity{name, admins_.count(name) > 0};
+}
+
+}  // namespace labelmesh::server

@@ -1,0 +1,95 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// Who a call comes from: a named client identity, from its bearer token (one
+// per client, listed in a clients file) or from its TLS client certificate's
+// common name. Jobs belong to the identity that submitted them; admins see
+// every job. Repeated failed authentication from one host is backed off.
+#pragma once
+
+#include <grpcpp/grpcpp.h>
+
+#include <map>
+#include <mutex>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "absl/time/time.h"
+#include "server/server_config.h"
+
+namespace labelmesh::server {
+
+struct ClientIdentity {
+  std::string name;
+  bool admin = false;
+};
+
+// The identity of calls on a server with no client authentication.
+inline constexpr char kAnonymous[] = "anonymous";
+
+struct TokenHolder {
+  std::string name;
+  std::string token;
+  bool admin = false;
+};
+
+// A clients file: one `NAME TOKEN [admin]` per line, `#` comments and blank
+// lines ignored. Names are 1-64 of [A-Za-z0-9._@-], tokens 16-256 printable
+// characters; both unique. Errors name the file and line.
+absl::StatusOr<std::vector<TokenHolder>> read_clients_file(const std::string& path);
+
+// Refuses every call from a host for a while once it failed authentication
+// `allowed_failures` times in a row: first `first_backoff`, doubling with
+// each further failure up to `longest_backoff`. A success clears the host.
+class AuthBackoff {
+ public:
+  AuthBackoff(int allowed_failures, absl::Duration first_backoff, absl::Duration longest_backoff)
+      : allowed_failures_(allowed_failures),
+        first_backoff_(first_backoff),
+        longest_backoff_(longest_backoff) {}
+
+  // RESOURCE_EXHAUSTED while `host` is backed off.
+  absl::Status check(const std::string& host, absl::Time now);
+  void failed(const std::string& host, absl::Time now);
+  void succeeded(const std::string& host);
+
+ private:
+  struct Host {
+    int failures = 0;
+    absl::Time blocked_until = absl::InfinitePast();
+  };
+  const int allowed_failures_;
+  const absl::Duration first_backoff_;
+  const absl::Duration longest_backoff_;
+  std::mutex mutex_;
+  std::map<std::string, Host> hosts_;
+};
+
+class ClientAuthenticator {
+ public:
+  // Reads the clients file and the single-token file the config names.
+  static absl::StatusOr<std::unique_ptr<ClientAuthenticator>> from_config(
+      const ServerConfig& config);
+
+  // No client authentication at all: every call is `anonymous`.
+  bool anonymous() const { return tokens_.empty() && !mutual_tls_; }
+  bool has_tokens() const { return !tokens_.empty(); }
+  // The admin token holder `name` with `token`, for the metrics endpoint.
+  bool is_admin_token(const std::string& name, const std::string& token) const;
+
+  // The caller's identity; UNAUTHENTICATED for a missing or wrong token,
+  // RESOURCE_EXHAUSTED while its host is backed off.
+  absl::StatusOr<ClientIdentity> identify(const grpc::ServerContext& context);
+
+ private:
+  ClientAuthenticator(std::vector<TokenHolder> tokens, bool mutual_tls,
+                      std::set<std::string> admins, const ServerConfig& config);
+  const TokenHolder* find_token(std::string_view presented) const;
+
+  const std::vector<TokenHolder> tokens_;
+  const bool mutual_tls_;
+  const std::set<std::string> admins_;
+  AuthBackoff backoff_;
+};
+
+}  // namespace labelmesh::server
