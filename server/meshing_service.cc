@@ -447,8 +447,11 @@ grpc::Status MeshingService::Fetch(grpc::ServerContext* context, const v1::Fetch
     return grpc::Status(grpc::StatusCode::NOT_FOUND,
                         absl::StrCat("job has no artifact '", request->artifact(), "'"));
   }
-  std::ifstream in(absl::StrCat(spool_.output_dir(request->job_id()), "/", artifact->name()),
-                   std::ios::binary);
+  auto job = table_.get(request->job_id());
+  if (!job.ok()) return to_grpc(job.status());
+  std::ifstream in(
+      absl::StrCat(spool_.output_dir(request->job_id(), job->attempts()), "/", artifact->name()),
+      std::ios::binary);
   if (!in) return grpc::Status(grpc::StatusCode::NOT_FOUND, "the artifact expired or was removed");
   auto stream = open_stream(*context);
   if (!stream.ok()) return to_grpc(stream.status());

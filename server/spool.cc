@@ -9,6 +9,7 @@
 #include <fstream>
 #include <random>
 
+#include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 #include "server/durable_file.h"
 #include "server/sha256.h"
@@ -50,8 +51,8 @@ std::string Spool::input_path(const v1::JobRecord& record) const {
   return absl::StrCat(job_dir(record.job().job_id()), "/input", record.input_extension());
 }
 
-std::string Spool::output_dir(const std::string& job_id) const {
-  return absl::StrCat(job_dir(job_id), "/out");
+std::string Spool::output_dir(const std::string& job_id, uint32_t attempt) const {
+  return absl::StrCat(job_dir(job_id), "/out-", attempt);
 }
 
 std::string Spool::worker_log(const std::string& job_id) const {
@@ -146,18 +147,22 @@ void Spool::remove_input(const v1::JobRecord& record) const {
   fs::remove(input_path(record), error);
 }
 
-absl::Status Spool::reset_output(const std::string& job_id) const {
+absl::Status Spool::reset_output(const std::string& job_id, uint32_t attempt) const {
   std::error_code error;
-  fs::remove_all(output_dir(job_id), error);
-  fs::create_directories(output_dir(job_id), error);
+  for (const auto& entry : fs::directory_iterator(job_dir(job_id), error)) {
+    const std::string name = entry.path().filename().string();
+    if (name == "out" || absl::StartsWith(name, "out-")) fs::remove_all(entry.path(), error);
+  }
+  error.clear();
+  fs::create_directories(output_dir(job_id, attempt), error);
   if (error) return io_error("cannot create the output directory", error);
   return absl::OkStatus();
 }
 
-absl::StatusOr<std::vector<v1::Artifact>> Spool::collect_artifacts(
-    const std::string& job_id) const {
+absl::StatusOr<std::vector<v1::Artifact>> Spool::collect_artifacts(const std::string& job_id,
+                                                                   uint32_t attempt) const {
   std::vector<v1::Artifact> artifacts;
-  const fs::path out = output_dir(job_id);
+  const fs::path out = output_dir(job_id, attempt);
   std::error_code error;
   for (const auto& entry : fs::recursive_directory_iterator(out, error)) {
     if (!entry.is_regular_file()) continue;

@@ -6,7 +6,9 @@
 //   <root>/jobs/<id>/job.pb       the JobRecord, replaced atomically
 //   <root>/jobs/<id>/input<ext>   the uploaded volume, until the job ends
 //                                 (unless the client asked to keep it)
-//   <root>/jobs/<id>/out/         meshes and report.json of the last attempt
+//   <root>/jobs/<id>/out-<n>/     meshes and report.json of attempt n: a
+//                                 stale worker of an earlier attempt can
+//                                 never write over a later one's results
 //   <root>/jobs/<id>/worker.log   the worker's stderr
 //   <root>/quarantine/            job directories whose record could not be
 //                                 read, kept for a person to look at
@@ -32,7 +34,7 @@ class Spool {
   std::string upload_path(const std::string& job_id, const std::string& extension) const;
   std::string job_dir(const std::string& job_id) const;
   std::string input_path(const v1::JobRecord& record) const;
-  std::string output_dir(const std::string& job_id) const;
+  std::string output_dir(const std::string& job_id, uint32_t attempt) const;
   std::string worker_log(const std::string& job_id) const;
 
   // Makes the job directory, moves the upload in and writes the record.
@@ -45,10 +47,13 @@ class Spool {
   void remove_job(const std::string& job_id) const;
   // Deletes the job's input (once it ended, unless the client kept it).
   void remove_input(const v1::JobRecord& record) const;
-  // Empties out/ before an attempt.
-  absl::Status reset_output(const std::string& job_id) const;
-  // Every regular file under out/, with size and SHA-256, sorted by name.
-  absl::StatusOr<std::vector<v1::Artifact>> collect_artifacts(const std::string& job_id) const;
+  // Before an attempt: removes the output of earlier attempts and makes an
+  // empty one for this attempt.
+  absl::Status reset_output(const std::string& job_id, uint32_t attempt) const;
+  // Every regular file of the attempt's output, with size and SHA-256,
+  // sorted by name.
+  absl::StatusOr<std::vector<v1::Artifact>> collect_artifacts(const std::string& job_id,
+                                                              uint32_t attempt) const;
   // Bytes an unprivileged writer may still use on the spool's file system.
   absl::StatusOr<uint64_t> free_bytes() const;
 

@@ -85,7 +85,7 @@ void send_failure(int fd, const absl::Status& status, const std::string& job_dir
   write_event(fd, event);
 }
 
-absl::Status run_job(const std::string& job_dir, int fd) {
+absl::Status run_job(const std::string& job_dir, const std::string& out_dir, int fd) {
   v1::JobRecord record;
   {
     std::ifstream in(absl::StrCat(job_dir, "/job.pb"), std::ios::binary);
@@ -107,7 +107,6 @@ absl::Status run_job(const std::string& job_dir, int fd) {
   auto result =
       run_pipeline(absl::StrCat(job_dir, "/input", record.input_extension()), *params, context);
   if (!result.ok()) return result.status();
-  const std::string out_dir = absl::StrCat(job_dir, "/out");
   if (auto status = write_results(*result, *params, out_dir, context); !status.ok()) return status;
   events.finish_stage();
   v1::JobEvent finished;
@@ -118,10 +117,10 @@ absl::Status run_job(const std::string& job_dir, int fd) {
 
 }  // namespace
 
-int run_worker(const std::string& job_dir, int event_fd) {
+int run_worker(const std::string& job_dir, const std::string& out_dir, int event_fd) {
   absl::Status status;
   try {
-    status = run_job(job_dir, event_fd);
+    status = run_job(job_dir, out_dir, event_fd);
   } catch (const std::bad_alloc&) {
     status = absl::ResourceExhaustedError("the job ran out of memory in the worker");
   } catch (const std::exception& e) {
@@ -141,16 +140,19 @@ int main(int argc, char** argv) {
   }
   // Only labelmeshd starts it, with the event pipe as descriptor 3: refuse
   // anything else.
-  if (argc != 3 || std::string_view(argv[1]) != kWorkerMode || fcntl(3, F_GETFD) == -1 ||
-      !std::filesystem::is_regular_file(std::filesystem::path(argv[2]) / "job.pb")) {
+  if (argc != 4 || std::string_view(argv[1]) != kWorkerMode || fcntl(3, F_GETFD) == -1 ||
+      !std::filesystem::is_regular_file(std::filesystem::path(argv[2]) / "job.pb") ||
+      std::filesystem::path(argv[3]).parent_path() != std::filesystem::path(argv[2]) ||
+      !std::filesystem::path(argv[3]).filename().string().starts_with("out-")) {
     std::fprintf(stderr,
                  "labelmesh-worker runs one job for labelmeshd, which starts it as "
-                 "`labelmesh-worker --worker JOB_DIR` with an event pipe; it is not run by hand\n");
+                 "`labelmesh-worker --worker JOB_DIR JOB_DIR/out-N` with an event pipe; it is "
+                 "not run by hand\n");
     return 2;
   }
   // `ps -o comm` and top show which job this is: "lmw-" and the job id's
   // first eleven digits (the kernel keeps 15 characters).
   const std::string job = std::filesystem::path(argv[2]).filename().string();
   prctl(PR_SET_NAME, ("lmw-" + job.substr(0, 11)).c_str());
-  return labelmesh::server::run_worker(argv[2], 3);
+  return labelmesh::server::run_worker(argv[2], argv[3], 3);
 }

@@ -38,13 +38,15 @@ void WorkerPool::run_thread() {
 
 void WorkerPool::run_job(const v1::JobRecord& record) {
   const std::string id = record.job().job_id();
-  if (auto status = spool_.reset_output(id); !status.ok()) {
+  const uint32_t attempt = record.job().attempts();
+  if (auto status = spool_.reset_output(id, attempt); !status.ok()) {
     table_.fail(id, static_cast<int>(status.code()), std::string(status.message()));
     return;
   }
   WorkerRun run;
   run.executable = executable_;
   run.job_dir = spool_.job_dir(id);
+  run.output_dir = spool_.output_dir(id, attempt);
   run.log_path = spool_.worker_log(id);
   run.limits.memory_bytes = config_.worker_memory_bytes;
   // Each worker meshes its labels on its share of the cores.
@@ -64,7 +66,7 @@ void WorkerPool::run_job(const v1::JobRecord& record) {
   WorkerOutcome outcome = run_worker_process(run);
   switch (outcome.kind) {
     case WorkerOutcome::Kind::kSucceeded: {
-      auto artifacts = spool_.collect_artifacts(id);
+      auto artifacts = spool_.collect_artifacts(id, attempt);
       if (!artifacts.ok()) {
         table_.fail(id, static_cast<int>(artifacts.status().code()),
                     std::string(artifacts.status().message()));

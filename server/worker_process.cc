@@ -162,9 +162,10 @@ WorkerOutcome run_worker_process(const WorkerRun& run) {
   }
   const int log_fd = ::open(run.log_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0640);
   const int null_fd = ::open("/dev/null", O_RDONLY | O_CLOEXEC);
-  std::string executable = run.executable, job_dir = run.job_dir;
+  std::string executable = run.executable, job_dir = run.job_dir, output_dir = run.output_dir;
   std::string mode = kWorkerMode;
-  std::vector<char*> argv{executable.data(), mode.data(), job_dir.data(), nullptr};
+  std::vector<char*> argv{executable.data(), mode.data(), job_dir.data(), output_dir.data(),
+                          nullptr};
   // Built before fork: the child may only make async-signal-safe calls.
   std::vector<std::string> variables;
   for (char** v = environ; *v != nullptr; ++v) {
@@ -326,7 +327,7 @@ int kill_stale_workers(const std::string& spool_root) {
     if (name.empty() || !std::all_of(name.begin(), name.end(), ::isdigit)) continue;
     std::ifstream in(entry.path() / "cmdline", std::ios::binary);
     std::string cmdline((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    // argv: <worker> --worker <spool>/jobs/<id>, after an interpreter's own
+    // argv: <worker> --worker <spool>/jobs/<id> <out dir>, after an interpreter's own
     // arguments when the worker is a script.
     std::vector<std::string> argv = absl::StrSplit(cmdline, '\0');
     bool stale = false;

@@ -45,6 +45,9 @@ struct WorkerOutcome {
 struct WorkerRun {
   std::string executable;
   std::string job_dir;
+  // Where this attempt writes its results: out-<attempt> in the job's
+  // directory.
+  std::string output_dir;
   // The child's stderr goes here.
   std::string log_path;
   WorkerLimits limits;

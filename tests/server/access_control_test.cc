@@ -151,7 +151,7 @@ TEST_F(AccessControlTest, DeleteRemovesInputAndResultsAtOnce) {
   ASSERT_TRUE(service.submit(sphere_, repaired_options(), &reply).ok());
   ASSERT_TRUE(service.watch(reply.job_id()).back().has_finished());
   const fs::path job_dir = spool_ / "jobs" / reply.job_id();
-  ASSERT_GT(count_files(job_dir / "out"), 2u);
+  ASSERT_GT(count_files(job_dir / "out-1"), 2u);
 
   v1::DeleteJobReply deleted;
   ASSERT_TRUE(delete_job(service, reply.job_id(), &deleted).ok());

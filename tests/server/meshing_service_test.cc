@@ -420,10 +420,10 @@ TEST_F(MeshingServiceTest, AResultSentBeforeTheDeadlineStands) {
     ::close(fd);
   }
   const fs::path lingering = dir_ / "lingering-worker.sh";
-  // Called as `lingering-worker.sh --worker JOB_DIR`.
-  write_file(lingering, absl::StrCat("#!/bin/sh\n", kAnswersVersion,
-                                     "mkdir -p \"$2/out\"\necho '{}' >\"$2/out/report.json\"\n",
-                                     "cat '", events.string(), "' >&3\nexec sleep 30\n"));
+  // Called as `lingering-worker.sh --worker JOB_DIR OUT_DIR`.
+  write_file(lingering,
+             absl::StrCat("#!/bin/sh\n", kAnswersVersion, "echo '{}' >\"$3/report.json\"\n",
+                          "cat '", events.string(), "' >&3\nexec sleep 30\n"));
   fs::permissions(lingering, fs::perms::owner_all);
   config_.worker_executable = lingering.string();
   config_.job_timeout = absl::Seconds(1);

@@ -105,5 +105,29 @@ TEST(Spool, UnreadableRecordsAreQuarantinedNotDeleted) {
   EXPECT_EQ(inputs_kept, 1u);
 }
 
+// A worker of an earlier attempt that is still alive (its server was killed)
+// writes into its own attempt's directory, which the next attempt removed:
+// it can never write over the new attempt's results.
+TEST(Spool, EachAttemptHasItsOwnOutputDirectory) {
+  const fs::path root = scratch_dir("SpoolAttemptOutput");
+  auto spool = server::Spool::open(root.string());
+  ASSERT_TRUE(spool.ok()) << spool.status();
+  const std::string id = server::new_job_id();
+  ASSERT_TRUE(save_queued(*spool, id));
+  ASSERT_TRUE(spool->reset_output(id, 1).ok());
+  testing::write_file(fs::path(spool->output_dir(id, 1)) / "surface-label1.stl", "first");
+  ASSERT_TRUE(spool->reset_output(id, 2).ok());
+  EXPECT_FALSE(fs::exists(spool->output_dir(id, 1)));
+  EXPECT_EQ(entries_in(spool->output_dir(id, 2)), 0u);
+  // The stale worker's next write fails; the new attempt's directory is untouched.
+  std::ofstream stale(fs::path(spool->output_dir(id, 1)) / "report.json");
+  EXPECT_FALSE(stale.is_open());
+  testing::write_file(fs::path(spool->output_dir(id, 2)) / "report.json", "{}");
+  auto artifacts = spool->collect_artifacts(id, 2);
+  ASSERT_TRUE(artifacts.ok()) << artifacts.status();
+  ASSERT_EQ(artifacts->size(), 1u);
+  EXPECT_EQ((*artifacts)[0].name(), "report.json");
+}
+
 }  // namespace
 }  // namespace labelmesh
