@@ -2,6 +2,7 @@
 // labelmeshd: the meshing service. Each job runs in a child process,
 // labelmesh-worker, which alone links the core meshing library.
 #include <signal.h>
+#include <unistd.h>
 #include <CLI/CLI.hpp>
 
 #include <cstdio>
@@ -9,6 +10,7 @@
 #include <thread>
 
 #include "absl/time/time.h"
+#include "server/json_log_format.h"
 #include "server/labelmesh_server.h"
 #include "server/worker_process.h"
 #include "spdlog/sinks/stdout_color_sinks.h"
@@ -157,12 +159,21 @@ int main(int argc, char** argv) {
   // Logs go to stderr, as a service manager or container runtime expects.
   spdlog::set_default_logger(spdlog::stderr_color_mt("labelmeshd"));
   ServerConfig config;
+  std::string log_format = "auto";
   CLI::App app{"labelmeshd " LABELMESH_VERSION
                ": the labelmesh gRPC meshing service. Every flag can also be set with the "
                "environment variable named after it. Without TLS it listens on loopback only."};
   app.set_version_flag("--version", "labelmeshd " LABELMESH_VERSION);
   add_server_flags(app, config);
+  app.add_option("--log-format", log_format,
+                 "json (one object per line, UTC), text, or auto: text on a terminal, else json")
+      ->check(CLI::IsMember({"auto", "json", "text"}))
+      ->envname("LABELMESHD_LOG_FORMAT")
+      ->capture_default_str();
   CLI11_PARSE(app, argc, argv);
+  if (log_format == "json" || (log_format == "auto" && isatty(STDERR_FILENO) != 1)) {
+    spdlog::set_formatter(std::make_unique<labelmesh::server::JsonLogFormatter>());
+  }
 
   auto server = labelmesh::server::LabelmeshServer::start(config);
   if (!server.ok()) {

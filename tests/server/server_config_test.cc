@@ -7,6 +7,7 @@
 #include "server/audit_log.h"
 #include "server/client_identity.h"
 #include "server/error_details.h"
+#include "server/json_log_format.h"
 #include "server/server_config.h"
 #include "support/test_files.h"
 
@@ -138,6 +139,18 @@ TEST(ErrorDetails, InvalidArgumentNamesTheFieldInABadRequest) {
   EXPECT_TRUE(
       server::to_grpc(absl::InvalidArgumentError("The header is bad: x")).error_details().empty());
   EXPECT_TRUE(server::to_grpc(absl::NotFoundError("spec.x: y")).error_details().empty());
+}
+
+TEST(JsonLogLine, CarriesTheJobIdAndEscapesTheMessage) {
+  const std::string id = "0123456789abcdef0123456789abcdef";
+  EXPECT_EQ(server::json_log_line("2026-01-31T12:00:00.000Z", "info",
+                                  "job " + id + " stage \"repair\" finished"),
+            "{\"time\":\"2026-01-31T12:00:00.000Z\",\"level\":\"info\",\"job_id\":\"" + id +
+                "\",\"msg\":\"job " + id + " stage \\\"repair\\\" finished\"}\n");
+  EXPECT_EQ(server::job_id_in("job 0123 and job " + id), id);
+  EXPECT_EQ(server::job_id_in("jobs " + id), "");
+  EXPECT_EQ(server::json_log_line("t", "warn", "a\nb"),
+            "{\"time\":\"t\",\"level\":\"warn\",\"msg\":\"a\\u000ab\"}\n");
 }
 
 }  // namespace
