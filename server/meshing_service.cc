@@ -11,12 +11,15 @@
 #include "server/error_details.h"
 #include "server/sha256.h"
 #include "server/upload_checks.h"
+#include "server/worker_process.h"
 #include "spdlog/spdlog.h"
 
 namespace labelmesh::server {
 namespace {
 
 constexpr size_t kChunkBytes = 1 << 20;
+// Longest a worker may take to read an upload the server cannot decode.
+constexpr std::chrono::milliseconds kVolumeCheckTime{120'000};
 
 grpc::Status invalid(const std::string& message) {
   return to_grpc(absl::InvalidArgumentError(message));
@@ -321,6 +324,16 @@ grpc::Status MeshingService::submit(grpc::ServerContext& context,
   if (!geometry.ok()) {
     reason = "bad_volume";
     return to_grpc(geometry.status());
+  }
+  // VTK XML arrays (base64, appended, compressed blocks) are decoded only by
+  // VTK's reader, which the server does not link: a worker reads them.
+  if (extension == ".vti") {
+    auto read = check_volume_in_worker(worker_executable(config_), upload.path(), voxel_limit,
+                                       config_.worker_memory_bytes, kVolumeCheckTime);
+    if (!read.ok()) {
+      reason = "bad_volume";
+      return to_grpc(read);
+    }
   }
   if (auto status = check_sizing_for_grid(params.poisson, *geometry); !status.ok()) {
     reason = "bad_request";

@@ -15,12 +15,14 @@
 #include <new>
 #include <string_view>
 
+#include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_replace.h"
 #include "core/pipeline/job_options.h"
 #include "core/pipeline/pipeline.h"
 #include "core/pipeline/report.h"
 #include "core/pipeline/write_results.h"
+#include "core/volume/read_label_volume.h"
 #include "server/event_pipe.h"
 #include "server/worker_process.h"
 
@@ -117,6 +119,24 @@ absl::Status run_job(const std::string& job_dir, const std::string& out_dir, int
 
 }  // namespace
 
+int check_volume(const std::string& path, const std::string& max_voxels) {
+  volume::ReadLimits limits;
+  limits.allow_data_file = false;
+  if (!absl::SimpleAtoi(max_voxels, &limits.max_voxels)) return 2;
+  absl::Status status;
+  try {
+    status = volume::read_label_volume(path, limits, RunContext()).status();
+  } catch (const std::bad_alloc&) {
+    status = absl::ResourceExhaustedError("the volume does not fit the worker's memory");
+  } catch (const std::exception& e) {
+    status = absl::InvalidArgumentError(absl::StrCat("the volume cannot be read: ", e.what()));
+  }
+  if (status.ok()) return 0;
+  const std::string message(status.message());
+  std::fwrite(message.data(), 1, message.size(), stdout);
+  return 1;
+}
+
 int run_worker(const std::string& job_dir, const std::string& out_dir, int event_fd) {
   absl::Status status;
   try {
@@ -137,6 +157,9 @@ int main(int argc, char** argv) {
   if (argc == 2 && std::string_view(argv[1]) == "--version") {
     std::printf("%s\n", labelmesh::server::kWorkerVersionLine);
     return 0;
+  }
+  if (argc == 4 && std::string_view(argv[1]) == labelmesh::server::kCheckVolumeMode) {
+    return labelmesh::server::check_volume(argv[2], argv[3]);
   }
   // Only labelmeshd starts it, with the event pipe as descriptor 3: refuse
   // anything else.

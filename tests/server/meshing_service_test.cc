@@ -316,9 +316,27 @@ TEST_F(MeshingServiceTest, UploadsThatCouldOnlyFailLaterAreRefusedAtSubmit) {
   EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
   EXPECT_TRUE(absl::StrContains(status.error_message(), "formats")) << status.error_message();
 
+  // VTK XML: the compressed appended array cut short, closing tags kept, so
+  // that the header passes and only reading the array finds it.
+  const fs::path vti = dir_ / "sphere.vti";
+  ASSERT_TRUE(volume::write_label_volume(
+                  volume::make_phantom(volume::PhantomShape::kSphere, 1.0).volume, vti.string())
+                  .ok());
+  const std::string whole = read_bytes(vti);
+  const size_t data = whole.find('_', whole.find("<AppendedData"));
+  ASSERT_NE(data, std::string::npos);
+  const fs::path cut_vti = dir_ / "cut.vti";
+  write_file(cut_vti, whole.substr(0, data + (whole.size() - data) / 2) +
+                          "\n  </AppendedData>\n</VTKFile>\n");
+  status = roomy.submit(cut_vti, repaired_options(), &reply);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT) << status.error_message();
+  EXPECT_FALSE(absl::StrContains(status.error_message(), spool_.string()))
+      << status.error_message();
+
   EXPECT_EQ(job_dirs(), 0u);
   EXPECT_EQ(uploads_left(), 0u);
   EXPECT_TRUE(roomy.submit(sphere, repaired_options(), &reply).ok());
+  EXPECT_TRUE(roomy.submit(vti, repaired_options(), &reply).ok());
 }
 
 TEST_F(MeshingServiceTest, CancelStopsARunningJobWithinASecond) {
