@@ -139,11 +139,14 @@ absl::StatusOr<ClientIdentity> MeshingService::identify(const grpc::ServerContex
   if (identity.ok()) return identity;
   const bool backed_off = identity.status().code() == absl::StatusCode::kResourceExhausted;
   metrics_.rejected(backed_off ? "auth_backoff" : "unauthenticated");
+  // Calls refused by the backoff are counted, not logged one by one: they
+  // come as fast as a client can send them, and would fill the disk.
+  if (backed_off) return identity;
   audit_.record({.event = "unauthenticated",
                  .peer = peer_host(context.peer()),
                  .call = call,
                  .code = code_name(static_cast<grpc::StatusCode>(identity.status().code())),
-                 .reason = backed_off ? "auth_backoff" : "bad_credentials"});
+                 .reason = "bad_credentials"});
   return identity;
 }
 

@@ -229,6 +229,9 @@ TEST_F(AccessControlTest, RepeatedFailedAuthenticationIsBackedOff) {
   EXPECT_NE(
       service.server().metrics().text().find("labelmesh_rejections_total{reason=\"auth_backoff\"}"),
       std::string::npos);
+  // Each failed authentication is audited; the backed-off calls are only
+  // counted, so that a client hammering the server cannot fill the disk.
+  EXPECT_EQ(audit_lines().size(), 6u);
 }
 
 // The status of a reflection call carrying no request.
