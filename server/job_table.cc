@@ -7,6 +7,7 @@
 
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
+#include "server/client_identity.h"
 #include "spdlog/spdlog.h"
 
 namespace labelmesh::server {
@@ -136,6 +137,9 @@ void JobTable::recover(absl::Duration result_ttl) {
   for (auto& record : records) {
     v1::Job& job = *record.mutable_job();
     const std::string id = job.job_id();
+    // Jobs from before identities belong to the anonymous client: every
+    // caller of a server without authentication, only admins otherwise.
+    if (job.owner().empty()) job.set_owner(kAnonymous);
     if (has_ended(job.state())) {
       if (job.finished_at() + absl::ToDoubleSeconds(result_ttl) < now) {
         spool_.remove_job(id);

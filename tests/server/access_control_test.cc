@@ -13,7 +13,9 @@
 #include "absl/strings/str_split.h"
 #include "core/volume/phantom.h"
 #include "core/volume/write_label_volume.h"
+#include "server/job_table.h"
 #include "server/metrics.h"
+#include "server/spool.h"
 #include "support/service_harness.h"
 
 namespace labelmesh::testing {
@@ -397,6 +399,39 @@ TEST_F(AccessControlTest, TheAuditLogHasALinePerJobAndNoHeaderText) {
     EXPECT_EQ(line.substr(32, 2), "Z\"") << line;
     EXPECT_FALSE(absl::StrContains(line, "DOE")) << line;
   }
+}
+
+// A spool written before jobs had owners: its jobs belong to the anonymous
+// client, so a server without authentication still shows them and one with
+// authentication shows them to admins only.
+TEST_F(AccessControlTest, JobsFromBeforeIdentitiesBelongToTheAnonymousClient) {
+  const std::string id = server::new_job_id();
+  {
+    auto spool = server::Spool::open(spool_.string());
+    ASSERT_TRUE(spool.ok()) << spool.status();
+    fs::create_directories(spool->job_dir(id));
+    v1::JobRecord record;
+    record.mutable_job()->set_job_id(id);
+    record.mutable_job()->set_state(v1::JOB_STATE_CANCELLED);
+    record.mutable_job()->set_created_at(server::unix_now());
+    record.mutable_job()->set_finished_at(server::unix_now());
+    ASSERT_TRUE(spool->save(record).ok());
+  }
+  {
+    ServiceHarness authenticated(config_);
+    authenticated.token = kAliceToken;
+    grpc::Status status;
+    authenticated.get(id, &status);
+    EXPECT_EQ(status.error_code(), grpc::StatusCode::NOT_FOUND);
+    authenticated.token = kCarolToken;
+    EXPECT_EQ(authenticated.get(id, &status).owner(), "anonymous");
+    EXPECT_TRUE(status.ok());
+  }
+  config_.clients_file.clear();
+  ServiceHarness anonymous(config_);
+  grpc::Status status;
+  anonymous.get(id, &status);
+  EXPECT_TRUE(status.ok()) << status.error_message();
 }
 
 }  // namespace
