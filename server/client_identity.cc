@@ -152,7 +152,8 @@ bool ClientAuthenticator::is_admin_token(const std::string& name, const std::str
   return holder != nullptr && holder->name == name && admins_.count(name) > 0;
 }
 
-absl::StatusOr<ClientIdentity> ClientAuthenticator::identify(const grpc::ServerContext& context) {
+absl::StatusOr<ClientIdentity> ClientAuthenticator::identify(
+    const grpc::ServerContextBase& context) {
   if (anonymous()) return ClientIdentity{kAnonymous, false};
   const std::string host = peer_host(context.peer());
   const absl::Time now = absl::Now();

@@ -79,7 +79,7 @@ class ClientAuthenticator {
 
   // The caller's identity; UNAUTHENTICATED for a missing or wrong token,
   // RESOURCE_EXHAUSTED while its host is backed off.
-  absl::StatusOr<ClientIdentity> identify(const grpc::ServerContext& context);
+  absl::StatusOr<ClientIdentity> identify(const grpc::ServerContextBase& context);
 
  private:
   ClientAuthenticator(std::vector<TokenHolder> tokens, bool mutual_tls,

@@ -123,6 +123,9 @@ void JobTable::add_event(Entry& entry, v1::JobEvent event) {
   *event.mutable_timestamp() = to_timestamp(event.time());
   if (event.has_progress() && entry.events.size() >= kMaxStoredEvents) return;
   entry.events.push_back(std::move(event));
+  const bool last = has_ended(entry.record.job().state());
+  for (EventListener* listener : entry.listeners) listener->on_event(entry.events.back(), last);
+  if (last) entry.listeners.clear();
   events_added_.notify_all();
 }
 
@@ -322,8 +325,7 @@ bool JobTable::remove_if_requested(const std::string& job_id) {
   Entry* entry = find(job_id);
   if (entry == nullptr || !entry->remove_when_ended) return false;
   spool_.remove_job(job_id);
-  jobs_.erase(job_id);
-  events_added_.notify_all();
+  erase_entry(job_id);
   spdlog::info("job {} deleted by a client once its worker stopped", job_id);
   return true;
 }
@@ -432,8 +434,7 @@ absl::StatusOr<v1::JobState> JobTable::remove(const std::string& job_id) {
     update_gauges();
   }
   spool_.remove_job(job_id);
-  jobs_.erase(job_id);
-  events_added_.notify_all();
+  erase_entry(job_id);
   spdlog::info("job {} deleted by a client", job_id);
   return state;
 }
@@ -519,15 +520,54 @@ std::vector<std::string> JobTable::expire(absl::Duration result_ttl, size_t max_
     spdlog::info("job {} results {} and deleted", id,
                  expired ? "expired" : "past the cap on ended jobs");
     removed.push_back(id);
-    jobs_.erase(id);
+    erase_entry(id);
   }
   if (!removed.empty()) events_added_.notify_all();
   return removed;
 }
 
+void JobTable::erase_entry(const std::string& job_id) {
+  auto it = jobs_.find(job_id);
+  if (it == jobs_.end()) return;
+  const absl::Status gone = absl::NotFoundError(absl::StrCat("job ", job_id, " was deleted"));
+  for (EventListener* listener : it->second.listeners) listener->on_closed(gone);
+  jobs_.erase(it);
+  events_added_.notify_all();
+}
+
+absl::Status JobTable::listen(const std::string& job_id, uint64_t from, EventListener* listener) {
+  std::lock_guard lock(mutex_);
+  Entry* entry = find(job_id);
+  if (entry == nullptr) return absl::NotFoundError(absl::StrCat("no job ", job_id));
+  const bool ended = has_ended(entry->record.job().state());
+  if (closed_ && !ended) return absl::UnavailableError("the server is shutting down");
+  bool replayed_last = false;
+  for (size_t i = 0; i < entry->events.size(); ++i) {
+    if (entry->events[i].sequence() < from) continue;
+    replayed_last = ended && i + 1 == entry->events.size();
+    listener->on_event(entry->events[i], replayed_last);
+  }
+  if (!ended) {
+    entry->listeners.push_back(listener);
+  } else if (!replayed_last) {
+    listener->on_closed(absl::OkStatus());
+  }
+  return absl::OkStatus();
+}
+
+void JobTable::unlisten(const std::string& job_id, EventListener* listener) {
+  std::lock_guard lock(mutex_);
+  if (Entry* entry = find(job_id)) std::erase(entry->listeners, listener);
+}
+
 void JobTable::close() {
   std::lock_guard lock(mutex_);
   closed_ = true;
+  const absl::Status closing = absl::UnavailableError("the server is shutting down");
+  for (auto& [id, entry] : jobs_) {
+    for (EventListener* listener : entry.listeners) listener->on_closed(closing);
+    entry.listeners.clear();
+  }
   queue_changed_.notify_all();
   events_added_.notify_all();
 }

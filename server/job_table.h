@@ -98,6 +98,23 @@ class JobTable {
   absl::StatusOr<EventBatch> events_since(const std::string& job_id, uint64_t from,
                                           absl::Duration wait) const;
 
+  // Told of a job's events as they are added, with no thread of its own.
+  // Called with the table locked: it must not call the table back.
+  class EventListener {
+   public:
+    virtual ~EventListener() = default;
+    // `last`: the job ended and this is its last event.
+    virtual void on_event(const v1::JobEvent& event, bool last) = 0;
+    // No event follows: OK when the job had ended with nothing left to
+    // replay, NOT_FOUND when it was deleted, UNAVAILABLE at shutdown.
+    virtual void on_closed(const absl::Status& status) = 0;
+  };
+  // Replays the job's events from `from` to `listener`, then tells it of
+  // each new one. NOT_FOUND for an unknown job, UNAVAILABLE after close().
+  absl::Status listen(const std::string& job_id, uint64_t from, EventListener* listener);
+  // Once this returns, `listener` is not called again.
+  void unlisten(const std::string& job_id, EventListener* listener);
+
   // Deletes jobs that ended more than `result_ttl` ago, and the oldest ended
   // jobs beyond `max_ended`; returns their ids.
   std::vector<std::string> expire(absl::Duration result_ttl, size_t max_ended);
@@ -113,6 +130,7 @@ class JobTable {
     bool cancel_requested = false;
     // Deleted by a client while running: gone once its worker ends.
     bool remove_when_ended = false;
+    std::vector<EventListener*> listeners;
   };
 
   Entry* find(const std::string& job_id);
@@ -135,6 +153,8 @@ class JobTable {
   // The job as clients see it: queue position and timestamps filled in.
   v1::Job view(const std::string& job_id, const v1::Job& job) const;
   uint32_t position_of(const std::string& job_id) const;
+  // Removes the job from the table (not the spool), closing its listeners.
+  void erase_entry(const std::string& job_id);
   void update_gauges();
 
   const Spool& spool_;

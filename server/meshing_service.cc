@@ -11,6 +11,7 @@
 #include "server/error_details.h"
 #include "server/sha256.h"
 #include "server/upload_checks.h"
+#include "server/watch_reactor.h"
 #include "server/worker_process.h"
 #include "spdlog/spdlog.h"
 
@@ -74,6 +75,13 @@ class UploadSlot {
   bool acquired_;
 };
 
+// A Watch refused before it streams anything.
+class RefusedWatch final : public grpc::ServerWriteReactor<v1::JobEvent> {
+ public:
+  explicit RefusedWatch(const grpc::Status& status) { Finish(status); }
+  void OnDone() override { delete this; }
+};
+
 // Holds a (owner, request_id) among the submits in progress.
 class RequestClaim {
  public:
@@ -127,13 +135,13 @@ MeshingService::MeshingService(JobTable& table, const Spool& spool, const Server
       streams_(config.max_streams_per_client, config.max_streams) {}
 
 absl::StatusOr<std::unique_ptr<StreamCounts::Slot>> MeshingService::open_stream(
-    const grpc::ServerContext& context) {
+    const grpc::ServerContextBase& context) {
   auto slot = streams_.open(context.peer());
   if (!slot.ok()) metrics_.rejected("too_many_streams");
   return slot;
 }
 
-absl::StatusOr<ClientIdentity> MeshingService::identify(const grpc::ServerContext& context,
+absl::StatusOr<ClientIdentity> MeshingService::identify(const grpc::ServerContextBase& context,
                                                         const char* call) {
   auto identity = authenticator_.identify(context);
   if (identity.ok()) return identity;
@@ -369,30 +377,16 @@ grpc::Status MeshingService::submit(grpc::ServerContext& context,
   return grpc::Status::OK;
 }
 
-grpc::Status MeshingService::Watch(grpc::ServerContext* context, const v1::WatchRequest* request,
-                                   grpc::ServerWriter<v1::JobEvent>* writer) {
+grpc::ServerWriteReactor<v1::JobEvent>* MeshingService::Watch(grpc::CallbackServerContext* context,
+                                                              const v1::WatchRequest* request) {
+  auto refuse = [](const grpc::Status& status) { return new RefusedWatch(status); };
   auto identity = identify(*context, "Watch");
-  if (!identity.ok()) return to_grpc(identity.status());
-  if (auto status = authorize(*identity, request->job_id()); !status.ok()) return status;
+  if (!identity.ok()) return refuse(to_grpc(identity.status()));
+  if (auto status = authorize(*identity, request->job_id()); !status.ok()) return refuse(status);
   auto stream = open_stream(*context);
-  if (!stream.ok()) return to_grpc(stream.status());
-  // Waiting for events is progress; a write the watcher does not read is not.
-  auto ticket =
-      watchdog_.watch(context, config_.stream_idle_timeout, absl::InfiniteDuration(), "watch");
-  uint64_t next = 0;
-  for (;;) {
-    ticket->touch();
-    auto batch = table_.events_since(request->job_id(), next, absl::Milliseconds(500));
-    if (!batch.ok()) return to_grpc(batch.status());
-    for (const auto& event : batch->events) {
-      if (!writer->Write(event))
-        return stalled_or(*ticket, grpc::Status(grpc::StatusCode::CANCELLED, "watcher left"));
-      ticket->touch();
-      next = event.sequence() + 1;
-    }
-    if (batch->ended) return grpc::Status::OK;
-    if (context->IsCancelled()) return grpc::Status(grpc::StatusCode::CANCELLED, "watcher left");
-  }
+  if (!stream.ok()) return refuse(to_grpc(stream.status()));
+  return WatchReactor::start(table_, watchdog_, config_.stream_idle_timeout, context,
+                             request->job_id(), std::move(*stream));
 }
 
 grpc::Status MeshingService::GetJob(grpc::ServerContext* context, const v1::GetJobRequest* request,

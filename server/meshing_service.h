@@ -19,7 +19,10 @@
 
 namespace labelmesh::server {
 
-class MeshingService final : public v1::MeshingService::Service {
+// Watch runs on gRPC's callback API (no thread per watcher); the other
+// methods are synchronous.
+class MeshingService final
+    : public v1::MeshingService::WithCallbackMethod_Watch<v1::MeshingService::Service> {
  public:
   MeshingService(JobTable& table, const Spool& spool, const ServerConfig& config, Metrics& metrics,
                  ClientAuthenticator& authenticator, AuditLog& audit);
@@ -29,8 +32,8 @@ class MeshingService final : public v1::MeshingService::Service {
 
   grpc::Status Submit(grpc::ServerContext* context, grpc::ServerReader<v1::SubmitRequest>* reader,
                       v1::SubmitReply* reply) override;
-  grpc::Status Watch(grpc::ServerContext* context, const v1::WatchRequest* request,
-                     grpc::ServerWriter<v1::JobEvent>* writer) override;
+  grpc::ServerWriteReactor<v1::JobEvent>* Watch(grpc::CallbackServerContext* context,
+                                                const v1::WatchRequest* request) override;
   grpc::Status GetJob(grpc::ServerContext* context, const v1::GetJobRequest* request,
                       v1::Job* reply) override;
   grpc::Status ListJobs(grpc::ServerContext* context, const v1::ListJobsRequest* request,
@@ -46,7 +49,7 @@ class MeshingService final : public v1::MeshingService::Service {
 
  private:
   // The caller's identity; a failure is counted and audited.
-  absl::StatusOr<ClientIdentity> identify(const grpc::ServerContext& context, const char* call);
+  absl::StatusOr<ClientIdentity> identify(const grpc::ServerContextBase& context, const char* call);
   // NOT_FOUND unless the id is well formed, the job exists and the caller
   // owns it or is an admin: other clients' jobs are not even named.
   grpc::Status authorize(const ClientIdentity& identity, const std::string& job_id) const;
@@ -58,7 +61,7 @@ class MeshingService final : public v1::MeshingService::Service {
                               StreamWatchdog::Ticket& ticket, std::string& reason);
   // A place among the client's streams, or RESOURCE_EXHAUSTED (counted).
   absl::StatusOr<std::unique_ptr<StreamCounts::Slot>> open_stream(
-      const grpc::ServerContext& context);
+      const grpc::ServerContextBase& context);
   // RESOURCE_EXHAUSTED "spool disk full" when an upload of this size would
   // leave less than the reserve free.
   absl::Status check_spool_space(uint64_t upload_bytes) const;

@@ -49,7 +49,13 @@ StreamWatchdog::~StreamWatchdog() {
 }
 
 StreamWatchdog::Ticket::~Ticket() {
-  std::lock_guard lock(watchdog_.mutex_);
+  std::unique_lock lock(watchdog_.mutex_);
+  // The stream's context must outlive a TryCancel in flight on it.
+  watchdog_.cancelled_.wait(lock, [this] {
+    auto it = watchdog_.entries_.find(id_);
+    return it == watchdog_.entries_.end() || !it->second.cancelling ||
+           std::this_thread::get_id() == watchdog_.thread_.get_id();
+  });
   watchdog_.entries_.erase(id_);
 }
 
@@ -65,14 +71,32 @@ std::string StreamWatchdog::Ticket::cancelled_because() const {
   return it == watchdog_.entries_.end() ? std::string() : it->second.cancelled_because;
 }
 
-std::unique_ptr<StreamWatchdog::Ticket> StreamWatchdog::watch(grpc::ServerContext* context,
+std::unique_ptr<StreamWatchdog::Ticket> StreamWatchdog::watch(grpc::ServerContextBase* context,
                                                               absl::Duration idle,
                                                               absl::Duration total,
                                                               std::string what) {
   const absl::Time now = absl::Now();
   std::lock_guard lock(mutex_);
   const uint64_t id = next_id_++;
-  entries_[id] = Entry{context, idle, total, now + total, now, std::move(what), {}};
+  entries_[id] = Entry{context, idle, total, now + total, now, std::move(what), {}, nullptr, false};
+  return std::unique_ptr<Ticket>(new Ticket(*this, id));
+}
+
+std::unique_ptr<StreamWatchdog::Ticket> StreamWatchdog::watch_writes(
+    grpc::ServerContextBase* context, absl::Duration idle, std::function<int64_t()> write_started,
+    std::string what) {
+  const absl::Time now = absl::Now();
+  std::lock_guard lock(mutex_);
+  const uint64_t id = next_id_++;
+  entries_[id] = Entry{context,
+                       idle,
+                       absl::InfiniteDuration(),
+                       absl::InfiniteFuture(),
+                       now,
+                       std::move(what),
+                       {},
+                       std::move(write_started),
+                       false};
   return std::unique_ptr<Ticket>(new Ticket(*this, id));
 }
 
@@ -80,9 +104,15 @@ void StreamWatchdog::loop() {
   std::unique_lock lock(mutex_);
   while (!wake_.wait_for(lock, std::chrono::milliseconds(100), [this] { return stopping_; })) {
     const absl::Time now = absl::Now();
+    std::vector<uint64_t> to_cancel;
     for (auto& [id, entry] : entries_) {
       if (!entry.cancelled_because.empty()) continue;
-      if (now - entry.last_touch > entry.idle) {
+      absl::Time busy_since = entry.last_touch;
+      if (entry.write_started) {
+        const int64_t started = entry.write_started();
+        busy_since = started == 0 ? now : absl::FromUnixNanos(started);
+      }
+      if (now - busy_since > entry.idle) {
         entry.cancelled_because =
             absl::StrCat(entry.what, " stalled for more than ", absl::FormatDuration(entry.idle));
       } else if (now > entry.deadline) {
@@ -92,8 +122,19 @@ void StreamWatchdog::loop() {
         continue;
       }
       spdlog::warn("{}: cancelled", entry.cancelled_because);
-      entry.context->TryCancel();
+      entry.cancelling = true;
+      to_cancel.push_back(id);
     }
+    // Cancelled with the lock released: gRPC may run the stream's reactions
+    // on other threads meanwhile, and those may end the stream.
+    for (uint64_t id : to_cancel) {
+      grpc::ServerContextBase* context = entries_.at(id).context;
+      lock.unlock();
+      context->TryCancel();
+      lock.lock();
+      if (auto it = entries_.find(id); it != entries_.end()) it->second.cancelling = false;
+    }
+    if (!to_cancel.empty()) cancelled_.notify_all();
   }
 }
 

@@ -10,6 +10,7 @@
 #include <atomic>
 #include <condition_variable>
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -81,23 +82,33 @@ class StreamWatchdog {
 
   // `idle`: longest time between touches; `total`: longest the stream may
   // live (absl::InfiniteDuration() for none). `what` names it in the reason.
-  std::unique_ptr<Ticket> watch(grpc::ServerContext* context, absl::Duration idle,
+  std::unique_ptr<Ticket> watch(grpc::ServerContextBase* context, absl::Duration idle,
                                 absl::Duration total, std::string what);
+  // For a stream that is idle by design between its messages (a callback
+  // watch): stalled when `write_started()` is set (a write is outstanding,
+  // nanoseconds since the epoch) and older than `idle`. Called with the
+  // watchdog's lock held: it may only read atomics.
+  std::unique_ptr<Ticket> watch_writes(grpc::ServerContextBase* context, absl::Duration idle,
+                                       std::function<int64_t()> write_started, std::string what);
 
  private:
   struct Entry {
-    grpc::ServerContext* context;
+    grpc::ServerContextBase* context;
     absl::Duration idle;
     absl::Duration total;
     absl::Time deadline;
     absl::Time last_touch;
     std::string what;
     std::string cancelled_because;
+    std::function<int64_t()> write_started;
+    // The watchdog is cancelling this stream with its lock released.
+    bool cancelling = false;
   };
   void loop();
 
   std::mutex mutex_;
   std::condition_variable wake_;
+  std::condition_variable cancelled_;
   std::map<uint64_t, Entry> entries_;
   uint64_t next_id_ = 1;
   bool stopping_ = false;

@@ -108,5 +108,42 @@ TEST_F(StalledClientsTest, AClientHoldsAtMostItsStreams) {
   second->Finish();
 }
 
+size_t threads_of_this_process() {
+  size_t count = 0;
+  for ([[maybe_unused]] const auto& entry : std::filesystem::directory_iterator("/proc/self/task"))
+    ++count;
+  return count;
+}
+
+// Watches on the callback API: a watcher waiting for news holds no server
+// thread, so a hundred of them add a few threads, not a hundred.
+TEST_F(StalledClientsTest, WaitingWatchersHoldNoThreads) {
+  config_.workers = 0;  // the job stays queued: its watchers wait
+  config_.max_streams_per_client = 200;
+  ServiceHarness service(config_);
+  v1::SubmitReply reply;
+  ASSERT_TRUE(service.submit(input_, testing::repaired_options(), &reply).ok());
+  v1::WatchRequest request;
+  request.set_job_id(reply.job_id());
+  // Client and server share this process: count before the first watch.
+  const size_t before = threads_of_this_process();
+  constexpr int kWatchers = 100;
+  std::vector<std::unique_ptr<grpc::ClientContext>> contexts;
+  std::vector<std::unique_ptr<grpc::ClientReader<v1::JobEvent>>> readers;
+  v1::JobEvent event;
+  for (int i = 0; i < kWatchers; ++i) {
+    contexts.push_back(std::make_unique<grpc::ClientContext>());
+    readers.push_back(service.stub().Watch(contexts.back().get(), request));
+    ASSERT_TRUE(readers.back()->Read(&event));  // open on the server: its "queued" came
+  }
+  const size_t during = threads_of_this_process();
+  EXPECT_LT(during, before + kWatchers / 4)
+      << before << " threads before, " << during << " with " << kWatchers << " watchers";
+  for (int i = 0; i < kWatchers; ++i) {
+    contexts[i]->TryCancel();
+    readers[i]->Finish();
+  }
+}
+
 }  // namespace
 }  // namespace labelmesh

@@ -1,0 +1,66 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// One Watch stream on gRPC's callback API: the job table hands it each event
+// as it is added and the reactor writes them in order, so a watcher waiting
+// for news holds no thread. A watcher that stops reading is cancelled by the
+// stream watchdog once a write has been outstanding for the idle timeout.
+#pragma once
+
+#include <grpcpp/grpcpp.h>
+
+#include <atomic>
+#include <deque>
+#include <memory>
+#include <mutex>
+#include <string>
+
+#include "labelmesh/v1/service.pb.h"
+#include "server/job_table.h"
+#include "server/stream_limits.h"
+
+namespace labelmesh::server {
+
+class WatchReactor final : public grpc::ServerWriteReactor<v1::JobEvent>,
+                           private JobTable::EventListener {
+ public:
+  // Starts streaming the job's events; the reactor deletes itself when gRPC
+  // is done with it. `slot` holds the stream's place among the client's.
+  static WatchReactor* start(JobTable& table, StreamWatchdog& watchdog, absl::Duration idle_timeout,
+                             grpc::CallbackServerContext* context, std::string job_id,
+                             std::unique_ptr<StreamCounts::Slot> slot);
+
+ private:
+  WatchReactor(JobTable& table, std::string job_id, std::unique_ptr<StreamCounts::Slot> slot);
+
+  void on_event(const v1::JobEvent& event, bool last) override;
+  void on_closed(const absl::Status& status) override;
+  void OnWriteDone(bool ok) override;
+  void OnCancel() override;
+  void OnDone() override;
+
+  // With mutex_ held: starts the next write, or finishes the stream when
+  // nothing is left to write and the end has come.
+  void write_next();
+  void finish(const grpc::Status& status);
+  grpc::Status left_or_stalled() const;
+
+  JobTable& table_;
+  const std::string job_id_;
+  std::unique_ptr<StreamCounts::Slot> slot_;
+  // When the outstanding write started (ns since the epoch), 0 when none:
+  // what the watchdog reads, without a lock.
+  std::atomic<int64_t> write_started_{0};
+  // Declared after what it reads, so that it goes first.
+  std::unique_ptr<StreamWatchdog::Ticket> ticket_;
+
+  std::mutex mutex_;
+  bool listening_ = false;
+  std::deque<v1::JobEvent> pending_;
+  v1::JobEvent writing_;
+  bool write_outstanding_ = false;
+  bool end_queued_ = false;
+  grpc::Status end_status_;
+  bool cancelled_ = false;
+  bool finished_ = false;
+};
+
+}  // namespace labelmesh::server
