@@ -1,6 +1,10 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 #include "server/client_identity.h"
 
+#include <arpa/inet.h>
+#include <netinet/in.h>
+
+#include <algorithm>
 #include <fstream>
 
 #include "absl/strings/ascii.h"
@@ -32,6 +36,9 @@ bool is_token_text(std::string_view token) {
   }
   return true;
 }
+
+// Identities the server gives itself: no client may be named so.
+bool is_reserved_name(std::string_view name) { return name == kAnonymous || name == "token"; }
 
 absl::StatusOr<std::string> read_single_token(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
@@ -65,6 +72,7 @@ absl::StatusOr<std::vector<TokenHolder>> read_clients_file(const std::string& pa
     if (fields.size() < 2 || fields.size() > 3) return bad("expected NAME TOKEN [admin]");
     TokenHolder holder{std::string(fields[0]), std::string(fields[1]), false};
     if (!is_identity_name(holder.name)) return bad("the name must be 1-64 of A-Z a-z 0-9 . _ @ -");
+    if (is_reserved_name(holder.name)) return bad("the names 'anonymous' and 'token' are reserved");
     if (!is_token_text(holder.token))
       return bad("the token must be 16 to 256 printable characters");
     if (fields.size() == 3) {
@@ -80,7 +88,28 @@ absl::StatusOr<std::vector<TokenHolder>> read_clients_file(const std::string& pa
   return holders;
 }
 
-absl::Status AuthBackoff::check(const std::string& host, absl::Time now) {
+// The key a host's failures count under: its address, or for IPv6 its /64
+// (one host holds a whole /64 and could step through it).
+std::string backoff_key(const std::string& host) {
+  std::string_view text = host;
+  if (text.substr(0, 5) != "ipv6:") return host;
+  text.remove_prefix(5);
+  std::string address(text);
+  for (const auto& [from, to] : {std::pair<std::string, std::string>{"%5B", "["}, {"%5D", "]"}}) {
+    for (size_t at; (at = address.find(from)) != std::string::npos;) address.replace(at, 3, to);
+  }
+  if (!address.empty() && address.front() == '[') address = address.substr(1);
+  if (const size_t close = address.find(']'); close != std::string::npos) address.resize(close);
+  in6_addr v6{};
+  if (inet_pton(AF_INET6, address.c_str(), &v6) != 1) return host;
+  std::fill(v6.s6_addr + 8, v6.s6_addr + 16, 0);
+  char prefix[INET6_ADDRSTRLEN] = "";
+  inet_ntop(AF_INET6, &v6, prefix, sizeof prefix);
+  return absl::StrCat("ipv6:", prefix, "/64");
+}
+
+absl::Status AuthBackoff::check(const std::string& peer, absl::Time now) {
+  const std::string host = backoff_key(peer);
   std::lock_guard lock(mutex_);
   auto it = hosts_.find(host);
   if (it == hosts_.end() || it->second.blocked_until <= now) return absl::OkStatus();
@@ -89,24 +118,24 @@ absl::Status AuthBackoff::check(const std::string& host, absl::Time now) {
       absl::FormatDuration(absl::Ceil(it->second.blocked_until - now, absl::Seconds(1)))));
 }
 
-void AuthBackoff::failed(const std::string& host, absl::Time now) {
+void AuthBackoff::failed(const std::string& peer, absl::Time now) {
+  const std::string host = backoff_key(peer);
   std::lock_guard lock(mutex_);
   if (hosts_.size() >= kMaxTrackedHosts && hosts_.find(host) == hosts_.end()) {
-    std::erase_if(hosts_, [now](const auto& entry) { return entry.second.blocked_until <= now; });
+    std::erase_if(hosts_, [now](const auto& entry) {
+      return entry.second.blocked_until <= now && now - entry.second.last_failure > kForgetAfter;
+    });
     if (hosts_.size() >= kMaxTrackedHosts) return;
   }
   Host& entry = hosts_[host];
+  if (now - entry.last_failure > kForgetAfter) entry.failures = 0;
+  entry.last_failure = now;
   ++entry.failures;
   const int over = entry.failures - allowed_failures_;
   if (over < 0) return;
   absl::Duration backoff = first_backoff_;
   for (int i = 0; i < over && backoff < longest_backoff_; ++i) backoff *= 2;
   entry.blocked_until = now + std::min(backoff, longest_backoff_);
-}
-
-void AuthBackoff::succeeded(const std::string& host) {
-  std::lock_guard lock(mutex_);
-  hosts_.erase(host);
 }
 
 absl::StatusOr<std::unique_ptr<ClientAuthenticator>> ClientAuthenticator::from_config(
@@ -120,6 +149,11 @@ absl::StatusOr<std::unique_ptr<ClientAuthenticator>> ClientAuthenticator::from_c
   if (!config.auth_token_file.empty()) {
     auto token = read_single_token(config.auth_token_file);
     if (!token.ok()) return token.status();
+    for (const auto& holder : tokens) {
+      if (holder.token == *token)
+        return absl::InvalidArgumentError(
+            "--auth-token-file: the shared token is also a client's token in --clients-file");
+    }
     tokens.push_back({"token", std::move(*token), false});
   }
   std::set<std::string> admins(config.admin_identities.begin(), config.admin_identities.end());
@@ -145,11 +179,6 @@ const TokenHolder* ClientAuthenticator::find_token(std::string_view presented) c
     if (digest::constant_time_equal(presented, holder.token)) found = &holder;
   }
   return found;
-}
-
-bool ClientAuthenticator::is_admin_token(const std::string& name, const std::string& token) const {
-  const TokenHolder* holder = find_token(token);
-  return holder != nullptr && holder->name == name && admins_.count(name) > 0;
 }
 
 absl::StatusOr<ClientIdentity> ClientAuthenticator::identify(
@@ -180,15 +209,16 @@ absl::StatusOr<ClientIdentity> ClientAuthenticator::identify(
     const auto auth = context.auth_context();
     const auto names = auth ? auth->FindPropertyValues(GRPC_X509_CN_PROPERTY_NAME)
                             : std::vector<grpc::string_ref>{};
-    if (names.empty() || !is_identity_name(std::string_view(names[0].data(), names[0].size()))) {
+    const std::string_view common_name =
+        names.empty() ? std::string_view() : std::string_view(names[0].data(), names[0].size());
+    if (!is_identity_name(common_name) || is_reserved_name(common_name)) {
       backoff_.failed(host, now);
       return absl::UnauthenticatedError(
           "the client certificate has no common name usable as an identity "
-          "(1-64 of A-Z a-z 0-9 . _ @ -)");
+          "(1-64 of A-Z a-z 0-9 . _ @ -, not 'anonymous' or 'token')");
     }
     name.assign(names[0].data(), names[0].size());
   }
-  backoff_.succeeded(host);
   return ClientIdentity{name, admins_.count(name) > 0};
 }
 

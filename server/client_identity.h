@@ -39,8 +39,11 @@ struct TokenHolder {
 absl::StatusOr<std::vector<TokenHolder>> read_clients_file(const std::string& path);
 
 // Refuses every call from a host for a while once it failed authentication
-// `allowed_failures` times in a row: first `first_backoff`, doubling with
-// each further failure up to `longest_backoff`. A success clears the host.
+// `allowed_failures` times: first `first_backoff`, doubling with each further
+// failure up to `longest_backoff`. A host's failures are forgotten after
+// `kForgetAfter` without one, not by a success (a client with a token of its
+// own could otherwise guess others' between its own calls). IPv6 hosts
+// count by their /64.
 class AuthBackoff {
  public:
   AuthBackoff(int allowed_failures, absl::Duration first_backoff, absl::Duration longest_backoff)
@@ -51,11 +54,12 @@ class AuthBackoff {
   // RESOURCE_EXHAUSTED while `host` is backed off.
   absl::Status check(const std::string& host, absl::Time now);
   void failed(const std::string& host, absl::Time now);
-  void succeeded(const std::string& host);
+  static constexpr absl::Duration kForgetAfter = absl::Minutes(15);
 
  private:
   struct Host {
     int failures = 0;
+    absl::Time last_failure = absl::InfinitePast();
     absl::Time blocked_until = absl::InfinitePast();
   };
   const int allowed_failures_;
@@ -74,8 +78,6 @@ class ClientAuthenticator {
   // No client authentication at all: every call is `anonymous`.
   bool anonymous() const { return tokens_.empty() && !mutual_tls_; }
   bool has_tokens() const { return !tokens_.empty(); }
-  // The admin token holder `name` with `token`, for the metrics endpoint.
-  bool is_admin_token(const std::string& name, const std::string& token) const;
 
   // The caller's identity; UNAUTHENTICATED for a missing or wrong token,
   // RESOURCE_EXHAUSTED while its host is backed off.

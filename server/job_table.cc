@@ -91,6 +91,16 @@ JobTable::Entry* JobTable::find(const std::string& job_id) {
   return it == jobs_.end() ? nullptr : &it->second;
 }
 
+const JobTable::Entry* JobTable::find_visible(const std::string& job_id) const {
+  const Entry* entry = find(job_id);
+  return entry == nullptr || entry->remove_when_ended ? nullptr : entry;
+}
+
+JobTable::Entry* JobTable::find_visible(const std::string& job_id) {
+  Entry* entry = find(job_id);
+  return entry == nullptr || entry->remove_when_ended ? nullptr : entry;
+}
+
 const JobTable::Entry* JobTable::find(const std::string& job_id) const {
   auto it = jobs_.find(job_id);
   return it == jobs_.end() ? nullptr : &it->second;
@@ -126,7 +136,6 @@ void JobTable::add_event(Entry& entry, v1::JobEvent event) {
   const bool last = has_ended(entry.record.job().state());
   for (EventListener* listener : entry.listeners) listener->on_event(entry.events.back(), last);
   if (last) entry.listeners.clear();
-  events_added_.notify_all();
 }
 
 void JobTable::recover(absl::Duration result_ttl) {
@@ -140,6 +149,12 @@ void JobTable::recover(absl::Duration result_ttl) {
   for (auto& record : records) {
     v1::Job& job = *record.mutable_job();
     const std::string id = job.job_id();
+    if (record.deleted()) {  // deleted by a client while it ran
+      spool_.remove_job(id);
+      continue;
+    }
+    // Results from before attempts had directories of their own.
+    if (job.state() == v1::JOB_STATE_SUCCEEDED) spool_.adopt_output(id, job.attempts());
     // Jobs from before identities belong to the anonymous client: every
     // caller of a server without authentication, only admins otherwise.
     if (job.owner().empty()) job.set_owner(kAnonymous);
@@ -358,14 +373,14 @@ v1::Job JobTable::view(const std::string& job_id, const v1::Job& stored) const {
 
 absl::StatusOr<v1::Job> JobTable::get(const std::string& job_id) const {
   std::lock_guard lock(mutex_);
-  const Entry* entry = find(job_id);
+  const Entry* entry = find_visible(job_id);
   if (entry == nullptr) return absl::NotFoundError(absl::StrCat("no job ", job_id));
   return view(job_id, entry->record.job());
 }
 
 absl::StatusOr<std::string> JobTable::owner(const std::string& job_id) const {
   std::lock_guard lock(mutex_);
-  const Entry* entry = find(job_id);
+  const Entry* entry = find_visible(job_id);
   if (entry == nullptr) return absl::NotFoundError(absl::StrCat("no job ", job_id));
   return entry->record.job().owner();
 }
@@ -386,7 +401,7 @@ absl::StatusOr<JobTable::JobPage> JobTable::list(const JobQuery& query) const {
   std::vector<std::pair<ListPosition, const Entry*>> order;
   for (const auto& [id, entry] : jobs_) {
     const v1::Job& job = entry.record.job();
-    if (!wanted(job)) continue;
+    if (entry.remove_when_ended || !wanted(job)) continue;
     ListPosition position = list_position(job);
     if (after && !(position < *after)) continue;
     order.emplace_back(std::move(position), &entry);
@@ -411,7 +426,9 @@ std::optional<JobTable::PriorRequest> JobTable::find_request(const std::string& 
   std::lock_guard lock(mutex_);
   for (const auto& [id, entry] : jobs_) {
     const v1::JobRecord& record = entry.record;
-    if (record.spec().request_id() != request_id || record.job().owner() != owner) continue;
+    if (entry.remove_when_ended || record.spec().request_id() != request_id ||
+        record.job().owner() != owner)
+      continue;
     const bool queued = record.job().state() == v1::JOB_STATE_QUEUED;
     return PriorRequest{id, record.spec().sha256(), queued ? position_of(id) : 0};
   }
@@ -420,17 +437,22 @@ std::optional<JobTable::PriorRequest> JobTable::find_request(const std::string& 
 
 absl::StatusOr<v1::JobState> JobTable::remove(const std::string& job_id) {
   std::lock_guard lock(mutex_);
-  Entry* entry = find(job_id);
+  Entry* entry = find_visible(job_id);
   if (entry == nullptr) return absl::NotFoundError(absl::StrCat("no job ", job_id));
   const v1::JobState state = entry->record.job().state();
   if (state == v1::JOB_STATE_RUNNING) {
     // The worker still writes in the job's directory: it goes when it stops.
+    // The record says so first, so that a restart meanwhile deletes it too.
+    v1::JobRecord deleted = entry->record;
+    deleted.set_deleted(true);
+    if (auto status = persist(deleted); !status.ok()) return status;
+    entry->record = std::move(deleted);
     entry->cancel_requested = true;
     entry->remove_when_ended = true;
     return state;
   }
-  if (state == v1::JOB_STATE_QUEUED) {
-    queue_.erase(std::find(queue_.begin(), queue_.end(), job_id));
+  if (auto it = std::find(queue_.begin(), queue_.end(), job_id); it != queue_.end()) {
+    queue_.erase(it);
     update_gauges();
   }
   spool_.remove_job(job_id);
@@ -441,7 +463,7 @@ absl::StatusOr<v1::JobState> JobTable::remove(const std::string& job_id) {
 
 absl::StatusOr<v1::Job> JobTable::cancel(const std::string& job_id) {
   std::lock_guard lock(mutex_);
-  Entry* entry = find(job_id);
+  Entry* entry = find_visible(job_id);
   if (entry == nullptr) return absl::NotFoundError(absl::StrCat("no job ", job_id));
   const v1::JobState state = entry->record.job().state();
   if (has_ended(state)) {
@@ -453,7 +475,8 @@ absl::StatusOr<v1::Job> JobTable::cancel(const std::string& job_id) {
   } else {
     // The client hears "cancelled" only once the record says so on disk.
     if (auto status = end_cancelled(*entry, Unsaved::kRefuse); !status.ok()) return status;
-    queue_.erase(std::find(queue_.begin(), queue_.end(), job_id));
+    if (auto it = std::find(queue_.begin(), queue_.end(), job_id); it != queue_.end())
+      queue_.erase(it);
     update_gauges();
   }
   return view(job_id, entry->record.job());
@@ -467,7 +490,7 @@ bool JobTable::cancel_requested(const std::string& job_id) const {
 
 absl::StatusOr<std::vector<v1::Artifact>> JobTable::artifacts(const std::string& job_id) const {
   std::lock_guard lock(mutex_);
-  const Entry* entry = find(job_id);
+  const Entry* entry = find_visible(job_id);
   if (entry == nullptr) return absl::NotFoundError(absl::StrCat("no job ", job_id));
   if (entry->record.job().state() != v1::JOB_STATE_SUCCEEDED) {
     return absl::FailedPreconditionError(absl::StrCat(
@@ -475,29 +498,6 @@ absl::StatusOr<std::vector<v1::Artifact>> JobTable::artifacts(const std::string&
   }
   return std::vector<v1::Artifact>(entry->record.artifacts().begin(),
                                    entry->record.artifacts().end());
-}
-
-absl::StatusOr<JobTable::EventBatch> JobTable::events_since(const std::string& job_id,
-                                                            uint64_t from,
-                                                            absl::Duration wait) const {
-  std::unique_lock lock(mutex_);
-  auto has_news = [&] {
-    const Entry* entry = find(job_id);
-    return closed_ || entry == nullptr ||
-           (!entry->events.empty() && entry->events.back().sequence() >= from);
-  };
-  events_added_.wait_for(lock, absl::ToChronoMilliseconds(wait), has_news);
-  const Entry* entry = find(job_id);
-  if (entry == nullptr) return absl::NotFoundError(absl::StrCat("no job ", job_id));
-  EventBatch batch;
-  for (const auto& event : entry->events) {
-    if (event.sequence() >= from) batch.events.push_back(event);
-  }
-  batch.ended = has_ended(entry->record.job().state());
-  if (closed_ && !batch.ended && batch.events.empty()) {
-    return absl::UnavailableError("the server is shutting down");
-  }
-  return batch;
 }
 
 std::vector<std::string> JobTable::expire(absl::Duration result_ttl, size_t max_ended) {
@@ -522,7 +522,6 @@ std::vector<std::string> JobTable::expire(absl::Duration result_ttl, size_t max_
     removed.push_back(id);
     erase_entry(id);
   }
-  if (!removed.empty()) events_added_.notify_all();
   return removed;
 }
 
@@ -532,12 +531,11 @@ void JobTable::erase_entry(const std::string& job_id) {
   const absl::Status gone = absl::NotFoundError(absl::StrCat("job ", job_id, " was deleted"));
   for (EventListener* listener : it->second.listeners) listener->on_closed(gone);
   jobs_.erase(it);
-  events_added_.notify_all();
 }
 
 absl::Status JobTable::listen(const std::string& job_id, uint64_t from, EventListener* listener) {
   std::lock_guard lock(mutex_);
-  Entry* entry = find(job_id);
+  Entry* entry = find_visible(job_id);
   if (entry == nullptr) return absl::NotFoundError(absl::StrCat("no job ", job_id));
   const bool ended = has_ended(entry->record.job().state());
   if (closed_ && !ended) return absl::UnavailableError("the server is shutting down");
@@ -569,7 +567,6 @@ void JobTable::close() {
     entry.listeners.clear();
   }
   queue_changed_.notify_all();
-  events_added_.notify_all();
 }
 
 void JobTable::stop_dispatch() {

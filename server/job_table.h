@@ -88,16 +88,6 @@ class JobTable {
   // FAILED_PRECONDITION unless the job succeeded.
   absl::StatusOr<std::vector<v1::Artifact>> artifacts(const std::string& job_id) const;
 
-  struct EventBatch {
-    std::vector<v1::JobEvent> events;
-    // The job ended and `events` holds everything up to its end.
-    bool ended = false;
-  };
-  // Events with sequence >= `from`, waiting up to `wait` for one to come.
-  // UNAVAILABLE after close().
-  absl::StatusOr<EventBatch> events_since(const std::string& job_id, uint64_t from,
-                                          absl::Duration wait) const;
-
   // Told of a job's events as they are added, with no thread of its own.
   // Called with the table locked: it must not call the table back.
   class EventListener {
@@ -135,6 +125,9 @@ class JobTable {
 
   Entry* find(const std::string& job_id);
   const Entry* find(const std::string& job_id) const;
+  // As clients see the table: a job deleted while it runs is gone already.
+  Entry* find_visible(const std::string& job_id);
+  const Entry* find_visible(const std::string& job_id) const;
   // Appends an event (sequence and time set here) and wakes watchers.
   void add_event(Entry& entry, v1::JobEvent event);
   // Saves to the spool; a failure is logged and counted, and returned.
@@ -163,7 +156,6 @@ class JobTable {
 
   mutable std::mutex mutex_;
   std::condition_variable queue_changed_;
-  mutable std::condition_variable events_added_;
   std::map<std::string, Entry> jobs_;
   std::deque<std::string> queue_;
   size_t running_ = 0;

@@ -81,17 +81,7 @@ absl::StatusOr<std::unique_ptr<LabelmeshServer>> LabelmeshServer::start(ServerCo
 
   server->metrics_ = std::make_unique<Metrics>(c.queue_capacity);
   if (!c.metrics_listen.empty()) {
-    // Behind tokens, /metrics asks for an admin's name and token (basic auth).
-    Metrics::BasicAuth authorize;
-    if (server->authenticator_->has_tokens()) {
-      authorize = [a = server->authenticator_.get()](const std::string& user,
-                                                     const std::string& password) {
-        return a->is_admin_token(user, password);
-      };
-    }
-    if (auto status = server->metrics_->expose(c.metrics_listen, std::move(authorize));
-        !status.ok())
-      return status;
+    if (auto status = server->metrics_->expose(c.metrics_listen); !status.ok()) return status;
   }
   auto spool = Spool::open(c.spool_dir);
   if (!spool.ok()) return spool.status();

@@ -338,9 +338,23 @@ grpc::Status MeshingService::submit(grpc::ServerContext& context,
   }
   // VTK XML arrays (base64, appended, compressed blocks) are decoded only by
   // VTK's reader, which the server does not link: a worker reads them.
+  // Progress for the watchdog is the reader's, and a client that leaves
+  // stops it; one reader at a time, so that uploads cannot multiply the
+  // worker memory limit outside the pool.
   if (extension == ".vti") {
+    auto keep_going = [&] {
+      ticket->touch();
+      return !context.IsCancelled();
+    };
+    std::unique_lock reading(volume_reader_, std::defer_lock);
+    while (!reading.try_lock_for(std::chrono::milliseconds(500))) {
+      if (!keep_going()) {
+        reason = "stalled";
+        return grpc::Status(grpc::StatusCode::CANCELLED, "the client left");
+      }
+    }
     auto read = check_volume_in_worker(worker_executable(config_), upload.path(), voxel_limit,
-                                       config_.worker_memory_bytes, kVolumeCheckTime);
+                                       config_.worker_memory_bytes, kVolumeCheckTime, keep_going);
     if (!read.ok()) {
       reason = "bad_volume";
       return to_grpc(read);
@@ -362,6 +376,11 @@ grpc::Status MeshingService::submit(grpc::ServerContext& context,
   spec.set_file_name(absl::StrCat("upload", extension));
   *record.mutable_spec() = spec;
   record.set_input_extension(extension);
+  // A client that left (or the watchdog dropped) hears nothing: no job.
+  if (context.IsCancelled()) {
+    reason = "stalled";
+    return stalled_or(*ticket, grpc::Status(grpc::StatusCode::CANCELLED, "the client left"));
+  }
   auto position = table_.accept(std::move(record), upload.path());
   if (!position.ok()) {
     if (position.status().code() == absl::StatusCode::kResourceExhausted) {

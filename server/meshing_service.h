@@ -75,6 +75,8 @@ class MeshingService final
   // Submits in progress by (owner, request_id), so that a retry that races
   // its first try waits instead of making a second job.
   std::mutex requests_mutex_;
+  // Held while a worker reads an upload the server cannot decode itself.
+  std::timed_mutex volume_reader_;
   std::set<std::pair<std::string, std::string>> requests_in_flight_;
   std::atomic<bool> accepting_{true};
   std::atomic<int> uploads_{0};

@@ -93,7 +93,7 @@ Metrics::Metrics(int queue_capacity) : registry_(std::make_shared<prometheus::Re
 
 Metrics::~Metrics() = default;
 
-absl::Status Metrics::expose(const std::string& address, BasicAuth authorize) {
+absl::Status Metrics::expose(const std::string& address) {
   try {
     static CivetCallbacks callbacks = [] {
       CivetCallbacks c{};
@@ -108,7 +108,6 @@ absl::Status Metrics::expose(const std::string& address, BasicAuth authorize) {
     return absl::InvalidArgumentError(
         absl::StrCat("--metrics-listen: cannot serve on ", address, ": ", e.what()));
   }
-  if (authorize) exposer_->RegisterAuth(std::move(authorize), "labelmesh metrics");
   exposer_->RegisterCollectable(registry_);
   return absl::OkStatus();
 }

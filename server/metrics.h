@@ -3,7 +3,6 @@
 #pragma once
 
 #include <cstdint>
-#include <functional>
 #include <memory>
 #include <string>
 
@@ -21,11 +20,8 @@ class Metrics {
   explicit Metrics(int queue_capacity);
   ~Metrics();
 
-  // Checks an HTTP basic-auth user and password.
-  using BasicAuth = std::function<bool(const std::string& user, const std::string& password)>;
-  // Serves /metrics on `address`, behind basic authentication when
-  // `authorize` is set. Errors: INVALID_ARGUMENT when it cannot bind.
-  absl::Status expose(const std::string& address, BasicAuth authorize = nullptr);
+  // Serves /metrics on `address`. Errors: INVALID_ARGUMENT when it cannot bind.
+  absl::Status expose(const std::string& address);
   // The port /metrics is served on (0 before expose()).
   int port() const;
   // The text exposition format of every metric (what /metrics returns).

@@ -90,8 +90,9 @@ struct ServerConfig {
 };
 
 // INVALID_ARGUMENT naming the flag at fault: ranges, TLS files in pairs, a
-// non-loopback address without TLS or --insecure, and a non-loopback address
-// (gRPC or metrics) without client authentication or --allow-anonymous.
+// non-loopback address without TLS or --insecure, a non-loopback gRPC address
+// without client authentication or --allow-anonymous, and a non-loopback
+// metrics address without --allow-anonymous.
 absl::Status validate_config(const ServerConfig& config);
 
 // True for addresses whose host is 127.0.0.0/8, ::1 (also as

@@ -159,6 +159,12 @@ absl::Status Spool::reset_output(const std::string& job_id, uint32_t attempt) co
   return absl::OkStatus();
 }
 
+void Spool::adopt_output(const std::string& job_id, uint32_t attempt) const {
+  const fs::path old = fs::path(job_dir(job_id)) / "out";
+  std::error_code error;
+  if (fs::is_directory(old, error)) fs::rename(old, output_dir(job_id, attempt), error);
+}
+
 absl::StatusOr<std::vector<v1::Artifact>> Spool::collect_artifacts(const std::string& job_id,
                                                                    uint32_t attempt) const {
   std::vector<v1::Artifact> artifacts;

@@ -50,6 +50,9 @@ class Spool {
   // Before an attempt: removes the output of earlier attempts and makes an
   // empty one for this attempt.
   absl::Status reset_output(const std::string& job_id, uint32_t attempt) const;
+  // Moves the results of a spool written before attempts had directories
+  // of their own (out/) to the attempt's (out-<n>/).
+  void adopt_output(const std::string& job_id, uint32_t attempt) const;
   // Every regular file of the attempt's output, with size and SHA-256,
   // sorted by name.
   absl::StatusOr<std::vector<v1::Artifact>> collect_artifacts(const std::string& job_id,

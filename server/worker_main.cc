@@ -10,6 +10,7 @@
 
 #include <fcntl.h>
 #include <sys/prctl.h>
+#include <unistd.h>
 #include <filesystem>
 #include <fstream>
 #include <new>
@@ -133,7 +134,7 @@ int check_volume(const std::string& path, const std::string& max_voxels) {
   }
   if (status.ok()) return 0;
   const std::string message(status.message());
-  std::fwrite(message.data(), 1, message.size(), stdout);
+  (void)!::write(3, message.data(), message.size());
   return 1;
 }
 
@@ -158,7 +159,8 @@ int main(int argc, char** argv) {
     std::printf("%s\n", labelmesh::server::kWorkerVersionLine);
     return 0;
   }
-  if (argc == 4 && std::string_view(argv[1]) == labelmesh::server::kCheckVolumeMode) {
+  if (argc == 4 && std::string_view(argv[1]) == labelmesh::server::kCheckVolumeMode &&
+      fcntl(3, F_GETFD) != -1) {
     return labelmesh::server::check_volume(argv[2], argv[3]);
   }
   // Only labelmeshd starts it, with the event pipe as descriptor 3: refuse

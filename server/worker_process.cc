@@ -321,37 +321,47 @@ absl::Status check_worker_version(const std::string& executable,
 
 absl::Status check_volume_in_worker(const std::string& executable, const std::string& path,
                                     uint64_t max_voxels, uint64_t memory_bytes,
-                                    std::chrono::milliseconds time_limit) {
+                                    std::chrono::milliseconds time_limit,
+                                    const std::function<bool()>& keep_going) {
   int out[2];
-  if (pipe2(out, O_CLOEXEC) != 0) return absl::InternalError("cannot create a pipe");
+  if (pipe2(out, O_CLOEXEC) != 0) return absl::UnavailableError("cannot create a pipe");
+  const int null_fd = ::open("/dev/null", O_RDWR | O_CLOEXEC);
   std::string program = executable, mode = kCheckVolumeMode, file = path,
               voxels = std::to_string(max_voxels);
   std::vector<char*> argv{program.data(), mode.data(), file.data(), voxels.data(), nullptr};
-  const rlim_t cpu_seconds = static_cast<rlim_t>(time_limit.count() / 1000 + 1);
+  // The same child as a job's: its answer comes on descriptor 3, its
+  // stdout and stderr (VTK's messages) go nowhere.
+  ChildSetup setup{.server_pid = getpid(),
+                   .event_write_fd = out[1],
+                   .log_fd = null_fd,
+                   .null_fd = null_fd,
+                   .limits = {.memory_bytes = memory_bytes,
+                              .cpu_seconds = uint64_t(time_limit.count() / 1000 + 1)},
+                   .environment = environ};
   const pid_t pid = fork();
-  if (pid < 0) return absl::InternalError("cannot start a worker to check the upload");
-  if (pid == 0) {
-    prctl(PR_SET_PDEATHSIG, SIGKILL);
-    dup2(out[1], STDOUT_FILENO);
-    if (memory_bytes > 0) {
-      const rlimit memory{memory_bytes, memory_bytes};
-      setrlimit(RLIMIT_AS, &memory);
-    }
-    const rlimit cpu{cpu_seconds, cpu_seconds};
-    setrlimit(RLIMIT_CPU, &cpu);
-    execv(argv[0], argv.data());
-    _exit(127);
-  }
+  if (pid == 0) exec_child(setup, argv.data());
   ::close(out[1]);
+  ::close(null_fd);
+  if (pid < 0) {
+    ::close(out[0]);
+    return absl::UnavailableError("cannot start a worker to read the upload; try again later");
+  }
   const auto deadline = std::chrono::steady_clock::now() + time_limit;
   std::string printed;
   char buffer[512];
+  bool stopped = false;
   while (printed.size() < 4096) {
+    if (!keep_going()) {
+      stopped = true;
+      break;
+    }
     const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
         deadline - std::chrono::steady_clock::now());
     pollfd readable{.fd = out[0], .events = POLLIN, .revents = 0};
-    const int ready = left.count() > 0 ? ::poll(&readable, 1, int(left.count())) : 0;
+    const int ready =
+        left.count() > 0 ? ::poll(&readable, 1, int(std::min<int64_t>(left.count(), 500))) : 0;
     if (ready < 0 && errno == EINTR) continue;
+    if (ready == 0 && left.count() > 500) continue;
     if (ready <= 0) break;
     const ssize_t n = ::read(out[0], buffer, sizeof buffer);
     if (n < 0 && errno == EINTR) continue;
@@ -360,23 +370,23 @@ absl::Status check_volume_in_worker(const std::string& executable, const std::st
   }
   ::close(out[0]);
   int status = 0;
-  if (!exited_before(pid, deadline, status)) {
-    return absl::DeadlineExceededError(absl::StrCat("upload: reading the volume took longer than ",
-                                                    time_limit.count() / 1000, " s"));
+  const bool exited =
+      exited_before(pid, stopped ? std::chrono::steady_clock::now() : deadline, status);
+  if (stopped) return absl::CancelledError("upload: the client left while the volume was read");
+  if (!exited) {
+    return absl::ResourceExhaustedError(absl::StrCat("upload: reading the volume took longer than ",
+                                                     time_limit.count() / 1000, " s"));
   }
   if (WIFEXITED(status) && WEXITSTATUS(status) == 0) return absl::OkStatus();
   if (WIFEXITED(status) && WEXITSTATUS(status) == 1) {
     return absl::InvalidArgumentError(
         absl::StrReplaceAll(printed.substr(0, 4096), {{path, "upload"}}));
   }
-  if (WIFSIGNALED(status) && WTERMSIG(status) == SIGXCPU) {
-    return absl::DeadlineExceededError("upload: reading the volume ran over its CPU time");
-  }
-  // Killed by the memory limit (an allocation failing where nothing catches
-  // it) or crashed: either way the job could not run.
-  return absl::InvalidArgumentError(absl::StrCat(
-      "upload: the volume could not be read within the worker's limits (",
-      WIFSIGNALED(status) ? absl::StrCat("signal ", WTERMSIG(status)) : "exit status", ")"));
+  // Over the memory or CPU limit (an allocation failing where nothing
+  // catches it, SIGXCPU) or crashed: a job on it could not run either.
+  return absl::ResourceExhaustedError(absl::StrCat(
+      "upload: the volume could not be read within a worker's memory and time limits (",
+      WIFSIGNALED(status) ? signal_description(WTERMSIG(status)) : "exit status", ")"));
 }
 
 int kill_stale_workers(const std::string& spool_root) {

@@ -61,7 +61,8 @@ struct WorkerRun {
 // The first argument of a worker started for a job.
 inline constexpr char kWorkerMode[] = "--worker";
 // `labelmesh-worker --check-volume FILE MAX_VOXELS`: reads the whole volume
-// with the readers a job uses, prints why it cannot be read, exits 0 if it can.
+// with the readers a job uses, writes why it cannot be read to descriptor 3,
+// exits 0 if it can.
 inline constexpr char kCheckVolumeMode[] = "--check-volume";
 // What `labelmesh-worker --version` prints, and what the server expects.
 inline constexpr char kWorkerVersionLine[] = "labelmesh-worker " LABELMESH_VERSION;
@@ -75,12 +76,13 @@ std::string worker_executable(const ServerConfig& config);
 // Reads an uploaded volume whole in a worker process (the server links no
 // image library), under the worker memory limit and `time_limit`: the
 // payloads the server cannot decode itself (VTK XML arrays) are checked
-// before a job is accepted. INVALID_ARGUMENT with the reader's message
-// (paths named "upload"), RESOURCE_EXHAUSTED over the memory limit,
-// DEADLINE_EXCEEDED over the time.
+// before a job is accepted. `keep_going` is asked twice a second; false
+// kills the reader (CANCELLED). INVALID_ARGUMENT with the reader's message
+// (paths named "upload"); RESOURCE_EXHAUSTED over the memory or time limit.
 absl::Status check_volume_in_worker(const std::string& executable, const std::string& path,
                                     uint64_t max_voxels, uint64_t memory_bytes,
-                                    std::chrono::milliseconds time_limit);
+                                    std::chrono::milliseconds time_limit,
+                                    const std::function<bool()>& keep_going);
 
 // Kills the workers of an earlier server on the same spool that are still
 // running (a server killed before its workers could see it go), so that

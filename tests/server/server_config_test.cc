@@ -47,12 +47,13 @@ TEST(ServerConfigRules, ANonLoopbackAddressNeedsClientAuthenticationOrAllowAnony
   EXPECT_TRUE(server::validate_config(config).ok());
 }
 
-TEST(ServerConfigRules, NonLoopbackMetricsNeedAdminTokensOrAllowAnonymous) {
+TEST(ServerConfigRules, NonLoopbackMetricsNeedAllowAnonymous) {
   server::ServerConfig config;
   config.metrics_listen = "0.0.0.0:9464";
   EXPECT_NE(server::validate_config(config).message().find("--metrics-listen"), std::string::npos);
+  // Client tokens do not guard /metrics (plain HTTP): still refused.
   config.clients_file = "clients";
-  EXPECT_TRUE(server::validate_config(config).ok());
+  EXPECT_NE(server::validate_config(config).message().find("--metrics-listen"), std::string::npos);
   config.clients_file.clear();
   config.allow_anonymous = true;
   EXPECT_TRUE(server::validate_config(config).ok());
@@ -79,6 +80,8 @@ TEST(ClientsFile, ListsNamedTokensAndRefusesWhatIsAmbiguous) {
       {"alice a-token-0123456789ab\nbob a-token-0123456789ab\n", "two clients"},
       {"al/ice a-token-0123456789ab\n", "the name"},
       {"alice a-token-0123456789ab root\n", "'admin'"},
+      {"anonymous a-token-0123456789ab\n", "reserved"},
+      {"alice a-token-0123456789ab\nbob short-token\n", "16 to 256"},
       {"# nobody\n", "no client"},
   };
   for (const auto& [text, why] : bad) {
@@ -91,7 +94,7 @@ TEST(ClientsFile, ListsNamedTokensAndRefusesWhatIsAmbiguous) {
   }
 }
 
-TEST(AuthBackoff, DoublesUpToTheLongestAndClearsOnSuccess) {
+TEST(AuthBackoff, DoublesUpToTheLongestAndForgetsOnlyWithTime) {
   server::AuthBackoff backoff(2, absl::Seconds(1), absl::Seconds(3));
   const absl::Time t0 = absl::FromUnixSeconds(1'000'000);
   backoff.failed("ipv4:10.0.0.7", t0);
@@ -106,9 +109,15 @@ TEST(AuthBackoff, DoublesUpToTheLongestAndClearsOnSuccess) {
   for (int i = 0; i < 5; ++i) backoff.failed("ipv4:10.0.0.7", t0);  // capped at 3 s
   EXPECT_FALSE(backoff.check("ipv4:10.0.0.7", t0 + absl::Milliseconds(2900)).ok());
   EXPECT_TRUE(backoff.check("ipv4:10.0.0.7", t0 + absl::Seconds(3)).ok());
-  backoff.succeeded("ipv4:10.0.0.7");
-  backoff.failed("ipv4:10.0.0.7", t0);
-  EXPECT_TRUE(backoff.check("ipv4:10.0.0.7", t0).ok());
+  // Failures are forgotten a while after the last one.
+  const absl::Time later = t0 + server::AuthBackoff::kForgetAfter + absl::Seconds(1);
+  backoff.failed("ipv4:10.0.0.7", later);
+  EXPECT_TRUE(backoff.check("ipv4:10.0.0.7", later).ok());
+  // IPv6 hosts count by their /64: stepping through it does not help.
+  backoff.failed("ipv6:[2001:db8:1:2::10]", t0);
+  backoff.failed("ipv6:%5B2001:db8:1:2::11%5D", t0);
+  EXPECT_FALSE(backoff.check("ipv6:[2001:db8:1:2::12]", t0).ok());
+  EXPECT_TRUE(backoff.check("ipv6:[2001:db8:1:3::12]", t0).ok());
 }
 
 TEST(AuditLine, IsOneJsonObjectWithEveryCharacterEscaped) {
