@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <memory>
 
 #include "core/util/text.h"
 #include "core/volume/header_checks.h"
@@ -43,7 +44,8 @@ absl::StatusOr<std::unique_ptr<PayloadStream>> PayloadStream::open(const std::st
       stream->zstream_.reset();
       return absl::InternalError("zlib could not start a decoder");
     }
-    stream->input_.resize(kChunk);
+    // No larger than the encoded bytes: a small file needs no megabyte.
+    stream->input_.resize(std::clamp<uint64_t>(stream->encoded_left_, 1, kChunk));
   }
   return stream;
 }
@@ -98,10 +100,12 @@ absl::StatusOr<uint64_t> PayloadStream::read(char* out, uint64_t n) {
 }
 
 absl::StatusOr<uint64_t> PayloadStream::skip(uint64_t n) {
-  std::vector<char> sink(static_cast<size_t>(std::min<uint64_t>(n, kChunk)));
+  // Left uninitialised: only the pages the decoder writes are touched.
+  const auto sink_size = static_cast<size_t>(std::min<uint64_t>(n, kChunk));
+  const auto sink = std::make_unique_for_overwrite<char[]>(sink_size);
   uint64_t skipped = 0;
   while (skipped < n) {
-    auto got = read(sink.data(), std::min<uint64_t>(n - skipped, sink.size()));
+    auto got = read(sink.get(), std::min<uint64_t>(n - skipped, sink_size));
     if (!got.ok()) return got.status();
     if (*got == 0) break;
     skipped += *got;

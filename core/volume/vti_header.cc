@@ -110,6 +110,9 @@ absl::StatusOr<VolumeHeader> check_vti_header(const std::string& path, const Rea
       g.origin[row] += g.direction[3 * row + axis] * (*extent)[2 * axis] * g.spacing[axis];
     }
   }
+  // A far extent start times a large spacing can leave the finite doubles.
+  if (auto s = check_finite(path, "Origin/WholeExtent/Spacing", g.origin.data(), 3); !s.ok())
+    return s;
 
   const size_t point_data = xml.find("<PointData");
   if (point_data == std::string_view::npos) {

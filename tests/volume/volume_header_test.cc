@@ -192,6 +192,11 @@ std::vector<BrokenFile> corpus() {
        "<PointData><DataArray type=\"UInt8\" "
        "NumberOfComponents=\"3\"/></PointData></ImageData></VTKFile>",
        false, bad, "NumberOfComponents"},
+      {"VtiOriginOverflows", "far.vti",
+       "<VTKFile type=\"ImageData\"><ImageData WholeExtent=\"-1e12 -1e12 0 0 0 0\" "
+       "Spacing=\"1e300 1 1\"><PointData><DataArray type=\"UInt8\"/></PointData></ImageData>"
+       "</VTKFile>",
+       false, bad, "Origin"},
       {"UnknownExtension", "volume.dcm", "DICM", false, bad, "extension"},
   };
   return files;
