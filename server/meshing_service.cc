@@ -26,28 +26,6 @@ grpc::Status invalid(const std::string& message) {
   return to_grpc(absl::InvalidArgumentError(message));
 }
 
-const char* code_name(grpc::StatusCode code) {
-  static const char* const kNames[] = {"OK",
-                                       "CANCELLED",
-                                       "UNKNOWN",
-                                       "INVALID_ARGUMENT",
-                                       "DEADLINE_EXCEEDED",
-                                       "NOT_FOUND",
-                                       "ALREADY_EXISTS",
-                                       "PERMISSION_DENIED",
-                                       "RESOURCE_EXHAUSTED",
-                                       "FAILED_PRECONDITION",
-                                       "ABORTED",
-                                       "OUT_OF_RANGE",
-                                       "UNIMPLEMENTED",
-                                       "INTERNAL",
-                                       "UNAVAILABLE",
-                                       "DATA_LOSS",
-                                       "UNAUTHENTICATED"};
-  const int index = static_cast<int>(code);
-  return index >= 0 && index <= 16 ? kNames[index] : "UNKNOWN";
-}
-
 // An unknown or malformed id is NOT_FOUND; only well-formed ids reach paths.
 grpc::Status check_job_id(const std::string& job_id) {
   if (is_job_id(job_id)) return grpc::Status::OK;
@@ -153,7 +131,7 @@ absl::StatusOr<ClientIdentity> MeshingService::identify(const grpc::ServerContex
   audit_.record({.event = "unauthenticated",
                  .peer = peer_host(context.peer()),
                  .call = call,
-                 .code = code_name(static_cast<grpc::StatusCode>(identity.status().code())),
+                 .code = absl::StatusCodeToString(identity.status().code()),
                  .reason = "bad_credentials"});
   return identity;
 }
@@ -245,7 +223,7 @@ grpc::Status MeshingService::Submit(grpc::ServerContext* context,
     if (reason.empty()) reason = "refused";
     metrics_.rejected(reason);
     entry.event = "refused";
-    entry.code = code_name(status.error_code());
+    entry.code = absl::StatusCodeToString(static_cast<absl::StatusCode>(status.error_code()));
     entry.reason = reason;
   }
   audit_.record(entry);

@@ -46,6 +46,43 @@ bool exited_before(pid_t pid, std::chrono::steady_clock::time_point deadline, in
   return false;
 }
 
+// What a child writes on `fd`, read until it closes it, `limit` bytes have
+// come, `deadline` passes or `keep_going` (asked at least twice a second)
+// says stop.
+struct ChildOutput {
+  std::string text;
+  bool closed = false;
+  bool stopped = false;
+};
+
+ChildOutput read_child_output(
+    int fd, std::chrono::steady_clock::time_point deadline, size_t limit,
+    const std::function<bool()>& keep_going = [] { return true; }) {
+  ChildOutput output;
+  char buffer[512];
+  while (output.text.size() < limit) {
+    if (!keep_going()) {
+      output.stopped = true;
+      break;
+    }
+    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
+        deadline - std::chrono::steady_clock::now());
+    if (left.count() <= 0) break;
+    pollfd readable{.fd = fd, .events = POLLIN, .revents = 0};
+    const int ready = ::poll(&readable, 1, int(std::min<int64_t>(left.count(), 500)));
+    if (ready == 0 || (ready < 0 && errno == EINTR)) continue;
+    if (ready < 0) break;
+    const ssize_t n = ::read(fd, buffer, sizeof buffer);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      output.closed = n == 0;
+      break;
+    }
+    output.text.append(buffer, size_t(n));
+  }
+  return output;
+}
+
 struct ChildSetup {
   pid_t server_pid;
   int event_write_fd;
@@ -276,24 +313,9 @@ absl::Status check_worker_version(const std::string& executable,
   // A worker that hangs must not hang the server's start: it is killed once
   // its time to answer is over.
   const auto deadline = std::chrono::steady_clock::now() + answer_time;
-  std::string printed;
-  bool answered = false;
-  char buffer[256];
-  while (pid > 0 && printed.size() < 4096) {
-    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
-        deadline - std::chrono::steady_clock::now());
-    pollfd readable{.fd = out[0], .events = POLLIN, .revents = 0};
-    const int ready = left.count() > 0 ? ::poll(&readable, 1, int(left.count())) : 0;
-    if (ready < 0 && errno == EINTR) continue;
-    if (ready <= 0) break;
-    const ssize_t n = ::read(out[0], buffer, sizeof buffer);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) {
-      answered = n == 0;
-      break;
-    }
-    printed.append(buffer, size_t(n));
-  }
+  const ChildOutput output = pid > 0 ? read_child_output(out[0], deadline, 4096) : ChildOutput{};
+  const std::string& printed = output.text;
+  bool answered = output.closed;
   ::close(out[0]);
   int status = 0;
   // Whoever prints more than a version line is not our worker: no waiting.
@@ -347,27 +369,9 @@ absl::Status check_volume_in_worker(const std::string& executable, const std::st
     return absl::UnavailableError("cannot start a worker to read the upload; try again later");
   }
   const auto deadline = std::chrono::steady_clock::now() + time_limit;
-  std::string printed;
-  char buffer[512];
-  bool stopped = false;
-  while (printed.size() < 4096) {
-    if (!keep_going()) {
-      stopped = true;
-      break;
-    }
-    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
-        deadline - std::chrono::steady_clock::now());
-    pollfd readable{.fd = out[0], .events = POLLIN, .revents = 0};
-    const int ready =
-        left.count() > 0 ? ::poll(&readable, 1, int(std::min<int64_t>(left.count(), 500))) : 0;
-    if (ready < 0 && errno == EINTR) continue;
-    if (ready == 0 && left.count() > 500) continue;
-    if (ready <= 0) break;
-    const ssize_t n = ::read(out[0], buffer, sizeof buffer);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) break;
-    printed.append(buffer, size_t(n));
-  }
+  const ChildOutput output = read_child_output(out[0], deadline, 4096, keep_going);
+  const std::string& printed = output.text;
+  const bool stopped = output.stopped;
   ::close(out[0]);
   int status = 0;
   const bool exited =
