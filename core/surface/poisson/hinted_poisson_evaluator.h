@@ -18,6 +18,7 @@
 
 #include "core/surface/cgal/cgal_mesh.h"
 #include "core/surface/poisson/poisson_kernel.h"
+#include "core/surface/poisson/time_stamped_bases.h"
 #include "core/util/run_context.h"
 
 namespace labelmesh::surface::poisson {

@@ -21,6 +21,7 @@
 #include <Eigen/IterativeLinearSolvers>
 
 #include "core/surface/poisson/poisson_kernel.h"
+#include "core/surface/poisson/time_stamped_bases.h"
 #include "core/util/run_context.h"
 
 namespace labelmesh::surface::poisson {
@@ -97,6 +98,14 @@ std::vector<typename Triangulation::Vertex_handle> along_hilbert_curve(const Tri
 }
 
 }  // namespace labelmesh::surface::poisson
+
+// The solve's triangulation must take the time-stamped bases, or its orders
+// follow heap addresses again.
+static_assert(CGAL::internal::Has_timestamp<CGAL::Poisson_reconstruction_function<
+                      labelmesh::surface::poisson::StopAwareKernel>::Triangulation::Cell>::value &&
+                  CGAL::internal::Has_timestamp<CGAL::Poisson_reconstruction_function<
+                      labelmesh::surface::poisson::StopAwareKernel>::Triangulation::Vertex>::value,
+              "the Poisson triangulation lost its creation stamps");
 
 // CGAL's solve_poisson for this solver: CGAL's linear system (cotangent
 // weights as Voronoi face area over edge length; on the right the
