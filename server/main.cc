@@ -82,6 +82,11 @@ void add_server_flags(CLI::App& app, ServerConfig& c) {
                      "Free spool disk space kept for running jobs; uploads into it are refused")
           ->capture_default_str(),
       "LABELMESHD_SPOOL_RESERVE_BYTES");
+  env(app.add_option("--max-job-output-bytes", c.max_job_output_bytes,
+                     "Most a job may write; an upload the spool cannot hold with this much output "
+                     "is refused (0: no limit)")
+          ->capture_default_str(),
+      "LABELMESHD_MAX_JOB_OUTPUT_BYTES");
   env(app.add_option("--max-voxels", c.max_voxels, "Largest volume, voxels")->capture_default_str(),
       "LABELMESHD_MAX_VOXELS");
   env(app.add_option("--max-concurrent-uploads", c.max_concurrent_uploads,

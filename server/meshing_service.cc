@@ -149,11 +149,14 @@ grpc::Status MeshingService::authorize(const ClientIdentity& identity,
 absl::Status MeshingService::check_spool_space(uint64_t upload_bytes) const {
   auto free = spool_.free_bytes();
   if (!free.ok()) return free.status();
-  if (*free < config_.spool_reserve_bytes + upload_bytes) {
-    return absl::ResourceExhaustedError(
-        absl::StrCat("spool disk full: ", *free, " bytes free, an upload of ", upload_bytes,
-                     " bytes would leave less than the reserve of ", config_.spool_reserve_bytes,
-                     "; try again later"));
+  // The job's results must fit too; what they will come to is not known
+  // before the job runs, so its output limit stands for them.
+  const uint64_t outputs = config_.max_job_output_bytes;
+  if (*free < config_.spool_reserve_bytes + upload_bytes + outputs) {
+    return absl::ResourceExhaustedError(absl::StrCat(
+        "spool disk full: ", *free, " bytes free, an upload of ", upload_bytes,
+        " bytes and results of up to ", outputs, " bytes would leave less than the reserve of ",
+        config_.spool_reserve_bytes, "; try again later"));
   }
   return absl::OkStatus();
 }

@@ -34,6 +34,11 @@ struct ServerConfig {
   // refused ("spool disk full") and health reports NOT_SERVING meanwhile, so
   // that running jobs can still write their results and records.
   uint64_t spool_reserve_bytes = uint64_t{512} << 20;
+  // Most a job may write: no result file grows past it (nor past the free
+  // space over the reserve when the job starts), and results larger in all
+  // fail the job. Submit refuses an upload the spool could not hold together
+  // with this much output. 0: no limit.
+  uint64_t max_job_output_bytes = uint64_t{2} << 30;
   uint64_t max_voxels = uint64_t{1} << 31;
   int max_concurrent_uploads = 8;
   // Streams (Submit, Watch, Fetch) one client host and all clients may hold

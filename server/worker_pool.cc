@@ -56,6 +56,12 @@ void WorkerPool::run_job(const v1::JobRecord& record) {
       config_.worker_cpu_seconds > 0
           ? config_.worker_cpu_seconds
           : static_cast<uint64_t>(2 * absl::ToDoubleSeconds(config_.job_timeout)) + 1;
+  auto room = output_room();
+  if (!room.ok()) {
+    table_.fail(id, static_cast<int>(room.status().code()), std::string(room.status().message()));
+    return;
+  }
+  run.limits.output_file_bytes = *room;
   run.deadline = absl::Now() + config_.job_timeout;
   run.on_event = [this, &id](v1::JobEvent event) { table_.publish(id, std::move(event)); };
   run.stop_request = [this, &id] {
@@ -67,7 +73,10 @@ void WorkerPool::run_job(const v1::JobRecord& record) {
   switch (outcome.kind) {
     case WorkerOutcome::Kind::kSucceeded: {
       auto artifacts = spool_.collect_artifacts(id, attempt);
+      if (artifacts.ok()) artifacts = within_output_limit(std::move(*artifacts));
       if (!artifacts.ok()) {
+        // Results that cannot be delivered take no space.
+        (void)spool_.reset_output(id, attempt);
         table_.fail(id, static_cast<int>(artifacts.status().code()),
                     std::string(artifacts.status().message()));
       } else {
@@ -76,6 +85,7 @@ void WorkerPool::run_job(const v1::JobRecord& record) {
       break;
     }
     case WorkerOutcome::Kind::kFailed:
+      (void)spool_.reset_output(id, attempt);
       table_.fail(id, outcome.code, outcome.message);
       break;
     case WorkerOutcome::Kind::kCancelled:
@@ -85,6 +95,32 @@ void WorkerPool::run_job(const v1::JobRecord& record) {
       table_.requeue_interrupted(id);
       break;
   }
+}
+
+absl::StatusOr<uint64_t> WorkerPool::output_room() const {
+  auto free = spool_.free_bytes();
+  if (!free.ok()) return free.status();
+  const uint64_t over_reserve =
+      *free > config_.spool_reserve_bytes ? *free - config_.spool_reserve_bytes : 0;
+  if (over_reserve < kLeastOutputRoom) {
+    return absl::ResourceExhaustedError(
+        absl::StrCat("spool disk full: ", *free, " bytes free, no room over the reserve of ",
+                     config_.spool_reserve_bytes, " bytes for the job's results"));
+  }
+  return config_.max_job_output_bytes > 0 ? std::min(config_.max_job_output_bytes, over_reserve)
+                                          : over_reserve;
+}
+
+absl::StatusOr<std::vector<v1::Artifact>> WorkerPool::within_output_limit(
+    std::vector<v1::Artifact> artifacts) const {
+  uint64_t total = 0;
+  for (const auto& artifact : artifacts) total += artifact.size_bytes();
+  if (config_.max_job_output_bytes > 0 && total > config_.max_job_output_bytes) {
+    return absl::ResourceExhaustedError(
+        absl::StrCat("the results came to ", total, " bytes, over the job's output limit of ",
+                     config_.max_job_output_bytes, " bytes; ask for fewer labels or formats"));
+  }
+  return artifacts;
 }
 
 void WorkerPool::drain(absl::Duration grace) {

@@ -121,6 +121,15 @@ struct ChildSetup {
     rlimit cpu{setup.limits.cpu_seconds, setup.limits.cpu_seconds + 5};
     setrlimit(RLIMIT_CPU, &cpu);
   }
+  if (setup.limits.output_file_bytes > 0) {
+    // SIGXFSZ ends the worker when a write would pass it. A lower limit
+    // inherited from the server stays.
+    rlimit file_size{};
+    getrlimit(RLIMIT_FSIZE, &file_size);
+    if (file_size.rlim_cur == RLIM_INFINITY || file_size.rlim_cur > setup.limits.output_file_bytes)
+      file_size.rlim_cur = setup.limits.output_file_bytes;
+    setrlimit(RLIMIT_FSIZE, &file_size);
+  }
   dup2(setup.null_fd, STDIN_FILENO);
   dup2(setup.log_fd, STDOUT_FILENO);
   dup2(setup.log_fd, STDERR_FILENO);
@@ -145,10 +154,18 @@ WorkerOutcome failed(absl::StatusCode code, std::string message) {
 }
 
 // What a child that ended without a result died of, from its wait status
-// and the CPU seconds it used against its limit.
-WorkerOutcome outcome_of_exit(int wait_status, double cpu_seconds_used, uint64_t cpu_limit) {
+// and the CPU seconds it used against its limits.
+WorkerOutcome outcome_of_exit(int wait_status, double cpu_seconds_used,
+                              const WorkerLimits& limits) {
+  const uint64_t cpu_limit = limits.cpu_seconds;
   if (WIFSIGNALED(wait_status)) {
     const int number = WTERMSIG(wait_status);
+    if (number == SIGXFSZ) {
+      return failed(
+          absl::StatusCode::kResourceExhausted,
+          absl::StrCat("a result file reached the job's output limit of ", limits.output_file_bytes,
+                       " bytes and the worker was stopped (", signal_description(number), ")"));
+    }
     // The kernel sends SIGXCPU at the soft CPU limit and SIGKILL at the hard.
     const bool over_cpu = number == SIGXCPU || (number == SIGKILL && cpu_limit > 0 &&
                                                 cpu_seconds_used >= double(cpu_limit));
@@ -285,7 +302,7 @@ WorkerOutcome run_worker_process(const WorkerRun& run) {
                                   1e-6 * double(usage.ru_utime.tv_usec + usage.ru_stime.tv_usec);
   if (stopped) return *stopped;
   if (result) return *result;
-  return outcome_of_exit(wait_status, cpu_seconds_used, run.limits.cpu_seconds);
+  return outcome_of_exit(wait_status, cpu_seconds_used, run.limits);
 }
 
 std::string worker_executable(const ServerConfig& config) {

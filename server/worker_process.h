@@ -28,6 +28,8 @@ struct WorkerLimits {
   uint64_t memory_bytes = 0;
   // CPU time, seconds; 0 for none.
   uint64_t cpu_seconds = 0;
+  // Largest file the worker may write, bytes; 0 for no limit of its own.
+  uint64_t output_file_bytes = 0;
 };
 
 enum class StopRequest { kNone, kCancel, kShutdown };

@@ -109,6 +109,7 @@ TEST_F(FullDiskTest, NoAcceptedJobIsLostWhenTheDiskFills) {
   auto config = ServiceHarness::config_for(spool_);
   config.workers = 0;  // The jobs stay queued.
   config.spool_reserve_bytes = 0;
+  config.max_job_output_bytes = 1 << 20;
   std::vector<std::string> jobs;
   {
     ServiceHarness service(config);

@@ -63,6 +63,7 @@ class ServiceHarness {
     config.worker_executable = LABELMESH_WORKER;
     // Small, so that the tests run on a nearly full disk too.
     config.spool_reserve_bytes = 1 << 20;
+    config.max_job_output_bytes = 256 << 20;
     return config;
   }
 
