@@ -13,6 +13,9 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
+#include <limits>
+#include <stdexcept>
 #include <type_traits>
 
 #include <CGAL/Reconstruction_triangulation_3.h>
@@ -30,15 +33,24 @@ using PoissonTriangulationTraits = CGAL::Reconstruction_triangulation_default_ge
     CGAL::Robust_circumcenter_filtered_traits_3<StopAwareKernel>>;
 
 // The stamp an element carries; CGAL's Compact_container assigns it at
-// insertion when it is still unset.
+// insertion when it is still unset. 32 bits fit where the elements had
+// padding, so the triangulation takes no more memory; a solve that made more
+// than four billion cells would need over a terabyte first.
 class CreationStamp {
  public:
   using Has_timestamp = std::true_type;
-  std::size_t time_stamp() const { return stamp_; }
-  void set_time_stamp(std::size_t stamp) { stamp_ = stamp; }
+  std::size_t time_stamp() const {
+    return stamp_ == kUnset ? static_cast<std::size_t>(-1) : stamp_;
+  }
+  void set_time_stamp(std::size_t stamp) {
+    if (stamp != static_cast<std::size_t>(-1) && stamp >= kUnset)
+      throw std::length_error("the Poisson triangulation made over 2^32 elements");
+    stamp_ = static_cast<std::uint32_t>(stamp);
+  }
 
  private:
-  std::size_t stamp_ = static_cast<std::size_t>(-1);
+  static constexpr std::uint32_t kUnset = std::numeric_limits<std::uint32_t>::max();
+  std::uint32_t stamp_ = kUnset;
 };
 
 }  // namespace labelmesh::surface::poisson
