@@ -4,6 +4,7 @@
 
 #include <cstdio>
 #include <memory>
+#include <string>
 
 #include "client/commands.h"
 #include "client/exit_codes.h"
@@ -18,6 +19,15 @@ struct InfoOptions {
   bool json = false;
   uint64_t max_voxels = volume::ReadLimits{}.max_voxels;
 };
+
+// A name from the file, with anything a terminal could act on replaced.
+std::string printable(const std::string& text) {
+  std::string shown = text;
+  for (char& c : shown) {
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = '?';
+  }
+  return shown;
+}
 
 void print_text(const std::string& path, const v1::InputSummary& s) {
   std::printf("file         %s\n", path.c_str());
@@ -38,10 +48,11 @@ void print_text(const std::string& path, const v1::InputSummary& s) {
   }
   std::printf("background   %llu voxels\n", static_cast<unsigned long long>(s.background_voxels()));
   std::printf("labels       %d\n", s.labels_size());
-  std::printf("  %10s %14s %16s\n", "label", "voxels", "volume (mm3)");
+  std::printf("  %10s %14s %16s  %s\n", "label", "voxels", "volume (mm3)", "name");
   for (const auto& label : s.labels()) {
-    std::printf("  %10d %14llu %16.3f\n", label.label(),
-                static_cast<unsigned long long>(label.voxels()), label.volume_mm3());
+    std::printf("  %10d %14llu %16.3f  %s\n", label.label(),
+                static_cast<unsigned long long>(label.voxels()), label.volume_mm3(),
+                printable(label.name()).c_str());
   }
 }
 
@@ -51,7 +62,7 @@ CommandRunner add_info_command(CLI::App& app) {
   auto options = std::make_shared<InfoOptions>();
   CLI::App* info = app.add_subcommand("info", "Show a label volume's geometry and labels");
   info->add_option("file", options->path,
-                   "Label volume (.nii .nii.gz .mha .mhd .nrrd .nhdr .inr .inr.gz .vti)")
+                   "Label volume (.nii .nii.gz .mha .mhd .nrrd .nhdr .inr .inr.gz .vti .dcm)")
       ->required();
   info->add_flag("--json", options->json, "Print the summary as protobuf JSON (InputSummary)");
   info->add_option("--max-voxels", options->max_voxels, "Refuse volumes with more voxels than this")

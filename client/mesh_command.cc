@@ -80,7 +80,7 @@ CommandRunner add_mesh_command(CLI::App& app) {
   auto options = std::make_shared<MeshCommandOptions>();
   CLI::App* mesh = app.add_subcommand("mesh", "Mesh a label volume in this process");
   mesh->add_option("file", options->path,
-                   "Label volume (.nii .nii.gz .mha .mhd .nrrd .nhdr .inr .inr.gz .vti)")
+                   "Label volume (.nii .nii.gz .mha .mhd .nrrd .nhdr .inr .inr.gz .vti .dcm)")
       ->required();
   mesh->add_option("--out", options->out_dir, "Output directory (created if missing)")->required();
   add_pipeline_flags(*mesh, options->pipeline);

@@ -182,7 +182,7 @@ CommandRunner add_submit_command(CLI::App& app) {
   CLI::App* submit = app.add_subcommand("submit", "Mesh a label volume on a labelmeshd server");
   submit
       ->add_option("file", flags->path,
-                   "Label volume held in one file (.nii .nii.gz .mha .nrrd .inr .inr.gz .vti)")
+                   "Label volume held in one file (.nii .nii.gz .mha .nrrd .inr .inr.gz .vti .dcm)")
       ->required();
   submit->add_option("--out", flags->out_dir, "Where the results are fetched to");
   add_pipeline_flags(*submit, flags->pipeline);

@@ -8,7 +8,7 @@ packages=(
   # toolchain
   build-essential cmake ninja-build ccache pkg-config git ca-certificates
   # core: image readers, geometry, meshing
-  libvtk9-dev libcgal-dev libeigen3-dev libtbb-dev libtet1.5-dev zlib1g-dev
+  libvtk9-dev libcgal-dev libeigen3-dev libtbb-dev libtet1.5-dev zlib1g-dev libdcmtk-dev
   # service: schema, RPC, logging, metrics
   libgrpc++-dev libgrpc-dev protobuf-compiler protobuf-compiler-grpc libprotobuf-dev
   libspdlog-dev libfmt-dev prometheus-cpp-dev libcivetweb-dev libssl-dev
@@ -16,6 +16,7 @@ packages=(
   libcli11-dev libgtest-dev libgmock-dev
   # tests that prove our files with tools we did not write
   python3 python3-numpy python3-nibabel python3-meshio python3-grpcio python3-protobuf
+  python3-pydicom
   # finite-element tools that must accept our volume meshes
   calculix-ccx gmsh
   # service tests: TLS certificates

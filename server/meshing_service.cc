@@ -318,11 +318,12 @@ grpc::Status MeshingService::submit(grpc::ServerContext& context,
     return to_grpc(geometry.status());
   }
   // VTK XML arrays (base64, appended, compressed blocks) are decoded only by
-  // VTK's reader, which the server does not link: a worker reads them.
-  // Progress for the watchdog is the reader's, and a client that leaves
-  // stops it; one reader at a time, so that uploads cannot multiply the
-  // worker memory limit outside the pool.
-  if (extension == ".vti") {
+  // VTK's reader, and DICOM SEG pixel data and segments only by DCMTK's,
+  // neither of which the server links: a worker reads them. Progress for
+  // the watchdog is the reader's, and a client that leaves stops it; one
+  // reader at a time, so that uploads cannot multiply the worker memory limit
+  // outside the pool.
+  if (extension == ".vti" || extension == ".dcm") {
     auto keep_going = [&] {
       ticket->touch();
       return !context.IsCancelled();

@@ -15,12 +15,13 @@ namespace labelmesh::server {
 absl::StatusOr<std::string> upload_extension(const std::string& file_name) {
   // Longest first: ".nii.gz" before ".nii" could never match it anyway, but
   // ".gz" alone must not pass.
-  for (const char* extension : {".nii.gz", ".inr.gz", ".nii", ".mha", ".nrrd", ".inr", ".vti"}) {
+  for (const char* extension :
+       {".nii.gz", ".inr.gz", ".nii", ".mha", ".nrrd", ".inr", ".vti", ".dcm"}) {
     if (absl::EndsWithIgnoreCase(file_name, extension)) return std::string(extension);
   }
   return absl::InvalidArgumentError(
       "spec.file_name: unknown or unsupported extension; uploads are single files: .nii, "
-      ".nii.gz, .mha, .nrrd, .inr, .inr.gz or .vti");
+      ".nii.gz, .mha, .nrrd, .inr, .inr.gz, .vti or .dcm (DICOM SEG)");
 }
 
 absl::Status check_spec(const v1::JobSpec& spec, const ServerConfig& config) {

@@ -14,6 +14,7 @@
 #include "core/surface/poisson_surface.h"
 #include "core/surface/surface_checks.h"
 #include "core/surface/surface_repair.h"
+#include "core/volume/label_description.h"
 #include "core/surface/surface_statistics.h"
 #include "core/surface/triangle_mesh.h"
 #include "core/util/stage_timer.h"
@@ -31,6 +32,7 @@ struct VolumeSummary {
   // Runs of equal planes per voxel axis (find_repeated_planes): 3 along z
   // means the segmentation was drawn on every third slice.
   std::array<int, 3> repeated_planes{1, 1, 1};
+  volume::LabelDescriptions descriptions;
 };
 
 // Which connected pieces of a label a surface covers.

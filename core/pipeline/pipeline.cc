@@ -26,6 +26,7 @@ VolumeSummary summary_of(const volume::LabelVolume& volume) {
   VolumeSummary summary{volume.format, volume.file_voxel_type, volume.geometry,
                         volume::compute_label_statistics(volume)};
   summary.repeated_planes = volume::find_repeated_planes(volume, summary.statistics);
+  summary.descriptions = volume.descriptions;
   return summary;
 }
 

@@ -114,6 +114,27 @@ void add_quality_figures(const SurfaceResult& surface, v1::SurfaceSummary& entry
   }
 }
 
+void set_concept(const volume::CodedConcept& from, v1::CodedConcept& to) {
+  to.set_scheme(from.scheme);
+  to.set_value(from.value);
+  to.set_meaning(from.meaning);
+}
+
+// The file's description of `label`, if it has one.
+void describe_label(int32_t label, const volume::LabelDescriptions& descriptions,
+                    v1::LabelSummary& entry) {
+  for (const auto& description : descriptions) {
+    if (description.label != label) continue;
+    entry.set_name(description.name);
+    if (description.colour) {
+      for (uint8_t c : *description.colour) entry.add_colour_rgb(c);
+    }
+    if (!description.category.empty()) set_concept(description.category, *entry.mutable_category());
+    if (!description.type.empty()) set_concept(description.type, *entry.mutable_type());
+    return;
+  }
+}
+
 }  // namespace
 
 v1::InputSummary make_input_summary(const VolumeSummary& summary) {
@@ -134,6 +155,7 @@ v1::InputSummary make_input_summary(const VolumeSummary& summary) {
     entry->set_label(label.label);
     entry->set_voxels(label.voxels);
     entry->set_volume_mm3(static_cast<double>(label.voxels) * voxel_volume);
+    describe_label(label.label, summary.descriptions, *entry);
   }
   input.set_background_voxels(summary.statistics.background_voxels);
   for (int axis = 0; axis < 3; ++axis) {

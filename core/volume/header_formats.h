@@ -22,5 +22,9 @@ absl::StatusOr<VolumeHeader> check_inr_header(const std::string& path, bool gzip
                                               const ReadLimits& limits);
 // VTK XML image data (.vti).
 absl::StatusOr<VolumeHeader> check_vti_header(const std::string& path, const ReadLimits& limits);
+// DICOM Segmentation objects (.dcm): our own walk of the header, then the
+// grid its frames land on (dicom_seg_grid.h).
+absl::StatusOr<VolumeHeader> check_dicom_seg_volume_header(const std::string& path,
+                                                           const ReadLimits& limits);
 
 }  // namespace labelmesh::volume::internal

@@ -35,6 +35,8 @@ std::string_view format_name(ImageFormat format) {
       return "inr";
     case ImageFormat::kVti:
       return "vti";
+    case ImageFormat::kDicomSeg:
+      return "dicom-seg";
   }
   return "unknown";
 }

@@ -8,7 +8,7 @@
 
 namespace labelmesh::volume {
 
-enum class ImageFormat { kNifti, kMetaImage, kNrrd, kInr, kVti };
+enum class ImageFormat { kNifti, kMetaImage, kNrrd, kInr, kVti, kDicomSeg };
 
 std::string_view format_name(ImageFormat format);
 

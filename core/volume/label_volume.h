@@ -8,6 +8,7 @@
 #include <vtkSmartPointer.h>
 
 #include "core/volume/image_geometry.h"
+#include "core/volume/label_description.h"
 
 namespace labelmesh::volume {
 
@@ -19,6 +20,8 @@ struct LabelVolume {
   // One integer scalar component per voxel, extent [0, dims-1], spacing 1 and
   // origin 0: index space. `geometry` carries the physical placement.
   vtkSmartPointer<vtkImageData> voxels;
+  // What the file says of its labels (DICOM SEG segments); may be empty.
+  LabelDescriptions descriptions;
 };
 
 }  // namespace labelmesh::volume

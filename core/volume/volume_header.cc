@@ -76,6 +76,7 @@ std::optional<ImageFormat> format_from_path(std::string_view path) {
     if (std::string_view(lower).ends_with(ext)) return ImageFormat::kInr;
   }
   if (std::string_view(lower).ends_with(".vti")) return ImageFormat::kVti;
+  if (std::string_view(lower).ends_with(".dcm")) return ImageFormat::kDicomSeg;
   return std::nullopt;
 }
 
@@ -86,7 +87,7 @@ absl::StatusOr<VolumeHeader> check_volume_header(const std::string& path,
     return absl::InvalidArgumentError(
         cat(path,
             ": file name: unknown extension; expected .nii, .nii.gz, .mha, .mhd, .nrrd, .nhdr, "
-            ".inr, .inr.gz or .vti"));
+            ".inr, .inr.gz, .vti or .dcm (DICOM SEG)"));
   }
   if (auto size = internal::file_size(path); !size.ok()) return size.status();
   const bool gzip = std::string_view(to_lower(path)).ends_with(".gz");
@@ -101,6 +102,8 @@ absl::StatusOr<VolumeHeader> check_volume_header(const std::string& path,
       return internal::check_inr_header(path, gzip, limits);
     case ImageFormat::kVti:
       return internal::check_vti_header(path, limits);
+    case ImageFormat::kDicomSeg:
+      return internal::check_dicom_seg_volume_header(path, limits);
   }
   return absl::InternalError("unhandled image format");
 }

@@ -43,6 +43,9 @@ struct ReadLimits {
   // ElementDataFile, NRRD "data file") before that file is looked for, so an
   // untrusted header cannot probe which paths exist.
   bool allow_data_file = true;
+  // DICOM SEG, FRACTIONAL: a pixel is inside its segment when its value over
+  // the Maximum Fractional Value is at least this.
+  double fractional_threshold = 0.5;
 };
 
 // Everything the readers need, taken from a header that passed every check.

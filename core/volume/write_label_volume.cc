@@ -233,6 +233,9 @@ absl::Status write_label_volume(const LabelVolume& volume, const std::string& pa
       return write_inr(volume, path, std::string_view(lower).ends_with(".gz"), *names, array);
     case ImageFormat::kVti:
       return write_vti(volume, path);
+    case ImageFormat::kDicomSeg:
+      return absl::InvalidArgumentError(
+          cat(path, ": writing DICOM SEG is not supported; use .nrrd, .nii.gz or .mha"));
   }
   return absl::InternalError("unhandled image format");
 }

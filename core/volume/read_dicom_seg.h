@@ -1,0 +1,23 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// Reads a DICOM Segmentation object (BINARY or FRACTIONAL) into a label
+// volume: segment number n becomes label n, and each segment's label, colour
+// and coded meaning become the label's description.
+#pragma once
+
+#include <string>
+
+#include "absl/status/statusor.h"
+#include "core/util/run_context.h"
+#include "core/volume/label_volume.h"
+#include "core/volume/volume_header.h"
+
+namespace labelmesh::volume {
+
+// The header and grid are checked first (dicom_seg_grid.h), then DCMTK's
+// dcmseg reads the segments and the pixel data. A FRACTIONAL pixel counts as
+// inside when value / Maximum Fractional Value >= limits.fractional_threshold.
+// Segments that overlap are an error naming them and the voxels they share.
+absl::StatusOr<LabelVolume> read_dicom_seg(const std::string& path, const ReadLimits& limits,
+                                           const RunContext& context);
+
+}  // namespace labelmesh::volume
