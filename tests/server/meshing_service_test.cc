@@ -339,6 +339,35 @@ TEST_F(MeshingServiceTest, UploadsThatCouldOnlyFailLaterAreRefusedAtSubmit) {
   EXPECT_TRUE(roomy.submit(vti, repaired_options(), &reply).ok());
 }
 
+// DICOM SEG: read whole in a worker at Submit, so what cannot be meshed
+// (segments that overlap, no patient geometry) is refused before it queues,
+// and what can comes back with its segments' names.
+TEST_F(MeshingServiceTest, ADicomSegIsMeshedWithItsSegmentNamesOrRefusedAtSubmit) {
+  ServiceHarness service(config_);
+  v1::SubmitReply reply;
+  for (const char* refused : {"dicom-seg/highdicom-seg_image_ct_binary_overlap.dcm",
+                              "dicom-seg/highdicom-seg_image_cr_binary.dcm"}) {
+    const grpc::Status status = service.submit(shared_data(refused), repaired_options(), &reply);
+    EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT) << refused;
+    EXPECT_TRUE(absl::StartsWith(status.error_message(), "upload: ")) << status.error_message();
+  }
+  EXPECT_EQ(job_dirs(), 0u);
+  EXPECT_EQ(uploads_left(), 0u);
+
+  ASSERT_TRUE(
+      service.submit(shared_data("dicom-seg/dcmqi-24x38x3-seg.dcm"), repaired_options(), &reply)
+          .ok());
+  service.watch(reply.job_id());
+  const v1::Job job = service.get(reply.job_id());
+  ASSERT_EQ(job.state(), v1::JOB_STATE_SUCCEEDED) << job.error().message();
+  const v1::InputSummary& input = job.report().input();
+  EXPECT_EQ(input.format(), "dicom-seg");
+  ASSERT_EQ(input.labels_size(), 1);
+  EXPECT_EQ(input.labels(0).name(), "Liver");
+  EXPECT_EQ(input.labels(0).voxels(), 315u);
+  EXPECT_EQ(input.labels(0).type().value(), "T-62000");
+}
+
 TEST_F(MeshingServiceTest, CancelStopsARunningJobWithinASecond) {
   ServiceHarness service(config_);
   v1::SubmitReply reply;
