@@ -13,11 +13,12 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds=${1:-600}
 jobs=${LABELMESH_FUZZ_JOBS:-1}
-harnesses=(volume_header_fuzzer payload_stream_fuzzer upload_checks_fuzzer job_spec_fuzzer)
+harnesses=(volume_header_fuzzer payload_stream_fuzzer upload_checks_fuzzer job_spec_fuzzer
+  dicom_seg_header_fuzzer)
 # Longest input per harness, bytes: a compressed payload decodes to up to a
 # thousand times its size, and the stream harness decodes all of it.
 declare -A max_len=([volume_header_fuzzer]=65536 [payload_stream_fuzzer]=4096
-  [upload_checks_fuzzer]=65536 [job_spec_fuzzer]=16384)
+  [upload_checks_fuzzer]=65536 [job_spec_fuzzer]=16384 [dicom_seg_header_fuzzer]=65536)
 
 if ! command -v clang++-14 >/dev/null; then
   echo "fuzz.sh: needs clang++-14 with libFuzzer (Debian: apt-get install clang-14)" >&2
