@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "core/pipeline/output_names.h"
 #include "core/pipeline/report.h"
 #include "core/surface/write_surface.h"
 #include "core/util/exception_status.h"
@@ -32,8 +33,8 @@ absl::Status write_all(MeshResult& result, const MeshParams& params, const std::
       surface.files.clear();
       if (!surface.is_output) continue;
       for (auto format : params.formats) {
-        const std::string name =
-            cat("surface-label", surface.label, ".", surface::surface_format_name(format));
+        const std::string name = cat(surface_file_stem(surface.label, result.input.descriptions),
+                                     ".", surface::surface_format_name(format));
         const auto path = (std::filesystem::path(out_dir) / name).string();
         if (auto s = surface::write_surface(surface.mesh, path, format); !s.ok()) return s;
         surface.files.push_back(name);

@@ -12,9 +12,9 @@
 
 namespace labelmesh {
 
-// Writes surface-label<N>.<ext> per surface and format, volume.<ext> per
-// volume format, then report.json, in `out_dir` (created if missing). Fills
-// each result's `files`.
+// Writes surface-label<N>[-<name>].<ext> (output_names.h) per surface and
+// format, volume.<ext> per volume format, then report.json, in `out_dir`
+// (created if missing). Fills each result's `files`.
 absl::Status write_results(MeshResult& result, const MeshParams& params, const std::string& out_dir,
                            const RunContext& context);
 
