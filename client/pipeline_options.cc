@@ -5,6 +5,8 @@
 
 #include <cstdio>
 
+#include "core/volume/label_table.h"
+
 namespace labelmesh::client {
 
 void add_pipeline_flags(CLI::App& command, PipelineFlags& flags) {
@@ -55,6 +57,10 @@ void add_pipeline_flags(CLI::App& command, PipelineFlags& flags) {
       ->capture_default_str();
   command.add_option("--label-sizing", flags.label_sizing,
                      "Per-label sizing LABEL:EDGE_MM[:DISTANCE_MM], e.g. 114:2:0.2; repeatable");
+  command.add_option("--label-names", flags.label_names,
+                     "Label names and colours: an ITK-SNAP label file, a FreeSurfer colour table "
+                     "or a JSON map {\"5\": \"liver\"}; they name the surface files and the "
+                     "report's labels");
   auto& guard = flags.guard;
   command
       .add_option("--volume-tolerance", guard.volume_percent,
@@ -172,6 +178,18 @@ absl::StatusOr<v1::MeshOptions> to_mesh_options(const PipelineFlags& flags) {
     entry->set_label(label);
     entry->set_max_edge_mm(edge);
     entry->set_max_distance_mm(distance);
+  }
+  if (!flags.label_names.empty()) {
+    auto table = volume::read_label_table(flags.label_names);
+    if (!table.ok()) return table.status();
+    for (const auto& named : *table) {
+      auto* entry = proto.add_label_names();
+      entry->set_label(named.label);
+      entry->set_name(named.name);
+      if (named.colour) {
+        for (uint8_t c : *named.colour) entry->add_colour_rgb(c);
+      }
+    }
   }
   if (flags.poisson.max_edge_mm > 0) proto.set_max_edge_mm(flags.poisson.max_edge_mm);
   if (flags.poisson.max_distance_mm > 0) proto.set_max_distance_mm(flags.poisson.max_distance_mm);

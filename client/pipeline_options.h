@@ -30,6 +30,8 @@ struct PipelineFlags {
   bool no_adapt_to_thickness = false;
   // LABEL:EDGE_MM[:DISTANCE_MM], one per label.
   std::vector<std::string> label_sizing;
+  // A label table: ITK-SNAP, FreeSurfer or JSON (volume/label_table.h).
+  std::string label_names;
   GuardOptions guard;
   bool no_fall_back = false;
   std::vector<std::string> formats{"stl", "vtp"};
@@ -38,7 +40,8 @@ struct PipelineFlags {
 
 void add_pipeline_flags(CLI::App& command, PipelineFlags& flags);
 
-// Errors: INVALID_ARGUMENT for a malformed --label-sizing entry.
+// Errors: INVALID_ARGUMENT for a malformed --label-sizing entry or label
+// table; NOT_FOUND for a missing label table.
 absl::StatusOr<v1::MeshOptions> to_mesh_options(const PipelineFlags& flags);
 
 }  // namespace labelmesh::client

@@ -54,6 +54,8 @@ constexpr double kMaxThicknessVoxels = 100000;
 // One entry per label is plenty; the bounds keep a job record small.
 constexpr int kMaxLabelSizings = 1000;
 constexpr int kMaxLabels = 10000;
+constexpr int kMaxLabelNames = 10000;
+constexpr size_t kMaxLabelNameBytes = 128;
 // Each format at most once, but a client may repeat itself a little.
 constexpr int kMaxFormatEntries = 32;
 
@@ -87,6 +89,41 @@ absl::Status read_guard_options(const v1::MeshOptions& options, GuardOptions& gu
   }
   if (options.has_fall_back()) guard.fall_back = options.fall_back();
   if (options.has_strict()) guard.strict = options.strict();
+  return absl::OkStatus();
+}
+
+// Each label named once, not the background, a short name of no control
+// characters and a colour of three components or none.
+absl::Status read_label_names(const v1::MeshOptions& options, volume::LabelDescriptions& names) {
+  if (options.label_names_size() > kMaxLabelNames)
+    return absl::InvalidArgumentError(
+        cat("label_names: ", options.label_names_size(), " entries; at most ", kMaxLabelNames));
+  for (const auto& entry : options.label_names()) {
+    const std::string field = cat("label_names: label ", entry.label());
+    if (entry.label() <= 0) return absl::InvalidArgumentError(cat(field, ": must be positive"));
+    if (entry.name().size() > kMaxLabelNameBytes)
+      return absl::InvalidArgumentError(cat(field, ": name over ", kMaxLabelNameBytes, " bytes"));
+    if (std::any_of(entry.name().begin(), entry.name().end(),
+                    [](char c) { return static_cast<unsigned char>(c) < 0x20 || c == 0x7f; }))
+      return absl::InvalidArgumentError(cat(field, ": name holds control characters"));
+    if (entry.colour_rgb_size() != 0 && entry.colour_rgb_size() != 3)
+      return absl::InvalidArgumentError(cat(field, ": colour_rgb needs three values or none"));
+    volume::LabelDescription named{.label = entry.label(), .name = entry.name()};
+    if (entry.colour_rgb_size() == 3) {
+      std::array<uint8_t, 3> colour{};
+      for (int c = 0; c < 3; ++c) {
+        if (entry.colour_rgb(c) > 255)
+          return absl::InvalidArgumentError(cat(field, ": colour_rgb values are 0-255"));
+        colour[c] = static_cast<uint8_t>(entry.colour_rgb(c));
+      }
+      named.colour = colour;
+    }
+    for (const auto& earlier : names) {
+      if (earlier.label == named.label)
+        return absl::InvalidArgumentError(cat(field, ": named more than once"));
+    }
+    names.push_back(std::move(named));
+  }
   return absl::OkStatus();
 }
 
@@ -281,6 +318,14 @@ v1::MeshOptions make_options(const MeshParams& params) {
   if (poisson.max_distance_mm > 0) options.set_max_distance_mm(poisson.max_distance_mm);
   options.set_adapt_to_thickness(poisson.adapt_to_thickness);
   options.set_poisson_min_thickness_voxels(poisson.min_thickness_voxels);
+  for (const auto& named : params.label_names) {
+    auto* entry = options.add_label_names();
+    entry->set_label(named.label);
+    entry->set_name(named.name);
+    if (named.colour) {
+      for (uint8_t c : *named.colour) entry->add_colour_rgb(c);
+    }
+  }
   for (const auto& sizing : poisson.label_sizing) {
     auto* entry = options.add_label_sizing();
     entry->set_label(sizing.label);
@@ -315,6 +360,7 @@ v1::MeshOptions make_options(const MeshParams& params) {
 
 absl::StatusOr<MeshParams> params_from_options(const v1::MeshOptions& options) {
   MeshParams params;
+  if (auto s = read_label_names(options, params.label_names); !s.ok()) return s;
   if (options.labels_size() > kMaxLabels)
     return absl::InvalidArgumentError(
         cat("labels: ", options.labels_size(), " entries; at most ", kMaxLabels));

@@ -10,6 +10,7 @@
 #include "core/surface/smooth_surface.h"
 #include "core/surface/surface_format.h"
 #include "core/surface/vertex_normals.h"
+#include "core/volume/label_description.h"
 #include "core/volume/volume_header.h"
 #include "core/volume_mesh/improve_tet_mesh.h"
 #include "core/volume_mesh/tetrahedralize.h"
@@ -131,6 +132,8 @@ struct MeshParams {
   unsigned threads = 0;
   // Size limits applied to the input before anything is allocated.
   volume::ReadLimits limits;
+  // Label names and colours over those the input gives (--label-names).
+  volume::LabelDescriptions label_names;
 };
 
 }  // namespace labelmesh

@@ -15,6 +15,7 @@
 #include "core/util/exception_status.h"
 #include "core/util/side_by_side.h"
 #include "core/util/text.h"
+#include "core/volume/label_table.h"
 #include "core/volume/read_label_volume.h"
 #include "core/volume/repeated_planes.h"
 
@@ -254,6 +255,7 @@ absl::StatusOr<MeshResult> run_stages(const std::string& path, const MeshParams&
   {
     StageTimer timer(result.stages, "label_statistics");
     result.input = summary_of(*volume);
+    volume::apply_label_table(params.label_names, result.input.descriptions);
   }
   auto labels = choose_labels(path, result.input.statistics, params.labels);
   if (!labels.ok()) return labels.status();

@@ -5,7 +5,9 @@
 
 #include <sys/wait.h>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <numbers>
 #include <sstream>
 
@@ -81,6 +83,21 @@ TEST(Cli, MeshWritesSurfacesAndReport) {
                                               "surface_statistics", "write"}));
   // The raw JSON keeps the proto field names.
   EXPECT_NE(slurp(dir / "out" / "report.json").find("\"min_angle_deg\""), std::string::npos);
+}
+
+// Names from an ITK-SNAP label file reach the file names and the report.
+TEST(Cli, LabelNamesNameTheSurfaceFiles) {
+  const auto dir = testing::scratch_dir("cli-label-names");
+  const std::string out = (dir / "out").string();
+  const CliRun run = run_cli("mesh " + testing::shared_data("MRIcrop-seg_converted.nii.gz") +
+                             " --out " + out + " --labels 4 --surface repaired --label-names " +
+                             testing::shared_data("MRIcrop-seg.label"));
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_TRUE(std::filesystem::exists(dir / "out" / "surface-label4-hippo-r.stl"));
+  std::ifstream report(dir / "out" / "report.json");
+  const std::string text((std::istreambuf_iterator<char>(report)), {});
+  EXPECT_NE(text.find("\"name\": \"hippo-R\""), std::string::npos);
+  EXPECT_NE(run_cli("mesh x.nii.gz --out d --label-names /no/such.label").exit_code, 0);
 }
 
 TEST(Cli, VersionIsTheProjects) {

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <functional>
 #include <string>
 #include <vector>
@@ -128,6 +129,42 @@ TEST(JobOptions, EveryOutOfRangeValueIsRefusedByName) {
     EXPECT_TRUE(absl::StrContains(params.status().message(), bad.field))
         << bad.field << ": " << params.status().message();
   }
+}
+
+TEST(JobOptions, LabelNamesAreBoundedAndSurviveTheRoundTrip) {
+  v1::MeshOptions options;
+  auto* liver = options.add_label_names();
+  liver->set_label(5);
+  liver->set_name("liver");
+  for (uint32_t c : {221u, 130u, 101u}) liver->add_colour_rgb(c);
+  auto params = params_from_options(options);
+  ASSERT_TRUE(params.ok()) << params.status();
+  ASSERT_EQ(params->label_names.size(), 1u);
+  EXPECT_EQ(params->label_names[0].colour, (std::array<uint8_t, 3>{221, 130, 101}));
+  const v1::MeshOptions again = make_options(*params);
+  ASSERT_EQ(again.label_names_size(), 1);
+  EXPECT_EQ(again.label_names(0).name(), "liver");
+
+  const std::vector<std::pair<std::function<void(v1::LabelName&)>, std::string>> bad = {
+      {[](v1::LabelName& n) { n.set_label(0); }, "must be positive"},
+      {[](v1::LabelName& n) { n.set_name(std::string(129, 'a')); }, "over 128 bytes"},
+      {[](v1::LabelName& n) { n.set_name("a\nb"); }, "control characters"},
+      {[](v1::LabelName& n) { n.add_colour_rgb(1); }, "three values or none"},
+      {[](v1::LabelName& n) { n.set_colour_rgb(0, 256); }, "0-255"},
+  };
+  for (const auto& [spoil, expected] : bad) {
+    v1::MeshOptions broken = options;
+    spoil(*broken.mutable_label_names(0));
+    const auto refused = params_from_options(broken);
+    ASSERT_FALSE(refused.ok()) << expected;
+    EXPECT_TRUE(absl::StrContains(refused.status().message(), expected)) << refused.status();
+  }
+  v1::MeshOptions twice = options;
+  *twice.add_label_names() = options.label_names(0);
+  EXPECT_TRUE(absl::StrContains(params_from_options(twice).status().message(), "more than once"));
+  v1::MeshOptions many;
+  for (int label = 1; label <= 10001; ++label) many.add_label_names()->set_label(label);
+  EXPECT_TRUE(absl::StrContains(params_from_options(many).status().message(), "at most 10000"));
 }
 
 TEST(JobOptions, RepeatedLabelsAndFormatsAreKeptOnceInOrder) {

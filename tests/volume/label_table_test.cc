@@ -1,0 +1,90 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+#include "core/volume/label_table.h"
+
+#include <gtest/gtest.h>
+
+#include <fstream>
+
+#include "absl/strings/match.h"
+#include "support/test_files.h"
+
+namespace labelmesh::volume {
+namespace {
+
+std::string write_table(const std::string& file, const std::string& text) {
+  const auto path = testing::scratch_dir("label-tables") / file;
+  std::ofstream(path) << text;
+  return path.string();
+}
+
+TEST(LabelTable, ReadsAnItkSnapLabelFile) {
+  auto table = read_label_table(testing::shared_data("MRIcrop-seg.label"));
+  ASSERT_TRUE(table.ok()) << table.status();
+  // Twelve rows; label 0 ("Clear") is the background.
+  ASSERT_EQ(table->size(), 11u);
+  EXPECT_EQ((*table)[0].label, 1);
+  EXPECT_EQ((*table)[0].name, "vent-lat");
+  EXPECT_EQ((*table)[0].colour, (std::array<uint8_t, 3>{0, 30, 255}));
+  EXPECT_EQ((*table)[3].name, "hippo-R");
+}
+
+TEST(LabelTable, ReadsAFreeSurferColourTable) {
+  auto table = read_label_table(write_table("lut.txt",
+                                            "#No. Label Name: R G B A\n"
+                                            "0   Unknown                 0   0   0   0\n"
+                                            "2   Left-Cerebral-White-Matter  245 245 245 0\n"
+                                            "41  Right-Cerebral-White-Matter 0 225 0 0\n"));
+  ASSERT_TRUE(table.ok()) << table.status();
+  ASSERT_EQ(table->size(), 2u);
+  EXPECT_EQ((*table)[1].label, 41);
+  EXPECT_EQ((*table)[1].name, "Right-Cerebral-White-Matter");
+  EXPECT_EQ((*table)[1].colour, (std::array<uint8_t, 3>{0, 225, 0}));
+}
+
+TEST(LabelTable, ReadsAJsonMapOfNamesOrObjects) {
+  auto table = read_label_table(write_table(
+      "names.json", R"({"5": "liver", "114": {"name": "spleen", "color": [157, 108, 162]}})"));
+  ASSERT_TRUE(table.ok()) << table.status();
+  ASSERT_EQ(table->size(), 2u);
+  EXPECT_EQ((*table)[0].label, 5);
+  EXPECT_EQ((*table)[0].name, "liver");
+  EXPECT_FALSE((*table)[0].colour.has_value());
+  EXPECT_EQ((*table)[1].name, "spleen");
+  EXPECT_EQ((*table)[1].colour, (std::array<uint8_t, 3>{157, 108, 162}));
+}
+
+TEST(LabelTable, ErrorsNameTheFileAndLine) {
+  const struct {
+    const char* text;
+    const char* expected;
+  } cases[] = {
+      {"1 0 0 0 1 1 1 \"open\n", "line 1: a label name without its closing quote"},
+      {"# ok\n1 0 0 300 1 1 1 \"x\"\n", "line 2: colour components"},
+      {"1 a 1 2 3 0\n1 b 1 2 3 0\n", "line 2: label 1 is named twice"},
+      {"x y 1 2 3\n", "line 1: does not start with a label number"},
+      {"{\"five\": \"liver\"}", "a key is not a label number"},
+      {"{\"5\": 7}", "label 5: must be a name"},
+  };
+  for (const auto& c : cases) {
+    const std::string path = write_table("bad.txt", c.text);
+    auto table = read_label_table(path);
+    ASSERT_FALSE(table.ok()) << c.text;
+    EXPECT_EQ(table.status().code(), absl::StatusCode::kInvalidArgument);
+    EXPECT_TRUE(absl::StrContains(table.status().message(), path)) << table.status();
+    EXPECT_TRUE(absl::StrContains(table.status().message(), c.expected)) << table.status();
+  }
+  EXPECT_EQ(read_label_table("/no/such/table.label").status().code(), absl::StatusCode::kNotFound);
+}
+
+TEST(LabelTable, ATableNamesOverWhatTheVolumeSaid) {
+  LabelDescriptions described{{.label = 1, .name = "Liver", .colour = {{221, 130, 101}}}};
+  apply_label_table({{.label = 1, .name = "liver (segment 1)"}, {.label = 3, .name = "kidney"}},
+                    described);
+  ASSERT_EQ(described.size(), 2u);
+  EXPECT_EQ(described[0].name, "liver (segment 1)");
+  EXPECT_EQ(described[0].colour, (std::array<uint8_t, 3>{221, 130, 101}));
+  EXPECT_EQ(described[1].label, 3);
+}
+
+}  // namespace
+}  // namespace labelmesh::volume
