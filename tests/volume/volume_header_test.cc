@@ -197,7 +197,8 @@ std::vector<BrokenFile> corpus() {
        "Spacing=\"1e300 1 1\"><PointData><DataArray type=\"UInt8\"/></PointData></ImageData>"
        "</VTKFile>",
        false, bad, "Origin"},
-      {"UnknownExtension", "volume.dcm", "DICM", false, bad, "extension"},
+      {"UnknownExtension", "volume.ima", "DICM", false, bad, "extension"},
+      {"DicomWithoutPreamble", "volume.dcm", "DICM", false, bad, "not a DICOM Part-10 file"},
   };
   return files;
 }
