@@ -152,7 +152,11 @@ absl::Status MeshingService::check_spool_space(uint64_t upload_bytes) const {
   // The job's results must fit too; what they will come to is not known
   // before the job runs, so its output limit stands for them.
   const uint64_t outputs = config_.max_job_output_bytes;
-  if (*free < config_.spool_reserve_bytes + upload_bytes + outputs) {
+  // Saturating: a huge limit must not wrap around to a small sum.
+  const uint64_t needed = config_.spool_reserve_bytes + upload_bytes;
+  const bool fits =
+      needed >= config_.spool_reserve_bytes && *free >= needed && *free - needed >= outputs;
+  if (!fits) {
     return absl::ResourceExhaustedError(absl::StrCat(
         "spool disk full: ", *free, " bytes free, an upload of ", upload_bytes,
         " bytes and results of up to ", outputs, " bytes would leave less than the reserve of ",

@@ -62,6 +62,16 @@ absl::Status check_kind(std::string_view path, const internal::DicomSegHeader& h
   if (header.segments == 0) {
     return field_error(path, "(0062,0002) Segment Sequence", "holds no segment");
   }
+  // The standard numbers segments 1, 2, 3, ... in sequence order, which is
+  // how DCMTK finds them.
+  for (size_t i = 0; i < header.segment_numbers.size(); ++i) {
+    if (header.segment_numbers[i] != i + 1) {
+      return field_error(path, absl::StrCat("segment item ", i + 1, ": (0062,0004) Segment Number"),
+                         absl::StrCat("is ", header.segment_numbers[i],
+                                      "; segments are numbered 1, "
+                                      "2, 3, ... in order"));
+    }
+  }
   if (header.frame_segments.size() != header.frames) {
     return field_error(path, "(0062,000B) Referenced Segment Number",
                        "is not given for every frame");

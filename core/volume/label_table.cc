@@ -14,6 +14,7 @@
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_split.h"
+#include "core/util/utf8.h"
 #include "core/volume/header_checks.h"
 
 namespace labelmesh::volume {
@@ -50,20 +51,23 @@ absl::Status add_entry(const std::string& path, const std::string& where, int64_
   }
   LabelDescription entry;
   entry.label = static_cast<int32_t>(label);
-  entry.name = std::move(name);
+  entry.name = valid_utf8(name);
   entry.colour = colour;
   table.push_back(std::move(entry));
   return absl::OkStatus();
 }
 
 // ITK-SNAP or FreeSurfer lines.
-absl::StatusOr<LabelDescriptions> read_text_table(const std::string& path, const std::string& text) {
+absl::StatusOr<LabelDescriptions> read_text_table(const std::string& path,
+                                                  const std::string& text) {
   LabelDescriptions table;
   int line_number = 0;
   for (absl::string_view line : absl::StrSplit(text, '\n')) {
     ++line_number;
     const std::string where = absl::StrCat("line ", line_number);
-    line = line.substr(0, line.find('#'));
+    // '#' starts a comment, but not inside a quoted ITK-SNAP name.
+    const size_t hash = line.find('#');
+    if (hash != absl::string_view::npos && hash < line.find('"')) line = line.substr(0, hash);
     line = absl::StripAsciiWhitespace(line);
     if (line.empty()) continue;
     std::string name;
@@ -96,7 +100,8 @@ absl::StatusOr<LabelDescriptions> read_text_table(const std::string& path, const
   return table;
 }
 
-absl::StatusOr<LabelDescriptions> read_json_table(const std::string& path, const std::string& text) {
+absl::StatusOr<LabelDescriptions> read_json_table(const std::string& path,
+                                                  const std::string& text) {
   google::protobuf::Struct map;
   if (!google::protobuf::util::JsonStringToMessage(text, &map).ok())
     return field_error(path, "JSON", "is not a JSON object");

@@ -19,6 +19,7 @@
 #include <vtkUnsignedShortArray.h>
 
 #include "absl/strings/str_cat.h"
+#include "core/util/utf8.h"
 #include "core/volume/dicom_seg_grid.h"
 #include "core/volume/header_checks.h"
 
@@ -39,9 +40,9 @@ void silence_dcmtk() {
 CodedConcept concept_of(CodeSequenceMacro& code) {
   CodedConcept coded;
   OFString text;
-  if (code.getCodingSchemeDesignator(text).good()) coded.scheme = text.c_str();
-  if (code.getCodeValue(text).good()) coded.value = text.c_str();
-  if (code.getCodeMeaning(text).good()) coded.meaning = text.c_str();
+  if (code.getCodingSchemeDesignator(text).good()) coded.scheme = valid_utf8(text.c_str());
+  if (code.getCodeValue(text).good()) coded.value = valid_utf8(text.c_str());
+  if (code.getCodeMeaning(text).good()) coded.meaning = valid_utf8(text.c_str());
   return coded;
 }
 
@@ -49,7 +50,8 @@ LabelDescription describe(int32_t label, DcmSegment& segment) {
   LabelDescription description;
   description.label = label;
   OFString name;
-  if (segment.getSegmentLabel(name).good()) description.name = name.c_str();
+  // In the file's own character set; Latin-1 names lose their accents.
+  if (segment.getSegmentLabel(name).good()) description.name = valid_utf8(name.c_str());
   Uint16 l = 0, a = 0, b = 0;
   if (segment.getRecommendedDisplayCIELabValue(l, a, b).good()) {
     double rgb[3];
@@ -103,6 +105,13 @@ absl::StatusOr<LabelVolume> read_dicom_seg(const std::string& path, const ReadLi
   if (condition.bad() || !segmentation) {
     return field_error(path, "DICOM SEG", absl::StrCat("DCMTK cannot read it: ", condition.text()));
   }
+  // DCMTK drops segment items it cannot read; then its segment n is not the
+  // file's, and names would land on the wrong labels.
+  if (segmentation->getNumberOfSegments() != header->segments) {
+    return field_error(path, "(0062,0002) Segment Sequence",
+                       absl::StrCat(header->segments - segmentation->getNumberOfSegments(),
+                                    " segment items are malformed"));
+  }
   auto pixels = pixel_bytes(path, *file.getDataset());
   if (!pixels.ok()) return pixels.status();
   const auto [bytes, byte_count] = *pixels;
@@ -148,8 +157,15 @@ absl::StatusOr<LabelVolume> read_dicom_seg(const std::string& path, const ReadLi
     }
   }
   if (!shared.empty()) {
+    // The first few pairs: the message must stay short.
+    constexpr size_t kPairsNamed = 10;
     std::string pairs;
+    size_t named = 0;
     for (const auto& [pair, count] : shared) {
+      if (named++ == kPairsNamed) {
+        absl::StrAppend(&pairs, " and ", shared.size() - kPairsNamed, " more pairs");
+        break;
+      }
       absl::StrAppend(&pairs, pairs.empty() ? "" : ", ", "segments ", pair.first, " and ",
                       pair.second, " share ", count, " voxels");
     }

@@ -6,6 +6,7 @@
 #include <fstream>
 
 #include "absl/strings/match.h"
+#include "core/util/utf8.h"
 #include "support/test_files.h"
 
 namespace labelmesh::volume {
@@ -51,6 +52,24 @@ TEST(LabelTable, ReadsAJsonMapOfNamesOrObjects) {
   EXPECT_FALSE((*table)[0].colour.has_value());
   EXPECT_EQ((*table)[1].name, "spleen");
   EXPECT_EQ((*table)[1].colour, (std::array<uint8_t, 3>{157, 108, 162}));
+}
+
+TEST(LabelTable, AHashInsideAQuotedNameIsNoComment) {
+  auto table =
+      read_label_table(write_table("hash.label", "# lesions\n1 255 0 0 1 1 1 \"Lesion #2\"\n"));
+  ASSERT_TRUE(table.ok()) << table.status();
+  ASSERT_EQ(table->size(), 1u);
+  EXPECT_EQ((*table)[0].name, "Lesion #2");
+}
+
+// A Latin-1 file: the report's string fields take only UTF-8.
+TEST(LabelTable, NamesThatAreNotUtf8AreMadeValid) {
+  auto table = read_label_table(write_table("latin1.label", "1 1 2 3 1 1 1 \"Gl\xe4ndula\"\n"));
+  ASSERT_TRUE(table.ok()) << table.status();
+  ASSERT_EQ(table->size(), 1u);
+  EXPECT_EQ((*table)[0].name, "Gl?ndula");
+  EXPECT_EQ(valid_utf8("Gl\xc3\xa4ndula \xe2\x82\xac"), "Gl\xc3\xa4ndula \xe2\x82\xac");
+  EXPECT_EQ(valid_utf8("\xc0\xaf \xed\xa0\x80 a\tb"), "?? ??? a?b");
 }
 
 TEST(LabelTable, ErrorsNameTheFileAndLine) {

@@ -11,6 +11,7 @@
 #include <string>
 
 #include "absl/strings/match.h"
+#include "core/volume/dicom_seg_grid.h"
 #include "core/volume/read_label_volume.h"
 #include "core/volume/voxel_access.h"
 #include "support/test_files.h"
@@ -155,6 +156,20 @@ TEST(DicomSeg, WhatHasNoPatientSpaceVolumeIsRefusedSayingWhy) {
   EXPECT_EQ(label_map.code(), absl::StatusCode::kInvalidArgument);
   EXPECT_TRUE(absl::StrContains(label_map.message(), "Label Map Segmentation Storage"))
       << label_map;
+}
+
+// DCMTK finds segment n as the n-th item; a file numbered otherwise would
+// put names on the wrong labels, so it is refused.
+TEST(DicomSeg, SegmentsNumberedOutOfOrderAreRefused) {
+  const std::string path = seg_file("dcmqi-24x38x3-seg.dcm");
+  auto header = internal::parse_dicom_seg_header(path);
+  ASSERT_TRUE(header.ok()) << header.status();
+  ASSERT_TRUE(dicom_seg_grid(path, *header, ReadLimits{}).ok());
+  header->segment_numbers = {2};
+  header->frame_segments = {2, 2, 2};
+  const absl::Status status = dicom_seg_grid(path, *header, ReadLimits{}).status();
+  EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_TRUE(absl::StrContains(status.message(), "numbered 1, 2, 3")) << status;
 }
 
 TEST(DicomSeg, TheVoxelLimitHoldsBeforeAnythingIsRead) {
