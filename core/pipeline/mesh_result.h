@@ -14,10 +14,10 @@
 #include "core/surface/poisson_surface.h"
 #include "core/surface/surface_checks.h"
 #include "core/surface/surface_repair.h"
-#include "core/volume/label_description.h"
 #include "core/surface/surface_statistics.h"
 #include "core/surface/triangle_mesh.h"
 #include "core/util/stage_timer.h"
+#include "core/volume/label_description.h"
 #include "core/volume/label_statistics.h"
 #include "core/volume/label_volume.h"
 
