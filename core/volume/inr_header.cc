@@ -49,7 +49,7 @@ absl::StatusOr<VolumeHeader> check_inr_header(const std::string& path, bool gzip
   }
   auto text = parse_text_header(
       path, std::string_view(*bytes).substr(0, end),
-      {.separator = "=", .comment = "#", .last_key = "", .skip_marker = ""}, end + 1);
+      {.separator = "=", .comment = "#", .last_key = "", .key_value_marker = ""}, end + 1);
   if (!text.ok()) return text.status();
   const TextHeader& h = *text;
 

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include <vtkImageData.h>
 #include <vtkSmartPointer.h>
@@ -22,6 +23,11 @@ struct LabelVolume {
   vtkSmartPointer<vtkImageData> voxels;
   // What the file says of its labels (DICOM SEG segments); may be empty.
   LabelDescriptions descriptions;
+  // Overlapping segments kept apart (ReadLimits::separate_overlapping):
+  // further images like `voxels` (same grid and scalar type), each holding
+  // segments that overlap something in the images before it. Every label is
+  // in exactly one image. Empty for other inputs and when nothing overlaps.
+  std::vector<vtkSmartPointer<vtkImageData>> more_layers;
 };
 
 }  // namespace labelmesh::volume

@@ -64,7 +64,7 @@ absl::StatusOr<VolumeHeader> check_metaimage_header(const std::string& path,
   if (!bytes.ok()) return bytes.status();
   auto text = parse_text_header(
       path, *bytes,
-      {.separator = "=", .comment = "", .last_key = "ElementDataFile", .skip_marker = ""},
+      {.separator = "=", .comment = "", .last_key = "ElementDataFile", .key_value_marker = ""},
       limits.max_header_bytes);
   if (!text.ok()) return text.status();
   const TextHeader& h = *text;

@@ -1,11 +1,18 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 // NRRD (.nrrd attached, .nhdr detached) header checks, after the NRRD0004/5
 // format definition: "field: value" lines, a blank line before attached data.
+// A 4-D file is read only as a 3D Slicer segmentation with layers: its first
+// axis is a list of layers, the other three the grid (slicer_segments.h).
+#include <array>
 #include <cmath>
+#include <optional>
+#include <utility>
+#include <vector>
 
 #include "core/util/text.h"
 #include "core/volume/header_checks.h"
 #include "core/volume/header_formats.h"
+#include "core/volume/slicer_segments.h"
 #include "core/volume/text_header.h"
 
 namespace labelmesh::volume::internal {
@@ -75,6 +82,79 @@ absl::StatusOr<std::array<double, 3>> nrrd_space_to_lps(const std::string& path,
                      "3D-right-handed)");
 }
 
+// Layers a Slicer segmentation may stack (its list axis).
+constexpr int64_t kMostLayers = 256;
+
+struct NrrdAxes {
+  int64_t layers = 1;
+  std::array<int64_t, 3> dims{};
+};
+
+// "sizes": the grid, after the layer count when `layered`. The voxel limit
+// counts every layer's voxels, since all are held in memory while read.
+absl::StatusOr<NrrdAxes> nrrd_sizes(const std::string& path, const TextHeader& h, bool layered,
+                                    const ReadLimits& limits) {
+  auto text = h.find("sizes");
+  if (!text) return field_error(path, "sizes", "is missing");
+  auto sizes = parse_numbers(path, "sizes", *text, layered ? 4 : 3);
+  if (!sizes.ok()) return sizes.status();
+  NrrdAxes axes;
+  if (layered) {
+    const double layers = sizes->front();
+    if (layers != std::floor(layers) || layers < 1 || layers > kMostLayers) {
+      return field_error(path, "sizes",
+                         cat("the layer count must be a whole number from 1 to ", kMostLayers));
+    }
+    axes.layers = static_cast<int64_t>(layers);
+    sizes->erase(sizes->begin());
+  }
+  auto whole = whole_sizes(path, "sizes", *sizes);
+  if (!whole.ok()) return whole.status();
+  axes.dims = *whole;
+  if (auto s = check_dims(path, "sizes", axes.dims, limits); !s.ok()) return s;
+  const auto voxels = static_cast<uint64_t>(axes.dims[0] * axes.dims[1] * axes.dims[2]);
+  if (voxels > limits.max_voxels / static_cast<uint64_t>(axes.layers)) {
+    return field_error(path, "sizes",
+                       cat(axes.layers, " layers of ", voxels, " voxels exceed the limit of ",
+                           limits.max_voxels, " voxels"));
+  }
+  return axes;
+}
+
+// Every axis spatial; in a layered file the first is the list of layers.
+absl::Status check_kinds(const std::string& path, const TextHeader& h, bool layered) {
+  auto kinds = h.find("kinds");
+  if (!kinds) {
+    if (!layered) return absl::OkStatus();
+    return field_error(path, "kinds", "a 4-D file must say its first axis is a list of layers");
+  }
+  std::vector<std::string_view> axes = split_any(*kinds, " ");
+  if (layered) {
+    if (axes.empty() || axes.front() != "list") {
+      return field_error(path, "kinds", "the first of 4 axes must be a list (of layers)");
+    }
+    axes.erase(axes.begin());
+  }
+  for (std::string_view kind : axes) {
+    if (kind != "domain" && kind != "space" && kind != "???" && kind != "none") {
+      return field_error(path, "kinds", "every grid axis must be a spatial (domain/space) axis");
+    }
+  }
+  return absl::OkStatus();
+}
+
+// A per-axis field without the layered file's list axis, which comes first
+// and has no direction or spacing ("none", "nan").
+std::optional<std::string_view> grid_part(std::string_view text, bool layered) {
+  if (!layered) return text;
+  text = trim(text);
+  const size_t end = text.find_first_of(" \t");
+  if (end == std::string_view::npos) return std::nullopt;
+  const std::string_view first = text.substr(0, end);
+  if (first != "none" && first != "nan" && first != "NaN") return std::nullopt;
+  return text.substr(end + 1);
+}
+
 }  // namespace
 
 absl::StatusOr<VolumeHeader> check_nrrd_header(const std::string& path, const ReadLimits& limits) {
@@ -84,38 +164,33 @@ absl::StatusOr<VolumeHeader> check_nrrd_header(const std::string& path, const Re
     return field_error(path, "magic", "the file does not start with NRRD000X");
   }
   auto text = parse_text_header(
-      path, *bytes, {.separator = ": ", .comment = "#", .last_key = "", .skip_marker = ":="},
+      path, *bytes, {.separator = ": ", .comment = "#", .last_key = "", .key_value_marker = ":="},
       limits.max_header_bytes);
   if (!text.ok()) return text.status();
   const TextHeader& h = *text;
 
   auto dimension = h.find("dimension");
-  if (!dimension || *dimension != "3") return field_error(path, "dimension", "must be 3");
+  if (!dimension || (*dimension != "3" && *dimension != "4")) {
+    return field_error(path, "dimension", "must be 3 (4 for a 3D Slicer segmentation's layers)");
+  }
+  const bool layered = *dimension == "4";
   if (auto space_dimension = h.find("space dimension");
       space_dimension && *space_dimension != "3") {
     return field_error(path, "space dimension", "must be 3");
+  }
+  auto axes = nrrd_sizes(path, h, layered, limits);
+  if (!axes.ok()) return axes.status();
+  auto segments = parse_slicer_segments(path, h.key_values, axes->layers);
+  if (!segments.ok()) return segments.status();
+  if (layered && segments->empty()) {
+    return field_error(path, "dimension",
+                       "is 4, which is read only as a 3D Slicer segmentation (Segment<i>_ keys)");
   }
   auto type_name = h.find("type");
   if (!type_name) return field_error(path, "type", "is missing");
   auto type = nrrd_scalar_type(path, *type_name);
   if (!type.ok()) return type.status();
-
-  auto size_text = h.find("sizes");
-  if (!size_text) return field_error(path, "sizes", "is missing");
-  auto sizes = parse_numbers(path, "sizes", *size_text, 3);
-  if (!sizes.ok()) return sizes.status();
-  auto whole = whole_sizes(path, "sizes", *sizes);
-  if (!whole.ok()) return whole.status();
-  const std::array<int64_t, 3> dims = *whole;
-  if (auto s = check_dims(path, "sizes", dims, limits); !s.ok()) return s;
-
-  if (auto kinds = h.find("kinds")) {
-    for (std::string_view kind : split_any(*kinds, " ")) {
-      if (kind != "domain" && kind != "space" && kind != "???" && kind != "none") {
-        return field_error(path, "kinds", "every axis must be a spatial (domain/space) axis");
-      }
-    }
-  }
+  if (auto s = check_kinds(path, h, layered); !s.ok()) return s;
   for (std::string_view skip : {"byte skip", "byteskip", "line skip", "lineskip"}) {
     if (auto value = h.find(skip); value && *value != "0") {
       return field_error(path, skip, "skipping data before the voxels is not supported");
@@ -125,8 +200,10 @@ absl::StatusOr<VolumeHeader> check_nrrd_header(const std::string& path, const Re
   VolumeHeader header;
   header.format = ImageFormat::kNrrd;
   header.scalar_type = *type;
+  header.layers = axes->layers;
+  header.segments = std::move(*segments);
   ImageGeometry& g = header.geometry;
-  g.dims = dims;
+  g.dims = axes->dims;
 
   std::array<double, 3> to_lps{1, 1, 1};
   if (auto space = h.find("space")) {
@@ -134,9 +211,13 @@ absl::StatusOr<VolumeHeader> check_nrrd_header(const std::string& path, const Re
     if (!flips.ok()) return flips.status();
     to_lps = *flips;
   }
-  if (auto directions = h.find("space directions")) {
+  if (auto all_directions = h.find("space directions")) {
+    auto directions = grid_part(*all_directions, layered);
+    if (!directions) {
+      return field_error(path, "space directions", "the list axis must come first, as none");
+    }
     if (contains(*directions, "none")) {
-      return field_error(path, "space directions", "every axis needs a direction");
+      return field_error(path, "space directions", "every grid axis needs a direction");
     }
     auto vectors = parse_numbers(path, "space directions", *directions, 9);
     if (!vectors.ok()) return vectors.status();
@@ -151,7 +232,9 @@ absl::StatusOr<VolumeHeader> check_nrrd_header(const std::string& path, const Re
     }
     if (auto s = check_spacing(path, "space directions", g.spacing); !s.ok()) return s;
     if (auto s = normalise_direction(path, "space directions", g.direction); !s.ok()) return s;
-  } else if (auto spacings = h.find("spacings")) {
+  } else if (auto all_spacings = h.find("spacings")) {
+    auto spacings = grid_part(*all_spacings, layered);
+    if (!spacings) return field_error(path, "spacings", "the list axis must come first, as nan");
     auto values = parse_numbers(path, "spacings", *spacings, 3);
     if (!values.ok()) return values.status();
     g.spacing = {(*values)[0], (*values)[1], (*values)[2]};

@@ -7,6 +7,7 @@
 #include <map>
 #include <memory>
 #include <utility>
+#include <vector>
 
 #include <dcmtk/config/osconfig.h>  // first, as DCMTK requires
 #include <dcmtk/dcmdata/dcdeftag.h>
@@ -22,6 +23,7 @@
 #include "core/util/utf8.h"
 #include "core/volume/dicom_seg_grid.h"
 #include "core/volume/header_checks.h"
+#include "core/volume/segment_layers.h"
 
 namespace labelmesh::volume {
 namespace {
@@ -135,6 +137,10 @@ absl::StatusOr<LabelVolume> read_dicom_seg(const std::string& path, const ReadLi
   labels->SetNumberOfTuples(g.voxel_count());
   uint16_t* voxels = labels->GetPointer(0);
   std::fill(voxels, voxels + g.voxel_count(), uint16_t{0});
+  auto inside = [&](uint64_t at) {
+    return binary ? ((bytes[at >> 3] >> (at & 7)) & 1) != 0
+                  : bytes[at] > 0 && double(bytes[at]) >= least_inside;
+  };
   // Voxels two segments both claim, per pair (lower number first).
   std::map<std::pair<uint16_t, uint16_t>, uint64_t> shared;
   for (uint32_t f = 0; f < header->frames; ++f) {
@@ -142,10 +148,7 @@ absl::StatusOr<LabelVolume> read_dicom_seg(const std::string& path, const ReadLi
     const uint64_t slice_start = uint64_t(grid->frame_slice[f]) * frame_pixels;
     const uint64_t first = uint64_t(f) * frame_pixels;
     for (uint64_t p = 0; p < frame_pixels; ++p) {
-      const uint64_t at = first + p;
-      const bool inside = binary ? ((bytes[at >> 3] >> (at & 7)) & 1) != 0
-                                 : bytes[at] > 0 && double(bytes[at]) >= least_inside;
-      if (!inside) continue;
+      if (!inside(first + p)) continue;
       uint16_t& voxel = voxels[slice_start + p];
       if (voxel != 0 && voxel != segment)
         ++shared[{std::min(voxel, segment), std::max(voxel, segment)}];
@@ -156,7 +159,7 @@ absl::StatusOr<LabelVolume> read_dicom_seg(const std::string& path, const ReadLi
       if (auto s = context.check_stop(); !s.ok()) return s;
     }
   }
-  if (!shared.empty()) {
+  if (!shared.empty() && !limits.separate_overlapping) {
     // The first few pairs: the message must stay short.
     constexpr size_t kPairsNamed = 10;
     std::string pairs;
@@ -172,7 +175,8 @@ absl::StatusOr<LabelVolume> read_dicom_seg(const std::string& path, const ReadLi
     return field_error(path, "segments",
                        absl::StrCat("overlap (", pairs,
                                     "); a label volume holds one label a voxel, so overlapping "
-                                    "segments cannot be meshed together"));
+                                    "segments cannot be meshed together",
+                                    kSeparateOverlappingHint));
   }
 
   LabelVolume volume;
@@ -181,7 +185,43 @@ absl::StatusOr<LabelVolume> read_dicom_seg(const std::string& path, const ReadLi
   volume.geometry = g;
   volume.voxels = vtkSmartPointer<vtkImageData>::New();
   volume.voxels->SetDimensions(int(g.dims[0]), int(g.dims[1]), int(g.dims[2]));
-  volume.voxels->GetPointData()->SetScalars(labels);
+  if (shared.empty()) {
+    volume.voxels->GetPointData()->SetScalars(labels);
+  } else {
+    labels = nullptr;  // its memory goes to the layers
+    // Each segment's frames, by segment index: the grid checks that
+    // segment n is item n - 1 and that every frame names one of them.
+    const std::vector<int32_t> numbers(header->segment_numbers.begin(),
+                                       header->segment_numbers.end());
+    std::vector<std::vector<uint32_t>> frames_of(numbers.size());
+    for (uint32_t f = 0; f < header->frames; ++f)
+      frames_of[header->frame_segments[f] - 1].push_back(f);
+    uint64_t frames_visited = 0;
+    auto layers = separate_segments(
+        path, numbers, numbers.size(), uint64_t(g.voxel_count()), VTK_UNSIGNED_SHORT, limits,
+        [&](size_t segment, SegmentVoxelSink sink) -> absl::Status {
+          for (uint32_t f : frames_of[segment]) {
+            if ((frames_visited++ & 63) == 0) {
+              if (auto s = context.check_stop(); !s.ok()) return s;
+            }
+            const uint64_t slice_start = uint64_t(grid->frame_slice[f]) * frame_pixels;
+            const uint64_t first = uint64_t(f) * frame_pixels;
+            for (uint64_t p = 0; p < frame_pixels; ++p) {
+              if (inside(first + p)) sink(segment, slice_start + p);
+            }
+          }
+          return absl::OkStatus();
+        },
+        context);
+    if (!layers.ok()) return layers.status();
+    volume.voxels->GetPointData()->SetScalars((*layers)[0]);
+    for (size_t k = 1; k < layers->size(); ++k) {
+      auto image = vtkSmartPointer<vtkImageData>::New();
+      image->SetDimensions(int(g.dims[0]), int(g.dims[1]), int(g.dims[2]));
+      image->GetPointData()->SetScalars((*layers)[k]);
+      volume.more_layers.push_back(std::move(image));
+    }
+  }
   for (uint16_t number : header->segment_numbers) {
     DcmSegment* segment = segmentation->getSegment(number);
     if (segment == nullptr) continue;

@@ -16,7 +16,11 @@ namespace labelmesh::volume {
 // The header and grid are checked first (dicom_seg_grid.h), then DCMTK's
 // dcmseg reads the segments and the pixel data. A FRACTIONAL pixel counts as
 // inside when value / Maximum Fractional Value >= limits.fractional_threshold.
-// Segments that overlap are an error naming them and the voxels they share.
+// Segments that overlap are an error naming them and the voxels they share,
+// unless limits.separate_overlapping: then each segment goes whole, in
+// segment-number order, to the first image (voxels, then more_layers) where
+// none of its voxels is taken (segment_layers.h); the images together count
+// against limits.max_voxels, an INVALID_ARGUMENT naming the file beyond it.
 absl::StatusOr<LabelVolume> read_dicom_seg(const std::string& path, const ReadLimits& limits,
                                            const RunContext& context);
 

@@ -16,6 +16,7 @@
 #include "core/util/text.h"
 #include "core/util/vtk_error_flag.h"
 #include "core/volume/header_checks.h"
+#include "core/volume/merge_slicer_layers.h"
 #include "core/volume/payload_stream.h"
 #include "core/volume/read_dicom_seg.h"
 
@@ -99,7 +100,8 @@ absl::StatusOr<DecodedVoxels> read_with_vtk(const std::string& path, const Volum
   return decoded;
 }
 
-// Our reader for INR, NRRD and MetaImage: one contiguous block, raw, gzip or zlib.
+// Our reader for INR, NRRD and MetaImage: one contiguous block, raw, gzip or
+// zlib; header.layers values a voxel (a layered Slicer segmentation).
 absl::StatusOr<DecodedVoxels> read_block(const std::string& path, const VolumeHeader& header) {
   auto stream = internal::PayloadStream::open(header.data_path, header.file_offset, header.encoding,
                                               header.compressed_bytes);
@@ -111,7 +113,7 @@ absl::StatusOr<DecodedVoxels> read_block(const std::string& path, const VolumeHe
   vtkSmartPointer<vtkDataArray> array;
   array.TakeReference(vtkDataArray::CreateDataArray(vtk_type_of(header.scalar_type)));
   array->SetNumberOfComponents(1);
-  array->SetNumberOfTuples(header.geometry.voxel_count());
+  array->SetNumberOfTuples(header.geometry.voxel_count() * header.layers);
   const uint64_t bytes = header.data_bytes();
   auto got = (*stream)->read(static_cast<char*>(array->GetVoidPointer(0)), bytes);
   if (!got.ok()) return got.status();
@@ -195,7 +197,7 @@ absl::StatusOr<LabelVolume> read_label_volume(const std::string& path, const Rea
   auto decoded = own_reader ? read_block(path, *header) : read_with_vtk(path, *header);
   if (!decoded.ok()) return decoded.status();
   if (decoded->array->GetNumberOfComponents() != 1 ||
-      decoded->array->GetNumberOfTuples() != header->geometry.voxel_count()) {
+      decoded->array->GetNumberOfTuples() != header->geometry.voxel_count() * header->layers) {
     return field_error(path, "voxel data", "does not hold one value per voxel");
   }
   if (auto s = context.check_stop(); !s.ok()) return s;
@@ -203,6 +205,20 @@ absl::StatusOr<LabelVolume> read_label_volume(const std::string& path, const Rea
   if (!labels.ok()) return labels.status();
 
   LabelVolume volume;
+  if (!header->segments.empty()) {
+    auto slicer = merge_slicer_layers(path, *header, *labels, limits, context);
+    if (!slicer.ok()) return slicer.status();
+    *labels = slicer->voxels;
+    volume.descriptions = std::move(slicer->descriptions);
+    for (const auto& layer : slicer->more_layers) {
+      auto image = vtkSmartPointer<vtkImageData>::New();
+      image->SetDimensions(static_cast<int>(header->geometry.dims[0]),
+                           static_cast<int>(header->geometry.dims[1]),
+                           static_cast<int>(header->geometry.dims[2]));
+      image->GetPointData()->SetScalars(layer);
+      volume.more_layers.push_back(std::move(image));
+    }
+  }
   volume.format = header->format;
   volume.file_voxel_type = std::string(scalar_type_name(header->scalar_type));
   volume.geometry = header->geometry;

@@ -17,7 +17,9 @@ namespace labelmesh::volume {
 // MetaImage (VTK's MetaIO stops at CompressedDataSize, which real files
 // understate: it loses the end of frogtissue.zraw).
 // Voxels of type uint32, (u)int64 and float are converted to int32; real
-// values must be whole numbers and every label must fit in int32.
+// values must be whole numbers and every label must fit in int32. A NRRD
+// with 3D Slicer segment keys (.seg.nrrd) gets its segments' names and
+// colours, its layers merged into one label a voxel (merge_slicer_layers.h).
 // Errors: NOT_FOUND (no file), INVALID_ARGUMENT naming the file and the field
 // or data at fault, CANCELLED.
 absl::StatusOr<LabelVolume> read_label_volume(const std::string& path, const ReadLimits& limits,

@@ -43,10 +43,16 @@ absl::StatusOr<TextHeader> parse_text_header(std::string_view path, std::string_
     if (!syntax.comment.empty() && line.substr(0, syntax.comment.size()) == syntax.comment) {
       continue;
     }
-    if (!syntax.skip_marker.empty() && line.find(syntax.skip_marker) != std::string_view::npos) {
-      continue;
-    }
     const size_t split = line.find(syntax.separator);
+    if (!syntax.key_value_marker.empty()) {
+      const size_t pair = line.find(syntax.key_value_marker);
+      if (pair != std::string_view::npos && pair < split) {
+        header.key_values.insert_or_assign(
+            std::string(trim(line.substr(0, pair))),
+            std::string(trim(line.substr(pair + syntax.key_value_marker.size()))));
+        continue;
+      }
+    }
     if (split == std::string_view::npos) {
       if (line_number == 1) continue;  // Magic line (NRRD000X).
       return field_error(path, cat("header line ", line_number),

@@ -15,6 +15,9 @@ namespace labelmesh::volume::internal {
 struct TextHeader {
   // Keys as written (case kept), values trimmed.
   std::map<std::string, std::string, std::less<>> fields;
+  // NRRD "key:=value" pairs, kept apart from the fields: keys as written,
+  // values trimmed. 3D Slicer stores its segments' names and colours here.
+  std::map<std::string, std::string, std::less<>> key_values;
   // Bytes from the start of the file to the first voxel byte.
   uint64_t size = 0;
 
@@ -29,8 +32,9 @@ struct TextHeaderSyntax {
   // The header ends after the line whose key is this (MetaImage's
   // ElementDataFile); empty when a blank line ends it (NRRD).
   std::string_view last_key;
-  // Lines containing this are skipped (NRRD's "key:=value" pairs); empty for none.
-  std::string_view skip_marker;
+  // Lines where this comes before any separator are key/value pairs, kept in
+  // TextHeader::key_values (NRRD's ":="); empty for none.
+  std::string_view key_value_marker;
 };
 
 // Splits the header at the start of `bytes` (at most max_bytes of it). Errors

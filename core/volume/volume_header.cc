@@ -57,7 +57,7 @@ int scalar_size(ScalarType type) {
 }
 
 uint64_t VolumeHeader::data_bytes() const {
-  return static_cast<uint64_t>(geometry.voxel_count()) *
+  return static_cast<uint64_t>(geometry.voxel_count()) * static_cast<uint64_t>(layers) *
          static_cast<uint64_t>(scalar_size(scalar_type));
 }
 

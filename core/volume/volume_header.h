@@ -9,9 +9,11 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "absl/status/statusor.h"
 #include "core/volume/image_geometry.h"
+#include "core/volume/slicer_segments.h"
 
 namespace labelmesh::volume {
 
@@ -37,8 +39,9 @@ enum class DataEncoding { kRaw, kGzip, kZlib };
 struct ReadLimits {
   // Volumes with more voxels than this are refused before any allocation.
   uint64_t max_voxels = uint64_t{1} << 31;
-  // Text headers (MetaImage, NRRD, INR, VTI) longer than this are refused, bytes.
-  uint64_t max_header_bytes = uint64_t{1} << 16;
+  // Text headers (MetaImage, NRRD, INR, VTI) longer than this are refused,
+  // bytes. A 3D Slicer segmentation writes about 450 bytes per segment.
+  uint64_t max_header_bytes = uint64_t{1} << 20;
   // False refuses headers that name a separate data file (MetaImage
   // ElementDataFile, NRRD "data file") before that file is looked for, so an
   // untrusted header cannot probe which paths exist.
@@ -46,6 +49,11 @@ struct ReadLimits {
   // DICOM SEG, FRACTIONAL: a pixel is inside its segment when its value over
   // the Maximum Fractional Value is at least this.
   double fractional_threshold = 0.5;
+  // DICOM SEG and 3D Slicer segments may overlap. False refuses them, naming
+  // the overlapping segments; true keeps each segment whole in the first
+  // layer where it overlaps nothing (LabelVolume::more_layers), so each is
+  // meshed on its own.
+  bool separate_overlapping = false;
 };
 
 // Everything the readers need, taken from a header that passed every check.
@@ -68,6 +76,11 @@ struct VolumeHeader {
   // NIfTI scl_slope/scl_inter; identity elsewhere.
   double rescale_slope = 1.0;
   double rescale_intercept = 0.0;
+  // Values stored per voxel, the fastest axis: the layers of a 4-D 3D Slicer
+  // segmentation; 1 elsewhere. Counts in data_bytes() and the voxel limit.
+  int64_t layers = 1;
+  // The segments a 3D Slicer segmentation names (NRRD); empty elsewhere.
+  std::vector<SlicerSegment> segments;
 
   uint64_t data_bytes() const;
 };

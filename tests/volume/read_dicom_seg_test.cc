@@ -5,10 +5,16 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
+#include <map>
 #include <string>
+#include <vector>
+
+#include <vtkPointData.h>
 
 #include "absl/strings/match.h"
 #include "core/volume/dicom_seg_grid.h"
@@ -134,6 +140,110 @@ TEST(DicomSeg, OverlappingSegmentsAreAnErrorNamingThem) {
   EXPECT_TRUE(absl::StrContains(status.message(), "segments 1 and 2 share 16 voxels")) << status;
   EXPECT_TRUE(absl::StrContains(status.message(), "highdicom-seg_image_ct_binary_overlap.dcm"))
       << status;
+  EXPECT_TRUE(absl::StrContains(status.message(), "--overlapping separate")) << status;
+}
+
+int64_t voxels_with(vtkImageData* image, int64_t label) {
+  int64_t count = 0;
+  visit_voxels(image, [&](const auto* voxels, size_t n) {
+    for (size_t i = 0; i < n; ++i) count += int64_t(voxels[i]) == label ? 1 : 0;
+  });
+  return count;
+}
+
+// Bits set in each segment's frames, counted from the Pixel Data bytes as
+// pydicom's pixel_array would sum them, without the reader.
+std::map<int64_t, int64_t> bits_per_segment(const std::string& path) {
+  auto header = internal::parse_dicom_seg_header(path);
+  EXPECT_TRUE(header.ok()) << header.status();
+  if (!header.ok()) return {};
+  EXPECT_EQ(header->bits_allocated, 1);
+  const std::string bytes = testing::read_bytes(path);
+  const uint64_t frame_pixels = uint64_t(header->rows) * header->columns;
+  std::map<int64_t, int64_t> bits;
+  for (uint32_t f = 0; f < header->frames; ++f) {
+    for (uint64_t p = 0; p < frame_pixels; ++p) {
+      const uint64_t at = f * frame_pixels + p;
+      const auto byte = static_cast<uint8_t>(bytes.at(header->pixel_data_offset + at / 8));
+      bits[header->frame_segments[f]] += (byte >> (at % 8)) & 1;
+    }
+  }
+  return bits;
+}
+
+std::vector<vtkImageData*> images_of(const LabelVolume& volume) {
+  std::vector<vtkImageData*> images{volume.voxels};
+  for (const auto& layer : volume.more_layers) images.push_back(layer);
+  return images;
+}
+
+TEST(DicomSeg, OverlappingSegmentsKeptApartLieWholeInLayersOfTheirOwn) {
+  const std::string path = seg_file("highdicom-seg_image_ct_binary_overlap.dcm");
+  ReadLimits limits;
+  limits.separate_overlapping = true;
+  const LabelVolume seg = read_or_fail(path, limits);
+  ASSERT_EQ(seg.more_layers.size(), 1u);
+  const std::map<int64_t, int64_t> expected = bits_per_segment(path);
+  ASSERT_EQ(expected.size(), 2u);
+  // Segment 1: four frames of 16 pixels; segment 2: four of 4, all in segment 1.
+  EXPECT_EQ(expected.at(1), 64);
+  EXPECT_EQ(expected.at(2), 16);
+  // Segment 1 first, in the voxels; segment 2 overlaps it, so in the next.
+  const auto images = images_of(seg);
+  EXPECT_EQ(voxels_with(images[0], 1), expected.at(1));
+  EXPECT_EQ(voxels_with(images[0], 2), 0);
+  EXPECT_EQ(voxels_with(images[1], 1), 0);
+  EXPECT_EQ(voxels_with(images[1], 2), expected.at(2));
+  for (vtkImageData* image : images) {
+    int dims[3];
+    image->GetDimensions(dims);
+    EXPECT_EQ((std::array<int64_t, 3>{dims[0], dims[1], dims[2]}), seg.geometry.dims);
+    EXPECT_EQ(image->GetScalarType(), seg.voxels->GetScalarType());
+  }
+  // Together the layers cover both segments, the 16 shared voxels once.
+  const auto count = static_cast<size_t>(seg.geometry.voxel_count());
+  std::vector<uint8_t> covered(count, 0);
+  for (vtkImageData* image : images) {
+    visit_voxels(image, [&](const auto* voxels, size_t n) {
+      for (size_t i = 0; i < std::min(n, count); ++i) covered[i] |= voxels[i] != 0;
+    });
+  }
+  EXPECT_EQ(std::count(covered.begin(), covered.end(), 1), expected.at(1) + expected.at(2) - 16);
+  ASSERT_EQ(seg.descriptions.size(), 2u);
+  EXPECT_EQ(seg.descriptions[1].label, 2);
+}
+
+TEST(DicomSeg, KeepingOverlapsApartChangesNothingWhenNothingOverlaps) {
+  ReadLimits separate;
+  separate.separate_overlapping = true;
+  for (const char* name : {"dcmqi-24x38x3-seg.dcm", "highdicom-seg_image_ct_binary.dcm"}) {
+    const LabelVolume plain = read_or_fail(seg_file(name));
+    const LabelVolume kept = read_or_fail(seg_file(name), separate);
+    EXPECT_TRUE(kept.more_layers.empty()) << name;
+    vtkDataArray* a = plain.voxels->GetPointData()->GetScalars();
+    vtkDataArray* b = kept.voxels->GetPointData()->GetScalars();
+    ASSERT_EQ(a->GetDataType(), b->GetDataType()) << name;
+    ASSERT_EQ(a->GetNumberOfTuples(), b->GetNumberOfTuples()) << name;
+    EXPECT_EQ(std::memcmp(a->GetVoidPointer(0), b->GetVoidPointer(0),
+                          size_t(a->GetNumberOfTuples()) * size_t(a->GetDataTypeSize())),
+              0)
+        << name;
+  }
+}
+
+TEST(DicomSeg, LayersKeptApartCountAgainstTheVoxelLimit) {
+  const std::string path = seg_file("highdicom-seg_image_ct_binary_overlap.dcm");
+  ReadLimits limits;
+  limits.separate_overlapping = true;
+  limits.max_voxels = 16 * 16 * 165;  // one layer, not two
+  const absl::Status status = read_label_volume(path, limits, RunContext{}).status();
+  EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_TRUE(absl::StrContains(status.message(), "highdicom-seg_image_ct_binary_overlap.dcm"))
+      << status;
+  EXPECT_TRUE(absl::StrContains(status.message(), "2 layers of 42240 voxels")) << status;
+  EXPECT_TRUE(absl::StrContains(status.message(), "exceeds the limit of 42240")) << status;
+  limits.max_voxels = 2 * 16 * 16 * 165;
+  EXPECT_TRUE(read_label_volume(path, limits, RunContext{}).ok());
 }
 
 TEST(DicomSeg, SparseFramesLandOnTheSliceGridAcrossTheGap) {
