@@ -21,6 +21,8 @@ packages=(
   calculix-ccx gmsh
   # service tests: TLS certificates
   openssl
+  # report.html rendered headless in its test
+  chromium
 )
 
 if [ "$(id -u)" -eq 0 ]; then sudo=(); else sudo=(sudo); fi
