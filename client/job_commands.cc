@@ -11,6 +11,7 @@
 #include "client/exit_codes.h"
 #include "client/job_follow.h"
 #include "client/label_warnings.h"
+#include "client/report_table.h"
 #include "client/server_connection.h"
 #include "core/pipeline/report.h"
 #include "grpc/health/v1/health.grpc.pb.h"
@@ -112,10 +113,12 @@ int run_fetch(const JobFlags& flags) {
   v1::GetJobRequest request;
   request.set_job_id(flags.job_id);
   v1::Job job;
-  if (stub->GetJob(context.get(), request, &job).ok()) print_label_warnings("fetch", job.report());
+  const bool known = stub->GetJob(context.get(), request, &job).ok();
+  if (known) print_label_warnings("fetch", job.report());
   if (flags.json) {
     std::printf("{\"job_id\": \"%s\", \"files\": %d}\n", flags.job_id.c_str(), *written);
   } else {
+    if (known && job.has_report()) std::printf("%s", report_table(job.report()).c_str());
     std::printf("%d files written to %s\n", *written, flags.out_dir.c_str());
   }
   return kExitSuccess;

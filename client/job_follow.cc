@@ -25,7 +25,8 @@ bool has_ended(v1::JobState state) {
 // per finished stage everywhere (logs of unattended runs).
 class EventPrinter {
  public:
-  explicit EventPrinter(bool json) : json_(json), live_(!json) {}
+  // The server sends one stage_finished per stage: the live line prints none.
+  explicit EventPrinter(bool json) : json_(json), live_(!json, false) {}
 
   void print(const v1::JobEvent& event) {
     if (json_) {
@@ -43,16 +44,18 @@ class EventPrinter {
     } else if (event.has_started()) {
       std::fprintf(stderr, "started (attempt %u)\n", event.started().attempt());
     } else if (event.has_progress()) {
-      live_.update(event.progress().stage(), event.progress().fraction());
+      const auto& progress = event.progress();
+      live_.update({progress.stage(), progress.fraction(), progress.label(), progress.label_name(),
+                    progress.label_index(), progress.label_count(), progress.labels_done()});
     } else if (event.has_stage_finished()) {
-      live_.update("", 0);
+      live_.clear();
       std::fprintf(stderr, "  %-20s done %8.2f s\n", event.stage_finished().stage().c_str(),
                    event.stage_finished().seconds());
     } else if (event.has_failed()) {
-      live_.update("", 0);
+      live_.clear();
       std::fprintf(stderr, "failed: %s\n", event.failed().message().c_str());
     } else if (event.has_cancelled()) {
-      live_.update("", 0);
+      live_.clear();
       std::fprintf(stderr, "cancelled\n");
     }
   }

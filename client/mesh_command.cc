@@ -9,6 +9,7 @@
 #include "client/exit_codes.h"
 #include "client/label_warnings.h"
 #include "client/pipeline_options.h"
+#include "client/report_table.h"
 #include "client/terminal_progress.h"
 #include "core/pipeline/job_options.h"
 #include "core/pipeline/pipeline.h"
@@ -26,53 +27,6 @@ struct MeshCommandOptions {
   bool json = false;
   unsigned threads = 0;
 };
-
-// "-" for a figure the stage does not measure.
-std::string optional_figure(bool present, double value, const char* format) {
-  if (!present) return "-";
-  char text[32];
-  std::snprintf(text, sizeof text, format, value);
-  return text;
-}
-
-void print_summary(const MeshResult& result, const std::string& out_dir) {
-  std::printf("%8s %-15s %9s %9s %8s %8s %6s %8s %14s %9s %9s\n", "label", "stage", "nodes",
-              "triangles", "min_ang", "max_ang", "closed", "manifold", "volume (mm3)", "self_int",
-              "hausdorff");
-  for (const auto& s : result.surfaces) {
-    if (s.error) {
-      std::printf("%8d %-15s not delivered: %s\n", s.label, s.stage.c_str(), s.error->c_str());
-      continue;
-    }
-    if (s.components && s.components->kept == 0) {
-      std::printf(
-          "%8d %-15s every component under --min-component-voxels: %u dropped, no surface\n",
-          s.label, s.stage.c_str(), s.components->dropped);
-      continue;
-    }
-    const auto& st = s.statistics;
-    const auto& distance = s.distance_to_marching_cubes;
-    std::printf("%8d %-15s %9u %9u %8.3f %8.3f %6s %8s %14.3f %9s %9s\n", s.label, s.stage.c_str(),
-                st.nodes, st.triangles, st.min_angle_deg, st.max_angle_deg,
-                st.closed ? "yes" : "no", st.manifold ? "yes" : "no", st.volume_mm3,
-                optional_figure(s.self_intersections.has_value(),
-                                double(s.self_intersections.value_or(0)), "%.0f")
-                    .c_str(),
-                optional_figure(distance.has_value(), distance ? distance->hausdorff_mm : 0, "%.3f")
-                    .c_str());
-  }
-  if (result.volume) {
-    const auto& v = *result.volume;
-    const auto& q = v.summary;
-    std::printf(
-        "volume (%s): %zu nodes, %zu tetrahedra; quality Q min %.3f mean %.3f; dihedral %.1f-%.1f "
-        "deg; invalid %lld, very bad %lld, questionable %lld, good %lld\n",
-        v.mesher.c_str(), v.mesh.points.size(), v.mesh.tetrahedra.size(), q.count ? q.min : 0,
-        q.mean, q.count ? q.min_dihedral_deg : 0, q.count ? q.max_dihedral_deg : 0,
-        (long long)q.invalid, (long long)q.very_bad, (long long)q.questionable, (long long)q.good);
-  }
-  std::printf("meshes and report.json written to %s\n", out_dir.c_str());
-}
 
 }  // namespace
 
@@ -99,25 +53,37 @@ CommandRunner add_mesh_command(CLI::App& app) {
       return int{kExitUsage};
     }
     params->threads = options->threads;
-    TerminalProgress progress(!options->json);
+    TerminalProgress progress(!options->json, true);
     RunContext context;
-    context.progress = [&progress](std::string_view stage, double fraction) {
-      progress.update(stage, fraction);
+    context.progress = [&progress](const ProgressUpdate& update) {
+      ProgressLine line;
+      line.stage = std::string(update.stage);
+      line.fraction = update.fraction;
+      if (const LabelInProgress* label = update.label) {
+        line.label = label->label;
+        line.label_name = label->name;
+        line.label_index = label->index;
+        line.label_count = label->count;
+        line.labels_done = label->done;
+      }
+      progress.update(line);
     };
     auto result = run_pipeline(options->path, *params, context);
     absl::Status status = result.status();
     if (status.ok()) status = write_results(*result, *params, options->out_dir, context);
-    progress.update("", 0);
+    progress.clear();
     if (!status.ok()) {
       std::fprintf(stderr, "labelmesh mesh: %s\n", std::string(status.message()).c_str());
       return exit_code_for(status);
     }
+    const v1::Report report = make_report(*result, *params);
     if (options->json) {
-      std::printf("%s\n", report_json(*result, *params).c_str());
+      std::printf("%s\n", to_json(report).c_str());
     } else {
-      print_summary(*result, options->out_dir);
+      std::printf("%s", report_table(report).c_str());
+      std::printf("meshes, report.json and report.html written to %s\n", options->out_dir.c_str());
     }
-    print_label_warnings("mesh", make_report(*result, *params));
+    print_label_warnings("mesh", report);
     return int{kExitSuccess};
   };
 }

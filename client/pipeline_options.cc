@@ -154,12 +154,25 @@ void add_pipeline_flags(CLI::App& command, PipelineFlags& flags) {
                    "triangles, -Y)");
   command
       .add_option("--formats", flags.formats,
-                  "Files to write: surfaces per label (stl, ply, obj, off, vtp) and, with "
+                  "Files to write: surfaces per label (stl, ply, obj, off, vtp); all surfaces in "
+                  "one scene (vtm); the label volume beside the meshes (vti, mha); and, with "
                   "--volume, one volume mesh (vtu, msh, mesh, inp, node); default stl,vtp; "
                   "with --volume and no volume format listed, vtu")
       ->delimiter(',')
-      ->check(
-          CLI::IsMember({"stl", "ply", "obj", "off", "vtp", "vtu", "msh", "mesh", "inp", "node"}));
+      ->check(CLI::IsMember({"stl", "ply", "obj", "off", "vtp", "vtm", "vti", "mha", "vtu", "msh",
+                             "mesh", "inp", "node"}));
+  command
+      .add_option("--coordinates", flags.coordinates,
+                  "Frame of the coordinates in the mesh files: lps (DICOM's patient frame) or "
+                  "ras (3D Slicer's world frame: x and y negated)")
+      ->check(CLI::IsMember({"lps", "ras"}))
+      ->capture_default_str();
+  command
+      .add_option("--overlapping", flags.overlapping,
+                  "Overlapping segments (DICOM SEG, 3D Slicer): refuse the input naming them, or "
+                  "separate: mesh each segment on its own")
+      ->check(CLI::IsMember({"refuse", "separate"}))
+      ->capture_default_str();
   command.add_option("--max-voxels", flags.max_voxels, "Refuse volumes with more voxels than this")
       ->capture_default_str();
 }
@@ -191,6 +204,10 @@ absl::StatusOr<v1::MeshOptions> to_mesh_options(const PipelineFlags& flags) {
       }
     }
   }
+  proto.set_coordinates(flags.coordinates == "ras" ? v1::COORDINATE_FRAME_RAS
+                                                   : v1::COORDINATE_FRAME_LPS);
+  proto.set_overlapping_segments(flags.overlapping == "separate" ? v1::OVERLAPPING_SEGMENTS_SEPARATE
+                                                                 : v1::OVERLAPPING_SEGMENTS_REFUSE);
   if (flags.poisson.max_edge_mm > 0) proto.set_max_edge_mm(flags.poisson.max_edge_mm);
   if (flags.poisson.max_distance_mm > 0) proto.set_max_distance_mm(flags.poisson.max_distance_mm);
   proto.set_adapt_to_thickness(!flags.no_adapt_to_thickness);

@@ -35,6 +35,8 @@ struct PipelineFlags {
   GuardOptions guard;
   bool no_fall_back = false;
   std::vector<std::string> formats{"stl", "vtp"};
+  std::string coordinates = "lps";
+  std::string overlapping = "refuse";
   uint64_t max_voxels = volume::ReadLimits{}.max_voxels;
 };
 

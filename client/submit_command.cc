@@ -17,6 +17,7 @@
 #include "client/job_follow.h"
 #include "client/label_warnings.h"
 #include "client/pipeline_options.h"
+#include "client/report_table.h"
 #include "client/server_connection.h"
 #include "core/pipeline/job_options.h"
 #include "core/pipeline/report.h"
@@ -168,6 +169,7 @@ int run_submit(const SubmitFlags& flags) {
   if (flags.json) {
     std::printf("%s\n", to_json(job->report()).c_str());
   } else {
+    std::printf("%s", report_table(job->report()).c_str());
     std::printf("job %s finished: %d files written to %s\n", reply->job_id().c_str(), *written,
                 flags.out_dir.c_str());
   }

@@ -340,6 +340,7 @@ grpc::Status MeshingService::submit(grpc::ServerContext& context,
       }
     }
     auto read = check_volume_in_worker(worker_executable(config_), upload.path(), voxel_limit,
+                                       params.limits.separate_overlapping,
                                        config_.worker_memory_bytes, kVolumeCheckTime, keep_going);
     if (!read.ok()) {
       reason = "bad_volume";

@@ -14,7 +14,9 @@
 #include <filesystem>
 #include <fstream>
 #include <new>
+#include <string>
 #include <string_view>
+#include <vector>
 
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
@@ -35,48 +37,91 @@ using Clock = std::chrono::steady_clock;
 // Turns the pipeline's progress callbacks into stage and progress events.
 // Some stages report only when they are done (fraction 1), so a stage is
 // taken to start when the one before it last reported, not at its own first
-// report.
+// report. Stages that work label by label run for several labels at once and
+// interleave: each is started once, at its first report, and all of them end
+// together when the next whole-volume stage begins, so a watcher sees every
+// stage once.
 class StageEvents {
  public:
   explicit StageEvents(int fd) : fd_(fd), last_report_(Clock::now()) {}
 
-  void update(std::string_view stage, double fraction) {
+  void update(const ProgressUpdate& update) {
     const Clock::time_point now = Clock::now();
-    if (stage != stage_) {
-      finish_stage();
-      stage_ = std::string(stage);
-      stage_start_ = last_report_;
-      percent_ = -1;
+    const bool labelled = update.label != nullptr;
+    if (!labelled && (open_.size() != 1 || open_.front().name != update.stage)) finish_stage();
+    if (labelled && !open_.empty() && !open_.front().labelled) finish_stage();
+    if (!is_open(update.stage)) {
+      open_.push_back({std::string(update.stage), labelled, last_report_, now});
       v1::JobEvent event;
-      event.mutable_stage_started()->set_stage(stage_);
+      event.mutable_stage_started()->set_stage(std::string(update.stage));
       write_event(fd_, event);
     }
+    for (auto& stage : open_)
+      if (stage.name == update.stage) stage.last = now;
     last_report_ = now;
-    const int percent = static_cast<int>(fraction * 100);
-    if (percent == percent_) return;
-    percent_ = percent;
-    v1::JobEvent event;
-    event.mutable_progress()->set_stage(stage_);
-    event.mutable_progress()->set_fraction(fraction);
-    write_event(fd_, event);
+    send_progress(update, now);
   }
 
+  // Ends every open stage, in the order they started.
   void finish_stage() {
-    if (stage_.empty()) return;
-    v1::JobEvent event;
-    event.mutable_stage_finished()->set_stage(stage_);
-    event.mutable_stage_finished()->set_seconds(
-        std::chrono::duration<double>(last_report_ - stage_start_).count());
-    write_event(fd_, event);
-    stage_.clear();
+    for (const auto& stage : open_) {
+      v1::JobEvent event;
+      event.mutable_stage_finished()->set_stage(stage.name);
+      event.mutable_stage_finished()->set_seconds(
+          std::chrono::duration<double>(stage.last - stage.start).count());
+      write_event(fd_, event);
+    }
+    open_.clear();
   }
 
  private:
+  struct OpenStage {
+    std::string name;
+    bool labelled;
+    Clock::time_point start, last;
+  };
+
+  bool is_open(std::string_view name) const {
+    for (const auto& stage : open_)
+      if (stage.name == name) return true;
+    return false;
+  }
+
+  // A progress event for each label's stage as it starts, then when its
+  // percentage moves: at most one each 50 ms for labels, which interleave
+  // and report often, but always its end.
+  void send_progress(const ProgressUpdate& update, Clock::time_point now) {
+    const int percent = static_cast<int>(update.fraction * 100);
+    const int32_t label = update.label ? update.label->label : 0;
+    const bool same = label == sent_label_ && update.stage == sent_stage_;
+    if (same && percent == sent_percent_) return;
+    if (same && label != 0 && percent < 100 && now - sent_at_ < std::chrono::milliseconds(50))
+      return;
+    sent_label_ = label;
+    sent_stage_ = std::string(update.stage);
+    sent_percent_ = percent;
+    sent_at_ = now;
+    v1::JobEvent event;
+    auto* progress = event.mutable_progress();
+    progress->set_stage(sent_stage_);
+    progress->set_fraction(update.fraction);
+    if (const LabelInProgress* in_progress = update.label) {
+      progress->set_label(in_progress->label);
+      progress->set_label_name(in_progress->name);
+      progress->set_label_index(in_progress->index);
+      progress->set_label_count(in_progress->count);
+      progress->set_labels_done(in_progress->done);
+    }
+    write_event(fd_, event);
+  }
+
   int fd_;
-  std::string stage_;
-  int percent_ = -1;
-  Clock::time_point stage_start_;
+  std::vector<OpenStage> open_;
   Clock::time_point last_report_;
+  int32_t sent_label_ = 0;
+  std::string sent_stage_;
+  int sent_percent_ = -1;
+  Clock::time_point sent_at_;
 };
 
 void send_failure(int fd, const absl::Status& status, const std::string& job_dir) {
@@ -104,9 +149,7 @@ absl::Status run_job(const std::string& job_dir, const std::string& out_dir, int
   }
   StageEvents events(fd);
   RunContext context;
-  context.progress = [&events](std::string_view stage, double fraction) {
-    events.update(stage, fraction);
-  };
+  context.progress = [&events](const ProgressUpdate& update) { events.update(update); };
   auto result =
       run_pipeline(absl::StrCat(job_dir, "/input", record.input_extension()), *params, context);
   if (!result.ok()) return result.status();
@@ -120,10 +163,13 @@ absl::Status run_job(const std::string& job_dir, const std::string& out_dir, int
 
 }  // namespace
 
-int check_volume(const std::string& path, const std::string& max_voxels) {
+int check_volume(const std::string& path, const std::string& max_voxels,
+                 std::string_view overlapping) {
   volume::ReadLimits limits;
   limits.allow_data_file = false;
   if (!absl::SimpleAtoi(max_voxels, &limits.max_voxels)) return 2;
+  if (overlapping != "separate" && overlapping != "refuse") return 2;
+  limits.separate_overlapping = overlapping == "separate";
   absl::Status status;
   try {
     status = volume::read_label_volume(path, limits, RunContext()).status();
@@ -159,9 +205,9 @@ int main(int argc, char** argv) {
     std::printf("%s\n", labelmesh::server::kWorkerVersionLine);
     return 0;
   }
-  if (argc == 4 && std::string_view(argv[1]) == labelmesh::server::kCheckVolumeMode &&
+  if (argc == 5 && std::string_view(argv[1]) == labelmesh::server::kCheckVolumeMode &&
       fcntl(3, F_GETFD) != -1) {
-    return labelmesh::server::check_volume(argv[2], argv[3]);
+    return labelmesh::server::check_volume(argv[2], argv[3], argv[4]);
   }
   // Only labelmeshd starts it, with the event pipe as descriptor 3: refuse
   // anything else.

@@ -359,15 +359,17 @@ absl::Status check_worker_version(const std::string& executable,
 }
 
 absl::Status check_volume_in_worker(const std::string& executable, const std::string& path,
-                                    uint64_t max_voxels, uint64_t memory_bytes,
-                                    std::chrono::milliseconds time_limit,
+                                    uint64_t max_voxels, bool separate_overlapping,
+                                    uint64_t memory_bytes, std::chrono::milliseconds time_limit,
                                     const std::function<bool()>& keep_going) {
   int out[2];
   if (pipe2(out, O_CLOEXEC) != 0) return absl::UnavailableError("cannot create a pipe");
   const int null_fd = ::open("/dev/null", O_RDWR | O_CLOEXEC);
   std::string program = executable, mode = kCheckVolumeMode, file = path,
-              voxels = std::to_string(max_voxels);
-  std::vector<char*> argv{program.data(), mode.data(), file.data(), voxels.data(), nullptr};
+              voxels = std::to_string(max_voxels),
+              overlapping = separate_overlapping ? "separate" : "refuse";
+  std::vector<char*> argv{program.data(), mode.data(),        file.data(),
+                          voxels.data(),  overlapping.data(), nullptr};
   // The same child as a job's: its answer comes on descriptor 3, its
   // stdout and stderr (VTK's messages) go nowhere.
   ChildSetup setup{.server_pid = getpid(),

@@ -81,9 +81,10 @@ std::string worker_executable(const ServerConfig& config);
 // before a job is accepted. `keep_going` is asked twice a second; false
 // kills the reader (CANCELLED). INVALID_ARGUMENT with the reader's message
 // (paths named "upload"); RESOURCE_EXHAUSTED over the memory or time limit.
+// `separate_overlapping` is the job's choice for overlapping segments.
 absl::Status check_volume_in_worker(const std::string& executable, const std::string& path,
-                                    uint64_t max_voxels, uint64_t memory_bytes,
-                                    std::chrono::milliseconds time_limit,
+                                    uint64_t max_voxels, bool separate_overlapping,
+                                    uint64_t memory_bytes, std::chrono::milliseconds time_limit,
                                     const std::function<bool()>& keep_going);
 
 // Kills the workers of an earlier server on the same spool that are still

@@ -108,7 +108,7 @@ absl::Status read_label_names(const v1::MeshOptions& options, volume::LabelDescr
       return absl::InvalidArgumentError(cat(field, ": name holds control characters"));
     if (entry.colour_rgb_size() != 0 && entry.colour_rgb_size() != 3)
       return absl::InvalidArgumentError(cat(field, ": colour_rgb needs three values or none"));
-    volume::LabelDescription named{.label = entry.label(), .name = entry.name()};
+    volume::LabelDescription named = volume::named_label(entry.label(), entry.name());
     if (entry.colour_rgb_size() == 3) {
       std::array<uint8_t, 3> colour{};
       for (int c = 0; c < 3; ++c) {
@@ -348,6 +348,13 @@ v1::MeshOptions make_options(const MeshParams& params) {
   } else {
     options.set_volume(v1::VOLUME_METHOD_NONE);
   }
+  for (auto format : params.scene_formats)
+    options.add_formats(std::string(scene_format_name(format)));
+  options.set_coordinates(params.frame == CoordinateFrame::kRas ? v1::COORDINATE_FRAME_RAS
+                                                                : v1::COORDINATE_FRAME_LPS);
+  options.set_overlapping_segments(params.limits.separate_overlapping
+                                       ? v1::OVERLAPPING_SEGMENTS_SEPARATE
+                                       : v1::OVERLAPPING_SEGMENTS_REFUSE);
   options.set_tet_radius_edge(params.tetgen.radius_edge_ratio);
   options.set_tet_min_dihedral_deg(params.tetgen.min_dihedral_deg);
   options.set_tet_max_volume_mm3(params.tetgen.max_volume_mm3);
@@ -394,6 +401,7 @@ absl::StatusOr<MeshParams> params_from_options(const v1::MeshOptions& options) {
     // format, kept once in the order first given.
     params.formats.clear();
     std::vector<volume_mesh::VolumeFormat> volume_formats;
+    std::vector<SceneFormat> scene_formats;
     auto add_once = [](auto& list, auto format) {
       if (std::find(list.begin(), list.end(), format) == list.end()) list.push_back(format);
     };
@@ -402,11 +410,13 @@ absl::StatusOr<MeshParams> params_from_options(const v1::MeshOptions& options) {
         add_once(params.formats, *format);
       } else if (auto volume_format = volume_mesh::volume_format_from_name(name)) {
         add_once(volume_formats, *volume_format);
+      } else if (auto scene_format = scene_format_from_name(name)) {
+        add_once(scene_formats, *scene_format);
       } else {
         return absl::InvalidArgumentError(
             cat("formats: '", name,
-                "' is not one of stl, ply, obj, off, vtp (surfaces), vtu, msh, mesh, inp, node "
-                "(volumes)"));
+                "' is not one of stl, ply, obj, off, vtp (surfaces), vtm, vti, mha (scene), vtu, "
+                "msh, mesh, inp, node (volumes)"));
       }
     }
     if (!volume_formats.empty()) {
@@ -416,6 +426,29 @@ absl::StatusOr<MeshParams> params_from_options(const v1::MeshOptions& options) {
       }
       params.volume_formats = std::move(volume_formats);
     }
+    params.scene_formats = std::move(scene_formats);
+  }
+  switch (options.overlapping_segments()) {
+    case v1::OVERLAPPING_SEGMENTS_UNSPECIFIED:
+    case v1::OVERLAPPING_SEGMENTS_REFUSE:
+      params.limits.separate_overlapping = false;
+      break;
+    case v1::OVERLAPPING_SEGMENTS_SEPARATE:
+      params.limits.separate_overlapping = true;
+      break;
+    default:
+      return absl::InvalidArgumentError("overlapping_segments: unknown choice");
+  }
+  switch (options.coordinates()) {
+    case v1::COORDINATE_FRAME_UNSPECIFIED:
+    case v1::COORDINATE_FRAME_LPS:
+      params.frame = CoordinateFrame::kLps;
+      break;
+    case v1::COORDINATE_FRAME_RAS:
+      params.frame = CoordinateFrame::kRas;
+      break;
+    default:
+      return absl::InvalidArgumentError("coordinates: unknown coordinate frame");
   }
   if (options.max_voxels() > 0) params.limits.max_voxels = options.max_voxels();
   return params;

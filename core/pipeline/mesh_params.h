@@ -6,10 +6,12 @@
 #include <cstdint>
 #include <vector>
 
+#include "core/pipeline/scene_format.h"
 #include "core/surface/poisson_surface.h"
 #include "core/surface/smooth_surface.h"
 #include "core/surface/surface_format.h"
 #include "core/surface/vertex_normals.h"
+#include "core/util/coordinate_frame.h"
 #include "core/volume/label_description.h"
 #include "core/volume/volume_header.h"
 #include "core/volume_mesh/improve_tet_mesh.h"
@@ -127,6 +129,11 @@ struct MeshParams {
   volume_mesh::ImproveParams improve;
   // Volume mesh files (when `volume` is not kNone).
   std::vector<volume_mesh::VolumeFormat> volume_formats{volume_mesh::VolumeFormat::kVtu};
+  // Files of the whole job: the surfaces in one scene, the label volume.
+  std::vector<SceneFormat> scene_formats;
+  // The frame every mesh file's coordinates are written in (report.json
+  // stays LPS and says which frame the files use).
+  CoordinateFrame frame = CoordinateFrame::kLps;
   // Labels meshed at once (each label's own stages use up to two threads);
   // 0: one per core. The output does not depend on it.
   unsigned threads = 0;

@@ -5,6 +5,7 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -33,6 +34,9 @@ struct VolumeSummary {
   // means the segmentation was drawn on every third slice.
   std::array<int, 3> repeated_planes{1, 1, 1};
   volume::LabelDescriptions descriptions;
+  // Images the labels were read into: more than 1 when overlapping segments
+  // were kept apart (volume::ReadLimits::separate_overlapping).
+  uint32_t layers = 1;
 };
 
 // Which connected pieces of a label a surface covers.
@@ -91,6 +95,10 @@ struct MeshResult {
   std::vector<StageTiming> stages;
   // Every label delivered outside its tolerance or not at all.
   std::vector<LabelWarning> warnings;
+  // The label volume as read, kept when a scene format writes it.
+  std::shared_ptr<const volume::LabelVolume> label_image;
+  // Files of the whole job (SceneFormat), relative to the output directory.
+  std::vector<std::string> scene_files;
 };
 
 }  // namespace labelmesh

@@ -5,28 +5,6 @@
 
 namespace labelmesh {
 
-std::string name_slug(std::string_view name) {
-  constexpr size_t kMostCharacters = 48;
-  std::string slug;
-  bool gap = false;
-  for (char c : name) {
-    const bool letter = (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9');
-    const bool upper = c >= 'A' && c <= 'Z';
-    if (!letter && !upper) {
-      gap = !slug.empty();
-      continue;
-    }
-    if (gap) {
-      if (slug.size() + 1 >= kMostCharacters) break;
-      slug.push_back('-');
-      gap = false;
-    }
-    if (slug.size() >= kMostCharacters) break;
-    slug.push_back(upper ? char(c - 'A' + 'a') : c);
-  }
-  return slug;
-}
-
 std::string surface_file_stem(int32_t label, const volume::LabelDescriptions& descriptions) {
   std::string stem = cat("surface-label", label);
   for (const auto& description : descriptions) {

@@ -6,11 +6,13 @@
 #include <malloc.h>
 
 #include <algorithm>
+#include <atomic>
 #include <mutex>
 #include <thread>
 
 #include "core/pipeline/label_queue.h"
 #include "core/pipeline/label_surfaces.h"
+#include "core/pipeline/volume_layers.h"
 #include "core/surface/extract_surfaces.h"
 #include "core/util/exception_status.h"
 #include "core/util/side_by_side.h"
@@ -24,8 +26,11 @@ namespace {
 
 // The input's format, placement, label counts and repeated planes.
 VolumeSummary summary_of(const volume::LabelVolume& volume) {
-  VolumeSummary summary{volume.format, volume.file_voxel_type, volume.geometry,
-                        volume::compute_label_statistics(volume)};
+  VolumeSummary summary;
+  summary.format = volume.format;
+  summary.file_voxel_type = volume.file_voxel_type;
+  summary.geometry = volume.geometry;
+  summary.statistics = volume::compute_label_statistics(volume);
   summary.repeated_planes = volume::find_repeated_planes(volume, summary.statistics);
   summary.descriptions = volume.descriptions;
   return summary;
@@ -116,26 +121,41 @@ unsigned label_threads(const MeshParams& params, size_t labels) {
 // joined in label order, so the result does not depend on the thread count.
 // A label whose stages fail gets that error and the others go on; a stop, a
 // bad option, or a failure of a label asked for by name ends the run.
-absl::Status add_every_label_surface(const volume::LabelVolume& volume, const VolumeSummary& input,
-                                     const std::vector<int32_t>& labels, const MeshParams& params,
-                                     const RunContext& context,
+absl::Status add_every_label_surface(const std::vector<volume::LabelVolume>& layers,
+                                     const std::vector<size_t>& layer_of,
+                                     const VolumeSummary& input, const std::vector<int32_t>& labels,
+                                     const MeshParams& params, const RunContext& context,
                                      std::vector<SurfaceResult>& surfaces,
                                      std::vector<StageTiming>& stages) {
   std::array<double, 3> drawn_spacing;
   for (int axis = 0; axis < 3; ++axis)
-    drawn_spacing[axis] = volume.geometry.spacing[axis] * input.repeated_planes[axis];
+    drawn_spacing[axis] = layers.front().geometry.spacing[axis] * input.repeated_planes[axis];
   const size_t count = labels.size();
   std::vector<std::vector<SurfaceResult>> label_surfaces(count);
   std::vector<std::vector<StageTiming>> label_stages(count);
   std::vector<absl::Status> label_status(count);
+  // Each label's stages report which label they work on, and how many
+  // labels are done by then.
+  std::vector<LabelInProgress> in_progress(count);
+  std::atomic<uint32_t> labels_done{0};
   // Progress callbacks expect one caller at a time.
   std::mutex progress_mutex;
   RunContext shared = context;
   if (context.progress) {
-    shared.progress = [&](std::string_view stage, double fraction) {
+    shared.progress = [&](const ProgressUpdate& update) {
       std::lock_guard<std::mutex> lock(progress_mutex);
-      context.progress(stage, fraction);
+      if (update.label == nullptr) return context.progress(update);
+      LabelInProgress now = *update.label;
+      now.done = labels_done.load();
+      context.progress({update.stage, update.fraction, &now});
     };
+  }
+  for (size_t i = 0; i < count; ++i) {
+    in_progress[i].label = labels[i];
+    in_progress[i].index = static_cast<uint32_t>(i + 1);
+    in_progress[i].count = static_cast<uint32_t>(count);
+    for (const auto& description : input.descriptions)
+      if (description.label == labels[i]) in_progress[i].name = description.name;
   }
   std::vector<bool> large(count);
   for (size_t i = 0; i < count; ++i)
@@ -149,10 +169,12 @@ absl::Status add_every_label_surface(const volume::LabelVolume& volume, const Vo
       const SurfaceTolerance tolerance =
           tolerance_for(statistics->voxels, drawn_spacing, guard.volume_percent,
                         guard.small_volume_percent, guard.hausdorff_mm);
+      RunContext label_context = shared;
+      label_context.label = &in_progress[i];
       absl::Status status;
       try {
-        status = add_label_surfaces(volume, *statistics, params, tolerance, shared,
-                                    label_surfaces[i], label_stages[i]);
+        status = add_label_surfaces(layers[layer_of[i]], *statistics, params, tolerance,
+                                    label_context, label_surfaces[i], label_stages[i]);
       } catch (const std::bad_alloc&) {
         status = absl::ResourceExhaustedError(cat("label ", labels[i], ": out of memory"));
       }
@@ -169,6 +191,7 @@ absl::Status add_every_label_surface(const volume::LabelVolume& volume, const Vo
         status = absl::OkStatus();
       }
       label_status[i] = status;
+      ++labels_done;
       if (!status.ok()) queue.end();
       queue.done(i);
       if (large[i]) release_free_memory();
@@ -185,6 +208,43 @@ absl::Status add_every_label_surface(const volume::LabelVolume& volume, const Vo
     for (const auto& stage : label_stages[i]) add_stage_time(stages, stage.name, stage.seconds);
   }
   return absl::OkStatus();
+}
+
+// The layer each of `labels` lives in.
+std::vector<size_t> layer_of_labels(const std::vector<volume::LabelVolume>& layers,
+                                    const std::vector<int32_t>& labels) {
+  std::vector<size_t> layer_of(labels.size(), 0);
+  if (layers.size() == 1) return layer_of;
+  for (size_t layer = 0; layer < layers.size(); ++layer) {
+    const auto statistics = volume::compute_label_statistics(layers[layer]);
+    for (size_t i = 0; i < labels.size(); ++i)
+      if (statistics.find(labels[i]) != nullptr) layer_of[i] = layer;
+  }
+  return layer_of;
+}
+
+// Marching Cubes of each label from its own layer, in the order of `labels`.
+absl::StatusOr<std::vector<surface::LabelSurface>> extract_layer_surfaces(
+    const std::vector<volume::LabelVolume>& layers, const std::vector<size_t>& layer_of,
+    const volume::VolumeStatistics& statistics, const std::vector<int32_t>& labels,
+    const RunContext& context) {
+  if (layers.size() == 1)
+    return surface::extract_surfaces(layers.front(), statistics, labels, context);
+  std::vector<surface::LabelSurface> all(labels.size());
+  for (size_t layer = 0; layer < layers.size(); ++layer) {
+    std::vector<int32_t> here;
+    std::vector<size_t> at;
+    for (size_t i = 0; i < labels.size(); ++i) {
+      if (layer_of[i] != layer) continue;
+      here.push_back(labels[i]);
+      at.push_back(i);
+    }
+    if (here.empty()) continue;
+    auto extracted = surface::extract_surfaces(layers[layer], statistics, here, context);
+    if (!extracted.ok()) return extracted.status();
+    for (size_t k = 0; k < at.size(); ++k) all[at[k]] = std::move((*extracted)[k]);
+  }
+  return all;
 }
 
 // TetGen on each label's output surface, then the improvement pass.
@@ -252,19 +312,23 @@ absl::StatusOr<MeshResult> run_stages(const std::string& path, const MeshParams&
   if (!volume.ok()) return volume.status();
   if (auto s = check_sizing_for_grid(params.poisson, volume->geometry); !s.ok())
     return absl::InvalidArgumentError(cat(path, ": ", std::string(s.message())));
+  const std::vector<volume::LabelVolume> layers = volume_layers(*volume);
   {
     StageTimer timer(result.stages, "label_statistics");
-    result.input = summary_of(*volume);
+    result.input = summary_of(layers.front());
+    if (layers.size() > 1) result.input.statistics = layered_statistics(layers);
+    result.input.layers = static_cast<uint32_t>(layers.size());
     volume::apply_label_table(params.label_names, result.input.descriptions);
   }
   auto labels = choose_labels(path, result.input.statistics, params.labels);
   if (!labels.ok()) return labels.status();
+  auto layer_of = layer_of_labels(layers, *labels);
 
   absl::StatusOr<std::vector<surface::LabelSurface>> surfaces;
   {
     StageTimer timer(result.stages, "marching_cubes");
     context.report("marching_cubes", 0);
-    surfaces = surface::extract_surfaces(*volume, result.input.statistics, *labels, context);
+    surfaces = extract_layer_surfaces(layers, layer_of, result.input.statistics, *labels, context);
   }
   if (!surfaces.ok()) return surfaces.status();
   // The Marching Cubes figures. When quality surfaces follow, the Marching
@@ -297,8 +361,8 @@ absl::StatusOr<MeshResult> run_stages(const std::string& path, const MeshParams&
     measure_marching_cubes();
   } else {
     side_by_side(measure_marching_cubes, [&] {
-      quality_status = add_every_label_surface(*volume, result.input, *labels, params, context,
-                                               quality_surfaces, result.stages);
+      quality_status = add_every_label_surface(layers, layer_of, result.input, *labels, params,
+                                               context, quality_surfaces, result.stages);
     });
   }
   add_stage_time(result.stages, "surface_statistics", statistics_stage.front().seconds);
@@ -324,6 +388,10 @@ absl::StatusOr<MeshResult> run_stages(const std::string& path, const MeshParams&
 
   if (tetrahedra) {
     if (auto s = add_volume_mesh(params, volume->geometry, context, result); !s.ok()) return s;
+  }
+  if (std::any_of(params.scene_formats.begin(), params.scene_formats.end(),
+                  [](SceneFormat f) { return f != SceneFormat::kVtm; })) {
+    result.label_image = std::make_shared<const volume::LabelVolume>(std::move(*volume));
   }
   return result;
 }

@@ -158,6 +158,7 @@ v1::InputSummary make_input_summary(const VolumeSummary& summary) {
     describe_label(label.label, summary.descriptions, *entry);
   }
   input.set_background_voxels(summary.statistics.background_voxels);
+  input.set_layers(summary.layers);
   for (int axis = 0; axis < 3; ++axis) {
     input.add_repeated_planes(static_cast<uint32_t>(summary.repeated_planes[axis]));
     input.add_drawn_spacing(g.spacing[axis] * summary.repeated_planes[axis]);
@@ -198,6 +199,8 @@ v1::Report make_report(const MeshResult& result, const MeshParams& params) {
     entry->set_label(warning.label);
     entry->set_reason(warning.reason);
   }
+  report.set_files_frame(std::string(frame_name(params.frame)));
+  for (const auto& file : result.scene_files) report.add_scene_files(file);
   for (const auto& stage : result.stages) {
     auto* entry = report.add_stages();
     entry->set_name(stage.name);

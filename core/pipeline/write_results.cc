@@ -7,15 +7,68 @@
 
 #include "core/pipeline/output_names.h"
 #include "core/pipeline/report.h"
+#include "core/pipeline/report_html.h"
 #include "core/surface/write_surface.h"
 #include "core/util/exception_status.h"
 #include "core/util/stage_timer.h"
 #include "core/util/text.h"
+#include "core/volume/write_label_volume.h"
 #include "core/volume_mesh/write_volume_mesh.h"
 
 namespace labelmesh {
 
 namespace {
+
+std::string label_name(int32_t label, const volume::LabelDescriptions& descriptions) {
+  for (const auto& description : descriptions)
+    if (description.label == label) return description.name;
+  return {};
+}
+
+// The whole job's files: every output surface in one scene, the label volume.
+absl::Status write_scene(MeshResult& result, const MeshParams& params, const std::string& out_dir) {
+  result.scene_files.clear();
+  for (auto format : params.scene_formats) {
+    const std::string name(scene_file_name(format));
+    const auto path = (std::filesystem::path(out_dir) / name).string();
+    if (format == SceneFormat::kVtm) {
+      std::vector<const surface::TriangleMesh*> meshes;
+      std::vector<surface::SurfaceFileInfo> infos;
+      for (const auto& surface : result.surfaces) {
+        if (!surface.is_output) continue;
+        meshes.push_back(&surface.mesh);
+        infos.push_back(
+            {surface.label, label_name(surface.label, result.input.descriptions), params.frame});
+      }
+      if (auto s = surface::write_surface_scene(meshes, infos, path); !s.ok()) return s;
+      result.scene_files.push_back(name);
+      // VTK writes the blocks to a directory named after the file.
+      std::vector<std::string> blocks;
+      for (const auto& entry :
+           std::filesystem::directory_iterator(std::filesystem::path(out_dir) / "surfaces"))
+        blocks.push_back(cat("surfaces/", entry.path().filename().string()));
+      std::sort(blocks.begin(), blocks.end());
+      result.scene_files.insert(result.scene_files.end(), blocks.begin(), blocks.end());
+      continue;
+    }
+    if (!result.label_image)
+      return absl::InternalError(cat(path, ": the label volume was not kept"));
+    volume::LabelVolume placed = *result.label_image;
+    if (format == SceneFormat::kVti && params.frame == CoordinateFrame::kRas) {
+      // The same voxels placed in RAS: origin and axis directions with x and y negated.
+      auto& g = placed.geometry;
+      g.origin = in_frame(g.origin, params.frame);
+      for (int column = 0; column < 3; ++column) {
+        const auto axis = in_frame(
+            {g.direction[column], g.direction[3 + column], g.direction[6 + column]}, params.frame);
+        for (int row = 0; row < 3; ++row) g.direction[3 * row + column] = axis[row];
+      }
+    }
+    if (auto s = volume::write_label_volume(placed, path); !s.ok()) return s;
+    result.scene_files.push_back(name);
+  }
+  return absl::OkStatus();
+}
 
 absl::Status write_all(MeshResult& result, const MeshParams& params, const std::string& out_dir,
                        const RunContext& context) {
@@ -36,20 +89,30 @@ absl::Status write_all(MeshResult& result, const MeshParams& params, const std::
         const std::string name = cat(surface_file_stem(surface.label, result.input.descriptions),
                                      ".", surface::surface_format_name(format));
         const auto path = (std::filesystem::path(out_dir) / name).string();
-        if (auto s = surface::write_surface(surface.mesh, path, format); !s.ok()) return s;
+        const surface::SurfaceFileInfo info{
+            surface.label, label_name(surface.label, result.input.descriptions), params.frame};
+        if (auto s = surface::write_surface(surface.mesh, path, format, info); !s.ok()) return s;
         surface.files.push_back(name);
       }
       context.report("write", double(++done) / double(outputs));
     }
   }
+  if (!params.scene_formats.empty()) {
+    StageTimer timer(result.stages, "write_scene");
+    if (auto s = write_scene(result, params, out_dir); !s.ok()) return s;
+  }
   if (result.volume) {
     StageTimer timer(result.stages, "write_volume");
     result.volume->files.clear();
+    volume_mesh::VolumeFileInfo info;
+    info.frame = params.frame;
+    for (const auto& description : result.input.descriptions)
+      if (!description.name.empty()) info.label_names[description.label] = description.name;
     for (auto format : params.volume_formats) {
       const std::string name = cat("volume.", volume_mesh::volume_format_name(format));
       const auto path = (std::filesystem::path(out_dir) / name).string();
       if (auto s = volume_mesh::write_volume_mesh(result.volume->mesh, result.volume->quality, path,
-                                                  format);
+                                                  format, info);
           !s.ok())
         return s;
       result.volume->files.push_back(name);
@@ -58,10 +121,15 @@ absl::Status write_all(MeshResult& result, const MeshParams& params, const std::
         result.volume->files.push_back("volume.ele");
     }
   }
+  const v1::Report report = make_report(result, params);
   const auto report_path = (std::filesystem::path(out_dir) / "report.json").string();
   std::ofstream out(report_path);
-  out << report_json(result, params);
+  out << to_json(report);
   if (!out) return absl::InternalError(cat(report_path, ": could not write the report"));
+  const auto html_path = (std::filesystem::path(out_dir) / "report.html").string();
+  std::ofstream html(html_path);
+  html << report_html(report);
+  if (!html) return absl::InternalError(cat(html_path, ": could not write the report"));
   return absl::OkStatus();
 }
 

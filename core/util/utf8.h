@@ -47,4 +47,14 @@ inline std::string valid_utf8(std::string_view text) {
   return out;
 }
 
+// The longest prefix of valid UTF-8 `text` of at most `bytes` bytes that
+// ends on a whole character.
+inline std::string_view utf8_prefix(std::string_view text, size_t bytes) {
+  if (text.size() <= bytes) return text;
+  size_t end = bytes;
+  // Back up over continuation bytes to the start of the cut character.
+  while (end > 0 && (static_cast<unsigned char>(text[end]) & 0xC0) == 0x80) --end;
+  return text.substr(0, end);
+}
+
 }  // namespace labelmesh

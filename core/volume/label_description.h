@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace labelmesh::volume {
@@ -29,5 +30,15 @@ struct LabelDescription {
 };
 
 using LabelDescriptions = std::vector<LabelDescription>;
+
+// A description with a name (and a colour) only.
+inline LabelDescription named_label(int32_t label, std::string name,
+                                    std::optional<std::array<uint8_t, 3>> colour = {}) {
+  LabelDescription description;
+  description.label = label;
+  description.name = std::move(name);
+  description.colour = colour;
+  return description;
+}
 
 }  // namespace labelmesh::volume

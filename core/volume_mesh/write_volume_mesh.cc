@@ -16,58 +16,20 @@
 #include <vtkCellType.h>
 #include <vtkDoubleArray.h>
 #include <vtkExecutive.h>
+#include <vtkFieldData.h>
 #include <vtkIntArray.h>
 #include <vtkNew.h>
 #include <vtkPoints.h>
 #include <vtkUnstructuredGrid.h>
 #include <vtkXMLUnstructuredGridWriter.h>
 
+#include "core/util/name_slug.h"
 #include "core/util/text.h"
+#include "core/util/text_file.h"
 #include "core/util/vtk_error_flag.h"
 
 namespace labelmesh::volume_mesh {
 namespace {
-
-// Buffered text output that remembers failure; finish() reports it naming the file.
-class TextFile {
- public:
-  explicit TextFile(std::string path)
-      : path_(std::move(path)), out_(path_, std::ios::binary | std::ios::trunc) {}
-
-  TextFile& operator<<(std::string_view text) {
-    buffer_.append(text);
-    if (buffer_.size() > (1u << 20)) flush();
-    return *this;
-  }
-  TextFile& operator<<(char c) {
-    buffer_.push_back(c);
-    return *this;
-  }
-  // Integers in decimal; reals in the shortest form that reads back to the same double.
-  template <typename T>
-  requires std::is_arithmetic_v<T> TextFile& operator<<(T value) {
-    char digits[32];
-    const auto result = std::to_chars(digits, digits + sizeof digits, value);
-    return *this << std::string_view(digits, static_cast<size_t>(result.ptr - digits));
-  }
-
-  absl::Status finish() {
-    flush();
-    out_.close();
-    if (!out_) return absl::InternalError(cat(path_, ": could not write the volume mesh"));
-    return absl::OkStatus();
-  }
-
- private:
-  void flush() {
-    if (out_) out_.write(buffer_.data(), static_cast<std::streamsize>(buffer_.size()));
-    buffer_.clear();
-  }
-
-  std::string path_;
-  std::ofstream out_;
-  std::string buffer_;
-};
 
 std::vector<int32_t> distinct_labels(const TetMesh& mesh) {
   std::vector<int32_t> labels = mesh.labels;
@@ -87,13 +49,40 @@ absl::Status check_positive_labels(const TetMesh& mesh, const std::string& path,
   return absl::OkStatus();
 }
 
+std::string upper_case(std::string text) {
+  for (char& c : text)
+    if (c >= 'a' && c <= 'z') c = char(c - 'a' + 'A');
+  return text;
+}
+
+std::string name_of(int32_t label, const VolumeFileInfo& info) {
+  const auto found = info.label_names.find(label);
+  return found == info.label_names.end() ? std::string() : found->second;
+}
+
+// The labels present and the frame, as numeric field data, which meshio reads
+// too (it refuses string arrays): one array per label, named by its group name
+// and holding the label, and "SPACE=LPS" (or RAS) holding 1.
+void add_label_fields(const TetMesh& mesh, const VolumeFileInfo& info, vtkFieldData* fields) {
+  for (int32_t label : distinct_labels(mesh)) {
+    vtkNew<vtkIntArray> array;
+    array->SetName(label_group_name(label, info).c_str());
+    array->InsertNextValue(label);
+    fields->AddArray(array);
+  }
+  vtkNew<vtkIntArray> space;
+  space->SetName(cat("SPACE=", frame_name(info.frame)).c_str());
+  space->InsertNextValue(1);
+  fields->AddArray(space);
+}
+
 absl::Status write_vtu(const TetMesh& mesh, const std::vector<double>& quality,
-                       const std::string& path) {
+                       const VolumeFileInfo& info, const std::string& path) {
   vtkNew<vtkPoints> points;
   points->SetDataTypeToDouble();
   points->SetNumberOfPoints(static_cast<vtkIdType>(mesh.points.size()));
   for (size_t i = 0; i < mesh.points.size(); ++i)
-    points->SetPoint(static_cast<vtkIdType>(i), mesh.points[i].data());
+    points->SetPoint(static_cast<vtkIdType>(i), in_frame(mesh.points[i], info.frame).data());
   vtkNew<vtkCellArray> cells;
   cells->AllocateExact(static_cast<vtkIdType>(mesh.tetrahedra.size()),
                        static_cast<vtkIdType>(4 * mesh.tetrahedra.size()));
@@ -110,6 +99,7 @@ absl::Status write_vtu(const TetMesh& mesh, const std::vector<double>& quality,
   for (size_t i = 0; i < mesh.labels.size(); ++i)
     labels->SetValue(static_cast<vtkIdType>(i), mesh.labels[i]);
   grid->GetCellData()->AddArray(labels);
+  add_label_fields(mesh, info, grid->GetFieldData());
   if (!quality.empty()) {
     vtkNew<vtkDoubleArray> values;
     values->SetName("quality");
@@ -135,17 +125,18 @@ absl::Status write_vtu(const TetMesh& mesh, const std::vector<double>& quality,
 
 // Gmsh MSH 2.2 ASCII (Gmsh reference manual, "Legacy formats: MSH file format version 2").
 absl::Status write_msh(const TetMesh& mesh, const std::vector<double>& quality,
-                       const std::string& path) {
+                       const VolumeFileInfo& info, const std::string& path) {
   if (auto status = check_positive_labels(mesh, path, "MSH"); !status.ok()) return status;
   const auto labels = distinct_labels(mesh);
-  TextFile file(path);
+  TextFile file(path, "the volume mesh");
   file << "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n";
   file << "$PhysicalNames\n" << labels.size() << '\n';
-  for (int32_t label : labels) file << "3 " << label << " \"label_" << label << "\"\n";
+  for (int32_t label : labels)
+    file << "3 " << label << " \"" << label_group_name(label, info) << "\"\n";
   file << "$EndPhysicalNames\n";
   file << "$Nodes\n" << mesh.points.size() << '\n';
   for (size_t i = 0; i < mesh.points.size(); ++i) {
-    const auto& p = mesh.points[i];
+    const auto p = in_frame(mesh.points[i], info.frame);
     file << i + 1 << ' ' << p[0] << ' ' << p[1] << ' ' << p[2] << '\n';
   }
   file << "$EndNodes\n";
@@ -170,12 +161,18 @@ absl::Status write_msh(const TetMesh& mesh, const std::vector<double>& quality,
 }
 
 // Medit .mesh (INRIA, "The Medit mesh file format"), read by Mmg, Medit, meshio and TetGen.
-absl::Status write_medit(const TetMesh& mesh, const std::string& path) {
+absl::Status write_medit(const TetMesh& mesh, const VolumeFileInfo& info, const std::string& path) {
   const auto faces = label_boundary_faces(mesh);
-  TextFile file(path);
+  TextFile file(path, "the volume mesh");
   file << "MeshVersionFormatted 2\n\nDimension 3\n\n";
+  file << "# labelmesh: coordinates in mm, SPACE=" << frame_name(info.frame) << '\n';
+  for (int32_t label : distinct_labels(mesh))
+    file << "# ref " << label << ": " << label_group_name(label, info) << '\n';
   file << "Vertices\n" << mesh.points.size() << '\n';
-  for (const auto& p : mesh.points) file << p[0] << ' ' << p[1] << ' ' << p[2] << " 0\n";
+  for (const auto& lps : mesh.points) {
+    const auto p = in_frame(lps, info.frame);
+    file << p[0] << ' ' << p[1] << ' ' << p[2] << " 0\n";
+  }
   file << "\nTriangles\n" << faces.size() << '\n';
   for (const auto& face : faces) {
     for (uint32_t v : face.points) file << v + 1 << ' ';
@@ -195,21 +192,23 @@ absl::Status write_medit(const TetMesh& mesh, const std::string& path) {
 // is det[p2-p1, p3-p1, p4-p1]: positive exactly for VTK ordering, which is written unchanged.
 // Faces (Abaqus Analysis User's Manual, "Three-dimensional solid element library"):
 // S1 = 1-2-3, S2 = 1-4-2, S3 = 2-4-3, S4 = 3-4-1; indexed here by the omitted local node.
-absl::Status write_abaqus(const TetMesh& mesh, const std::string& path) {
+absl::Status write_abaqus(const TetMesh& mesh, const VolumeFileInfo& info,
+                          const std::string& path) {
   if (auto status = check_positive_labels(mesh, path, "INP"); !status.ok()) return status;
   static constexpr std::array<int, 4> kFaceByOmittedNode{3, 4, 2, 1};
   const auto labels = distinct_labels(mesh);
   const auto faces = label_boundary_faces(mesh);
-  TextFile file(path);
-  file << "** labelmesh tetrahedral mesh: coordinates in mm (LPS), one ELSET per label\n";
+  TextFile file(path, "the volume mesh");
+  file << "** labelmesh tetrahedral mesh: coordinates in mm, SPACE=" << frame_name(info.frame)
+       << ", one ELSET per label\n";
   file << "*HEADING\nlabelmesh volume mesh\n";
   file << "*NODE\n";
   for (size_t i = 0; i < mesh.points.size(); ++i) {
-    const auto& p = mesh.points[i];
+    const auto p = in_frame(mesh.points[i], info.frame);
     file << i + 1 << ", " << p[0] << ", " << p[1] << ", " << p[2] << '\n';
   }
   for (int32_t label : labels) {
-    file << "*ELEMENT, TYPE=C3D4, ELSET=LABEL_" << label << '\n';
+    file << "*ELEMENT, TYPE=C3D4, ELSET=" << upper_case(label_group_name(label, info)) << '\n';
     for (size_t i = 0; i < mesh.tetrahedra.size(); ++i) {
       if (mesh.labels[i] != label) continue;
       const auto& t = mesh.tetrahedra[i];
@@ -226,7 +225,8 @@ absl::Status write_abaqus(const TetMesh& mesh, const std::string& path) {
       nodes.insert(faces[end].points.begin(), faces[end].points.end());
       ++end;
     }
-    file << "*NSET, NSET=LABEL_" << label << "_BOUNDARY\n";
+    const std::string group = upper_case(label_group_name(label, info));
+    file << "*NSET, NSET=" << group << "_BOUNDARY\n";
     size_t on_line = 0;
     for (uint32_t node : nodes) {
       // At most 16 entries per data line.
@@ -237,7 +237,7 @@ absl::Status write_abaqus(const TetMesh& mesh, const std::string& path) {
       }
     }
     if (on_line != 0) file << '\n';
-    file << "*SURFACE, TYPE=ELEMENT, NAME=LABEL_" << label << "_SURFACE\n";
+    file << "*SURFACE, TYPE=ELEMENT, NAME=" << group << "_SURFACE\n";
     for (size_t i = begin; i < end; ++i)
       file << faces[i].tet + 1 << ", S" << kFaceByOmittedNode[faces[i].across] << '\n';
     begin = end;
@@ -247,7 +247,8 @@ absl::Status write_abaqus(const TetMesh& mesh, const std::string& path) {
 
 // TetGen .node and .ele (TetGen 1.5 manual, §5.2.1 and §5.2.4). TetGen's tetrahedra have the
 // same orientation as VTK's, so corners are written unchanged.
-absl::Status write_tetgen(const TetMesh& mesh, const std::string& path) {
+absl::Status write_tetgen(const TetMesh& mesh, const VolumeFileInfo& info,
+                          const std::string& path) {
   constexpr std::string_view kSuffix = ".node";
   if (path.size() <= kSuffix.size() ||
       std::string_view(path).substr(path.size() - kSuffix.size()) != kSuffix) {
@@ -255,16 +256,16 @@ absl::Status write_tetgen(const TetMesh& mesh, const std::string& path) {
   }
   const std::string ele_path = path.substr(0, path.size() - kSuffix.size()) + ".ele";
   {
-    TextFile file(path);
-    file << "# labelmesh: points in mm (LPS), numbered from 1\n";
+    TextFile file(path, "the volume mesh");
+    file << "# labelmesh: points in mm, SPACE=" << frame_name(info.frame) << ", numbered from 1\n";
     file << mesh.points.size() << " 3 0 0\n";
     for (size_t i = 0; i < mesh.points.size(); ++i) {
-      const auto& p = mesh.points[i];
+      const auto p = in_frame(mesh.points[i], info.frame);
       file << i + 1 << ' ' << p[0] << ' ' << p[1] << ' ' << p[2] << '\n';
     }
     if (auto status = file.finish(); !status.ok()) return status;
   }
-  TextFile file(ele_path);
+  TextFile file(ele_path, "the volume mesh");
   file << "# labelmesh: tetrahedra numbered from 1; the region attribute is the label\n";
   file << mesh.tetrahedra.size() << " 4 1\n";
   for (size_t i = 0; i < mesh.tetrahedra.size(); ++i) {
@@ -277,8 +278,17 @@ absl::Status write_tetgen(const TetMesh& mesh, const std::string& path) {
 
 }  // namespace
 
+std::string label_group_name(int32_t label, const VolumeFileInfo& info) {
+  std::string group = cat("label_", label);
+  std::string slug = name_slug(name_of(label, info));
+  std::replace(slug.begin(), slug.end(), '-', '_');
+  if (!slug.empty()) group += cat("_", slug);
+  return group;
+}
+
 absl::Status write_volume_mesh(const TetMesh& mesh, const std::vector<double>& cell_quality,
-                               const std::string& path, VolumeFormat format) {
+                               const std::string& path, VolumeFormat format,
+                               const VolumeFileInfo& info) {
   if (auto status = check_tet_mesh(mesh); !status.ok()) {
     return absl::InvalidArgumentError(cat(path, ": ", std::string(status.message())));
   }
@@ -288,15 +298,15 @@ absl::Status write_volume_mesh(const TetMesh& mesh, const std::vector<double>& c
   }
   switch (format) {
     case VolumeFormat::kVtu:
-      return write_vtu(mesh, cell_quality, path);
+      return write_vtu(mesh, cell_quality, info, path);
     case VolumeFormat::kMsh:
-      return write_msh(mesh, cell_quality, path);
+      return write_msh(mesh, cell_quality, info, path);
     case VolumeFormat::kMedit:
-      return write_medit(mesh, path);
+      return write_medit(mesh, info, path);
     case VolumeFormat::kAbaqus:
-      return write_abaqus(mesh, path);
+      return write_abaqus(mesh, info, path);
     case VolumeFormat::kTetgen:
-      return write_tetgen(mesh, path);
+      return write_tetgen(mesh, info, path);
   }
   return absl::InternalError("unhandled volume format");
 }

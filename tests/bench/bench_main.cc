@@ -281,9 +281,9 @@ int bench_cancellation(const std::string& path, const std::vector<int32_t>& labe
     labelmesh::RunContext context;
     context.stop = &stop;
     // Stages on two threads report at once.
-    context.progress = [&](std::string_view name, double) {
+    context.progress = [&](const labelmesh::ProgressUpdate& update) {
       std::lock_guard<std::mutex> lock(mutex);
-      stage = std::string(name);
+      stage = std::string(update.stage);
     };
     absl::StatusCode code = absl::StatusCode::kOk;
     std::thread run([&] { code = labelmesh::run_pipeline(path, params, context).status().code(); });

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <sys/wait.h>
+#include <array>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -97,7 +98,41 @@ TEST(Cli, LabelNamesNameTheSurfaceFiles) {
   std::ifstream report(dir / "out" / "report.json");
   const std::string text((std::istreambuf_iterator<char>(report)), {});
   EXPECT_NE(text.find("\"name\": \"hippo-R\""), std::string::npos);
+  // The summary table names the label.
+  EXPECT_NE(run.output.find("      4  hippo-R "), std::string::npos) << run.output;
   EXPECT_NE(run_cli("mesh x.nii.gz --out d --label-names /no/such.label").exit_code, 0);
+}
+
+// RAS coordinates are LPS with x and y negated, in every surface file, and the
+// files say so.
+TEST(Cli, RasCoordinatesNegateXAndY) {
+  const auto dir = testing::scratch_dir("cli-ras");
+  const std::string input = (dir / "torus.mha").string();
+  ASSERT_EQ(run_cli("phantom torus --out " + input).exit_code, 0);
+  for (const char* frame : {"lps", "ras"}) {
+    const CliRun run = run_cli("mesh " + input + " --out " + (dir / frame).string() +
+                               " --surface repaired --formats obj,vtm --coordinates " + frame);
+    ASSERT_EQ(run.exit_code, 0) << run.output;
+  }
+  const std::string lps = slurp(dir / "lps" / "surface-label1.obj");
+  const std::string ras = slurp(dir / "ras" / "surface-label1.obj");
+  EXPECT_EQ(lps.rfind("# SPACE=LPS\n", 0), 0u);
+  EXPECT_EQ(ras.rfind("# SPACE=RAS\n", 0), 0u);
+  auto first_vertex = [](const std::string& obj) {
+    std::istringstream in(obj.substr(obj.find("\nv ") + 3));
+    std::array<double, 3> p{};
+    in >> p[0] >> p[1] >> p[2];
+    return p;
+  };
+  const auto a = first_vertex(lps), b = first_vertex(ras);
+  EXPECT_EQ(b[0], -a[0]);
+  EXPECT_EQ(b[1], -a[1]);
+  EXPECT_EQ(b[2], a[2]);
+  EXPECT_TRUE(std::filesystem::exists(dir / "ras" / "surfaces.vtm"));
+  EXPECT_NE(slurp(dir / "ras" / "report.json").find("\"files_frame\": \"RAS\""), std::string::npos);
+  EXPECT_EQ(
+      run_cli("mesh " + input + " --out " + (dir / "x").string() + " --coordinates xyz").exit_code,
+      2);
 }
 
 TEST(Cli, VersionIsTheProjects) {

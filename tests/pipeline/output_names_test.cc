@@ -23,7 +23,7 @@ TEST(OutputNames, SlugsKeepLettersAndDigitsOnly) {
 }
 
 TEST(OutputNames, UnnamedLabelsKeepTheirNumberOnly) {
-  volume::LabelDescriptions names{{.label = 5, .name = "Liver"}, {.label = 6, .name = "%%"}};
+  volume::LabelDescriptions names{volume::named_label(5, "Liver"), volume::named_label(6, "%%")};
   EXPECT_EQ(surface_file_stem(5, names), "surface-label5-liver");
   EXPECT_EQ(surface_file_stem(6, names), "surface-label6");
   EXPECT_EQ(surface_file_stem(7, names), "surface-label7");

@@ -6,6 +6,8 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <set>
+#include <string>
 #include <thread>
 #include <tuple>
 
@@ -109,8 +111,8 @@ TEST_F(MeshingServiceTest, WholeJobFromUploadToFetchedArtifacts) {
   ASSERT_TRUE(service.stub().ListArtifacts(ctx.get(), list_request, &artifacts).ok());
   std::vector<std::string> names;
   for (const auto& artifact : artifacts.artifacts()) names.push_back(artifact.name());
-  EXPECT_EQ(names,
-            (std::vector<std::string>{"report.json", "surface-label1.stl", "surface-label1.vtp"}));
+  EXPECT_EQ(names, (std::vector<std::string>{"report.html", "report.json", "surface-label1.stl",
+                                             "surface-label1.vtp"}));
   for (const auto& artifact : artifacts.artifacts()) {
     auto fetch_ctx = service.context();
     v1::FetchRequest request;
@@ -357,7 +359,7 @@ TEST_F(MeshingServiceTest, ADicomSegIsMeshedWithItsSegmentNamesOrRefusedAtSubmit
   ASSERT_TRUE(
       service.submit(shared_data("dicom-seg/dcmqi-24x38x3-seg.dcm"), repaired_options(), &reply)
           .ok());
-  service.watch(reply.job_id());
+  const auto events = service.watch(reply.job_id());
   const v1::Job job = service.get(reply.job_id());
   ASSERT_EQ(job.state(), v1::JOB_STATE_SUCCEEDED) << job.error().message();
   const v1::InputSummary& input = job.report().input();
@@ -366,6 +368,54 @@ TEST_F(MeshingServiceTest, ADicomSegIsMeshedWithItsSegmentNamesOrRefusedAtSubmit
   EXPECT_EQ(input.labels(0).name(), "Liver");
   EXPECT_EQ(input.labels(0).voxels(), 315u);
   EXPECT_EQ(input.labels(0).type().value(), "T-62000");
+  EXPECT_EQ(input.layers(), 1u);
+  // Progress of the label-by-label stages names the segment; every stage
+  // starts and finishes once.
+  std::set<std::string> started, finished;
+  int named = 0;
+  for (const auto& event : events) {
+    if (event.has_stage_started()) {
+      EXPECT_TRUE(started.insert(event.stage_started().stage()).second);
+    }
+    if (event.has_stage_finished()) {
+      EXPECT_TRUE(finished.insert(event.stage_finished().stage()).second);
+    }
+    if (event.has_progress() && event.progress().label() != 0) {
+      ++named;
+      EXPECT_EQ(event.progress().label(), 1);
+      EXPECT_EQ(event.progress().label_name(), "Liver");
+      EXPECT_EQ(event.progress().label_index(), 1u);
+      EXPECT_EQ(event.progress().label_count(), 1u);
+    }
+  }
+  EXPECT_GT(named, 0);
+  EXPECT_EQ(started, finished);
+  EXPECT_TRUE(started.count("repair"));
+  EXPECT_TRUE(started.count("marching_cubes"));
+}
+
+// With overlapping segments kept apart, the SEG refused above is meshed:
+// each segment on its own.
+TEST_F(MeshingServiceTest, OverlappingSegmentsCanBeMeshedEachOnItsOwn) {
+  ServiceHarness service(config_);
+  v1::MeshOptions options = repaired_options();
+  options.set_overlapping_segments(v1::OVERLAPPING_SEGMENTS_SEPARATE);
+  // Its segments are small (64 and 16 voxels): keep every component.
+  options.set_min_component_voxels(1);
+  v1::SubmitReply reply;
+  ASSERT_TRUE(service
+                  .submit(shared_data("dicom-seg/highdicom-seg_image_ct_binary_overlap.dcm"),
+                          options, &reply)
+                  .ok());
+  service.watch(reply.job_id());
+  const v1::Job job = service.get(reply.job_id());
+  ASSERT_EQ(job.state(), v1::JOB_STATE_SUCCEEDED) << job.error().message();
+  EXPECT_EQ(job.report().input().layers(), 2u);
+  EXPECT_EQ(job.report().options().overlapping_segments(), v1::OVERLAPPING_SEGMENTS_SEPARATE);
+  std::set<int32_t> outputs;
+  for (const auto& surface : job.report().surfaces())
+    if (surface.output()) outputs.insert(surface.label());
+  EXPECT_EQ(outputs, (std::set<int32_t>{1, 2}));
 }
 
 TEST_F(MeshingServiceTest, CancelStopsARunningJobWithinASecond) {

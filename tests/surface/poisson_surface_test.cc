@@ -345,8 +345,8 @@ TEST(PoissonSurface, CancellingStopsWithinASecond) {
   RunContext context;
   context.stop = &stop;
   std::atomic<bool> in_poisson{false};
-  context.progress = [&](std::string_view stage, double) {
-    if (stage == "poisson") in_poisson = true;
+  context.progress = [&](const ProgressUpdate& update) {
+    if (update.stage == "poisson") in_poisson = true;
   };
   MeshParams params = poisson_everywhere();
   params.poisson.max_edge_voxels = 1;  // slow meshing, so there is time to cancel
@@ -374,8 +374,8 @@ TEST(PoissonSurface, AStopDuringTheChecksCancelsTheRun) {
   std::atomic<bool> stop{false};
   RunContext context;
   context.stop = &stop;
-  context.progress = [&](std::string_view stage, double) {
-    if (stage == "surface_distance") stop = true;
+  context.progress = [&](const ProgressUpdate& update) {
+    if (update.stage == "surface_distance") stop = true;
   };
   auto result = run_pipeline(path, poisson_everywhere(), context);
   EXPECT_EQ(result.status().code(), absl::StatusCode::kCancelled);

@@ -96,9 +96,8 @@ TEST(LabelTable, ErrorsNameTheFileAndLine) {
 }
 
 TEST(LabelTable, ATableNamesOverWhatTheVolumeSaid) {
-  LabelDescriptions described{{.label = 1, .name = "Liver", .colour = {{221, 130, 101}}}};
-  apply_label_table({{.label = 1, .name = "liver (segment 1)"}, {.label = 3, .name = "kidney"}},
-                    described);
+  LabelDescriptions described{named_label(1, "Liver", {{221, 130, 101}})};
+  apply_label_table({named_label(1, "liver (segment 1)"), named_label(3, "kidney")}, described);
   ASSERT_EQ(described.size(), 2u);
   EXPECT_EQ(described[0].name, "liver (segment 1)");
   EXPECT_EQ(described[0].colour, (std::array<uint8_t, 3>{221, 130, 101}));

@@ -2,10 +2,13 @@
 # SPDX-License-Identifier: AGPL-3.0-or-later
 """The liver's tetrahedral mesh in solvers nobody here wrote.
 
-`labelmesh mesh liver.inr.gz --labels 255 --volume tet --formats inp,msh`, then:
+`labelmesh mesh liver.inr.gz --labels 255 --volume tet --formats inp,msh`,
+with the label named "liver" by a label table, then:
 - Gmsh loads volume.msh and its coherence check (duplicate nodes and
-  elements, isolated nodes) finds nothing, with the report's counts;
-- CalculiX solves a linear-elastic load case on volume.inp: the nodes in the
+  elements, isolated nodes) finds nothing, with the report's counts, and
+  Gmsh writes the physical group back under its name, label_255_liver;
+- CalculiX solves a linear-elastic load case on volume.inp, on the element set
+  named after the label (LABEL_255_LIVER): the nodes in the
   lowest 5 % of the z range fixed, gravity along -z, soft-tissue material.
   It must finish without an error or a Jacobian warning, and the largest
   displacement must be finite, positive and downward at the far end.
@@ -38,7 +41,7 @@ def read_nodes(inp):
     return nodes
 
 
-def write_deck(work, nodes, label):
+def write_deck(work, nodes, element_set):
     zs = [p[2] for p in nodes.values()]
     z_min, z_max = min(zs), max(zs)
     fixed = sorted(n for n, p in nodes.items() if p[2] <= z_min + 0.05 * (z_max - z_min))
@@ -50,10 +53,10 @@ def write_deck(work, nodes, label):
         # solve of its sag would be meaningless), nearly incompressible.
         "*MATERIAL, NAME=TISSUE", "*ELASTIC", "1.0, 0.45",
         "*DENSITY", "1.06e-9",
-        f"*SOLID SECTION, ELSET=LABEL_{label}, MATERIAL=TISSUE",
+        f"*SOLID SECTION, ELSET={element_set}, MATERIAL=TISSUE",
         "*BOUNDARY", "FIXED, 1, 3",
         "*STEP", "*STATIC",
-        "*DLOAD", f"LABEL_{label}, GRAV, 9810., 0., 0., -1.",
+        "*DLOAD", f"{element_set}, GRAV, 9810., 0., 0., -1.",
         "*NODE PRINT, NSET=EVERY", "U",
         "*END STEP",
     ]
@@ -78,7 +81,15 @@ def check_gmsh(work, report):
     if not elements or int(elements.group(1)) != int(volume["tetrahedra"]):
         fail(f"gmsh read {elements and elements.group(1)} elements, "
              f"the report has {volume['tetrahedra']}")
-    print(f"gmsh: {nodes.group(1)} nodes, {elements.group(1)} elements, coherence check clean")
+    # Gmsh writes what it read: the physical group must come back with its name.
+    run = subprocess.run(["gmsh", "-0", str(work / "volume.msh"), "-o", str(work / "gmsh.msh"),
+                          "-format", "msh4"], capture_output=True, text=True, timeout=300)
+    if run.returncode != 0:
+        fail(f"gmsh could not write the mesh back: {(run.stdout + run.stderr)[-2000:]}")
+    if '3 255 "label_255_liver"' not in (work / "gmsh.msh").read_text():
+        fail("gmsh did not keep the physical name label_255_liver")
+    print(f"gmsh: {nodes.group(1)} nodes, {elements.group(1)} elements, coherence check clean, "
+          "physical name label_255_liver")
 
 
 def check_calculix(work, nodes, fixed):
@@ -122,9 +133,11 @@ def main():
     args = parser.parse_args()
     with tempfile.TemporaryDirectory(prefix="labelmesh-fe-") as tmp:
         work = pathlib.Path(tmp)
+        (work / "names.json").write_text('{"255": "liver"}')
         run = subprocess.run([args.labelmesh, "mesh", f"{args.data}/liver.inr.gz", "--labels", "255",
                               "--volume", "tet", "--formats", "inp,msh", "--out", str(work),
-                              "--json"], capture_output=True, text=True, timeout=600)
+                              "--label-names", str(work / "names.json"), "--json"],
+                             capture_output=True, text=True, timeout=600)
         if run.returncode != 0:
             fail(f"labelmesh mesh exited {run.returncode}: {run.stderr[-2000:]}")
         report = json.loads(run.stdout)
@@ -132,7 +145,7 @@ def main():
         nodes = read_nodes(work / "volume.inp")
         if len(nodes) != int(report["volume"]["nodes"]):
             fail(f"volume.inp has {len(nodes)} nodes, the report {report['volume']['nodes']}")
-        fixed = write_deck(work, nodes, 255)
+        fixed = write_deck(work, nodes, "LABEL_255_LIVER")
         check_calculix(work, nodes, fixed)
     print("PASS")
 

@@ -346,9 +346,9 @@ TEST(Tetrahedralize, StopRequestCancelsAndProgressReachesOne) {
 
   std::vector<double> fractions;
   RunContext watched;
-  watched.progress = [&](std::string_view stage, double fraction) {
-    EXPECT_EQ(stage, "tetgen");
-    fractions.push_back(fraction);
+  watched.progress = [&](const ProgressUpdate& update) {
+    EXPECT_EQ(update.stage, "tetgen");
+    fractions.push_back(update.fraction);
   };
   ASSERT_TRUE(tetrahedralize(surface, 1, TetgenParams{}, watched, figures).ok());
   ASSERT_GE(fractions.size(), 2u);

@@ -135,6 +135,9 @@ for name, cells in sorted(m.cell_sets.items()):
     print("cell_set:" + name, sum(len(c) for c in cells))
 for name, points in sorted(m.point_sets.items()):
     print("point_set:" + name, len(points))
+for name in sorted(m.field_data):
+    print("field:" + name, *m.field_data[name])
+print("point0", *(repr(float(x)) for x in m.points[0]))
 )";
   const std::string command = "/usr/bin/python3 " + script + " " + path + " 2>&1";
   FILE* pipe = popen(command.c_str(), "r");
@@ -398,6 +401,63 @@ TEST(WriteVolumeMesh, AbaqusElementsArePositiveAndSurfacesLieOnTheBoundary) {
   EXPECT_EQ(summary.at("cell_set:LABEL_1"), std::to_string(count_label(mesh, 1)));
   EXPECT_EQ(summary.at("cell_set:LABEL_2"), std::to_string(count_label(mesh, 2)));
   EXPECT_EQ(summary.at("point_set:LABEL_1_BOUNDARY"), "98");
+}
+
+// Label names and the RAS frame reach every format: group names that solvers and meshio read,
+// comments and field data that say the frame, coordinates with x and y negated and no element
+// turned inside out.
+TEST(WriteVolumeMesh, NamesAndTheFrameReachEveryFormat) {
+  const TetMesh& mesh = two_labels();
+  VolumeFileInfo info;
+  info.label_names = {{1, "Liver"}, {2, "Right kidney (\"RK\")"}};
+  info.frame = CoordinateFrame::kRas;
+  EXPECT_EQ(label_group_name(1, info), "label_1_liver");
+  EXPECT_EQ(label_group_name(2, info), "label_2_right_kidney_rk");
+  EXPECT_EQ(label_group_name(3, info), "label_3");
+  const auto dir = testing::scratch_dir("write-volume-names");
+  const Point& first = mesh.points[0];
+  for (VolumeFormat format : all_volume_formats()) {
+    SCOPED_TRACE(std::string(volume_format_name(format)));
+    const auto path = path_in(dir, format);
+    ASSERT_TRUE(write_volume_mesh(mesh, {}, path, format, info).ok());
+    const auto summary = meshio_summary(dir, path);
+    expect_meshio_counts(summary, mesh);
+    std::istringstream point0(summary.at("point0"));
+    double x = 0, y = 0, z = 0;
+    point0 >> x >> y >> z;
+    EXPECT_EQ(x, -first[0]);
+    EXPECT_EQ(y, -first[1]);
+    EXPECT_EQ(z, first[2]);
+    const std::string text = format == VolumeFormat::kVtu ? "" : read_text(path);
+    switch (format) {
+      case VolumeFormat::kMsh:
+        EXPECT_EQ(summary.at("field:label_1_liver"), "1 3");
+        EXPECT_EQ(summary.at("field:label_2_right_kidney_rk"), "2 3");
+        break;
+      case VolumeFormat::kAbaqus:
+        EXPECT_NE(text.find("SPACE=RAS"), std::string::npos);
+        EXPECT_EQ(summary.at("cell_set:LABEL_1_LIVER"), std::to_string(count_label(mesh, 1)));
+        EXPECT_EQ(summary.at("cell_set:LABEL_2_RIGHT_KIDNEY_RK"),
+                  std::to_string(count_label(mesh, 2)));
+        EXPECT_EQ(summary.at("point_set:LABEL_2_RIGHT_KIDNEY_RK_BOUNDARY"), "98");
+        EXPECT_NE(text.find("*SURFACE, TYPE=ELEMENT, NAME=LABEL_1_LIVER_SURFACE"),
+                  std::string::npos);
+        break;
+      case VolumeFormat::kMedit:
+        EXPECT_NE(text.find("# labelmesh: coordinates in mm, SPACE=RAS\n"), std::string::npos);
+        EXPECT_NE(text.find("# ref 2: label_2_right_kidney_rk\n"), std::string::npos);
+        break;
+      case VolumeFormat::kTetgen:
+        EXPECT_NE(text.find("SPACE=RAS"), std::string::npos);
+        break;
+      case VolumeFormat::kVtu: {
+        EXPECT_EQ(summary.at("field:label_1_liver"), "1");
+        EXPECT_EQ(summary.at("field:label_2_right_kidney_rk"), "2");
+        EXPECT_EQ(summary.at("field:SPACE=RAS"), "1");
+        break;
+      }
+    }
+  }
 }
 
 TEST(WriteVolumeMesh, BadInputsAndPathsAreErrorsNamingTheFile) {
