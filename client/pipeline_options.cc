@@ -123,8 +123,14 @@ void add_pipeline_flags(CLI::App& command, PipelineFlags& flags) {
       ->capture_default_str();
   command
       .add_option("--volume", flags.volume,
-                  "Volume mesh: none, or tet (TetGen on each label's output surface)")
-      ->check(CLI::IsMember({"none", "tet"}))
+                  "Volume mesh: none; tet (TetGen on each label's output surface); or mixed "
+                  "(hexahedra inside each label, pyramids and tetrahedra out to its surface)")
+      ->check(CLI::IsMember({"none", "tet", "mixed"}))
+      ->capture_default_str();
+  command
+      .add_option("--hex-size", flags.hex_size_mm,
+                  "Mixed: the hexahedra's edge, mm; 0 for three voxels")
+      ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   auto& tetgen = flags.tetgen;
   command
@@ -239,8 +245,9 @@ absl::StatusOr<v1::MeshOptions> to_mesh_options(const PipelineFlags& flags) {
   proto.set_point_reduction(flags.point_reduction == "hierarchy" ? v1::POINT_REDUCTION_HIERARCHY
                             : flags.point_reduction == "none"    ? v1::POINT_REDUCTION_NONE
                                                                  : v1::POINT_REDUCTION_GRID);
-  if (flags.volume == "tet") {
-    proto.set_volume(v1::VOLUME_METHOD_TETGEN);
+  if (flags.volume == "tet" || flags.volume == "mixed") {
+    proto.set_volume(flags.volume == "mixed" ? v1::VOLUME_METHOD_MIXED : v1::VOLUME_METHOD_TETGEN);
+    proto.set_hex_size_mm(flags.hex_size_mm);
     proto.set_tet_radius_edge(flags.tetgen.radius_edge_ratio);
     proto.set_tet_min_dihedral_deg(flags.tetgen.min_dihedral_deg);
     proto.set_tet_max_volume_mm3(flags.tetgen.max_volume_mm3);

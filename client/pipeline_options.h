@@ -24,6 +24,7 @@ struct PipelineFlags {
   std::string point_reduction = "grid";
   bool keep_strands = false;
   std::string volume = "none";
+  double hex_size_mm = 0;
   volume_mesh::TetgenParams tetgen;
   volume_mesh::ImproveParams improve;
   bool tet_split_boundary = false;

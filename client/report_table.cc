@@ -51,7 +51,16 @@ std::string report_table(const v1::Report& report) {
                  s.stage().c_str(), s.nodes(), s.min_angle_deg(), s.max_angle_deg(), s.volume_mm3(),
                  hausdorff.c_str(), warnings[s.label()].c_str());
   }
-  if (report.has_volume()) {
+  if (report.has_volume() && report.volume().hexahedra() > 0) {
+    const auto& v = report.volume();
+    table +=
+        row("volume (%s, %.2f mm): %llu nodes, %llu hexahedra, %llu pyramids, %llu tetrahedra; "
+            "Jacobian ratio min %.3f mean %.3f; tetra Q min %.3f; inverted %llu; volume %+.4f %%\n",
+            v.mesher().c_str(), v.hex_size_mm(), (unsigned long long)v.nodes(),
+            (unsigned long long)v.hexahedra(), (unsigned long long)v.pyramids(),
+            (unsigned long long)v.tetrahedra(), v.jacobian_ratio_min(), v.jacobian_ratio_mean(),
+            v.tetra_quality_min(), (unsigned long long)v.inverted(), 100 * v.volume_change());
+  } else if (report.has_volume()) {
     const auto& v = report.volume();
     const auto& c = v.categories();
     table +=

@@ -259,9 +259,16 @@ absl::Status read_volume_options(const v1::MeshOptions& options, MeshParams& par
     case v1::VOLUME_METHOD_TETGEN:
       params.volume = VolumeMethod::kTetgen;
       break;
+    case v1::VOLUME_METHOD_MIXED:
+      params.volume = VolumeMethod::kMixed;
+      break;
     default:
       return absl::InvalidArgumentError("volume: unknown volume method");
   }
+  if (options.has_hex_size_mm()) params.hex_size_mm = options.hex_size_mm();
+  if (!(params.hex_size_mm == 0 || (params.hex_size_mm >= 0.05 && params.hex_size_mm <= 1000)))
+    return absl::InvalidArgumentError(
+        cat("hex_size_mm: ", params.hex_size_mm, " is neither 0 nor in [0.05, 1000]"));
   auto& tetgen = params.tetgen;
   if (options.has_tet_radius_edge()) tetgen.radius_edge_ratio = options.tet_radius_edge();
   if (options.has_tet_min_dihedral_deg()) tetgen.min_dihedral_deg = options.tet_min_dihedral_deg();
@@ -341,8 +348,10 @@ v1::MeshOptions make_options(const MeshParams& params) {
 
   for (auto format : params.formats)
     options.add_formats(std::string(surface::surface_format_name(format)));
-  if (params.volume == VolumeMethod::kTetgen) {
-    options.set_volume(v1::VOLUME_METHOD_TETGEN);
+  if (params.volume != VolumeMethod::kNone) {
+    options.set_volume(params.volume == VolumeMethod::kMixed ? v1::VOLUME_METHOD_MIXED
+                                                             : v1::VOLUME_METHOD_TETGEN);
+    options.set_hex_size_mm(params.hex_size_mm);
     for (auto format : params.volume_formats)
       options.add_formats(std::string(volume_mesh::volume_format_name(format)));
   } else {
@@ -425,6 +434,13 @@ absl::StatusOr<MeshParams> params_from_options(const v1::MeshOptions& options) {
             "formats: a volume format was asked for without a volume method (volume: tet)");
       }
       params.volume_formats = std::move(volume_formats);
+    }
+    if (params.volume == VolumeMethod::kMixed &&
+        std::count(params.volume_formats.begin(), params.volume_formats.end(),
+                   volume_mesh::VolumeFormat::kTetgen) > 0) {
+      return absl::InvalidArgumentError(
+          "formats: node (TetGen) holds tetrahedra only; a mixed mesh goes to vtu, msh, mesh or "
+          "inp");
     }
     params.scene_formats = std::move(scene_formats);
   }

@@ -94,6 +94,9 @@ enum class VolumeMethod {
   kNone,
   // TetGen on each label's output surface (paper §2.4.2), one region per label.
   kTetgen,
+  // Hexahedra inside each label, pyramids and tetrahedra out to its surface
+  // (paper §2.4.3-2.4.4; mixed_mesh/mixed_mesher.h).
+  kMixed,
 };
 
 // The guard on what is delivered: each label's output surface is compared
@@ -125,6 +128,9 @@ struct MeshParams {
   std::vector<surface::SurfaceFormat> formats{surface::SurfaceFormat::kStl,
                                               surface::SurfaceFormat::kVtp};
   VolumeMethod volume = VolumeMethod::kNone;
+  // kMixed: the hexahedra's edge, mm; 0 for three voxels (the cube root of
+  // the voxel volume).
+  double hex_size_mm = 0;
   volume_mesh::TetgenParams tetgen;
   volume_mesh::ImproveParams improve;
   // Volume mesh files (when `volume` is not kNone).

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "core/pipeline/label_mixed_meshes.h"
 #include "core/pipeline/label_tet_meshes.h"
 #include "core/pipeline/surface_fidelity.h"
 #include "core/surface/poisson_surface.h"
@@ -90,8 +91,9 @@ struct LabelWarning {
 struct MeshResult {
   VolumeSummary input;
   std::vector<SurfaceResult> surfaces;
-  // When a volume method was asked for.
+  // When a volume method was asked for: tetrahedra, or mixed elements.
   std::optional<VolumeResult> volume;
+  std::optional<MixedVolumeResult> mixed;
   std::vector<StageTiming> stages;
   // Every label delivered outside its tolerance or not at all.
   std::vector<LabelWarning> warnings;

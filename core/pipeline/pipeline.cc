@@ -247,6 +247,26 @@ absl::StatusOr<std::vector<surface::LabelSurface>> extract_layer_surfaces(
   return all;
 }
 
+// Mixed elements for each label's output surface.
+absl::Status add_mixed_mesh(const MeshParams& params, const volume::ImageGeometry& geometry,
+                            const RunContext& context, MeshResult& result) {
+  std::vector<LabelBoundary> boundaries;
+  for (const auto& surface : result.surfaces) {
+    if (surface.is_output)
+      boundaries.push_back({surface.label, &surface.mesh, surface.self_intersections});
+  }
+  mixed_mesh::MixedParams mixed;
+  mixed.core.cell_mm = params.hex_size_mm > 0 ? params.hex_size_mm : 3 * voxel_size_mm(geometry);
+  mixed.core.threads = label_threads(params, 2);
+  mixed.tetgen = params.tetgen;
+  mixed.improve = improve_params_for(params, geometry);
+  StageTimer timer(result.stages, "mixed_mesh");
+  auto meshes = mesh_labels_mixed(boundaries, mixed, context);
+  if (!meshes.ok()) return meshes.status();
+  result.mixed = std::move(*meshes);
+  return absl::OkStatus();
+}
+
 // TetGen on each label's output surface, then the improvement pass.
 absl::Status add_volume_mesh(const MeshParams& params, const volume::ImageGeometry& geometry,
                              const RunContext& context, MeshResult& result) {
@@ -388,6 +408,9 @@ absl::StatusOr<MeshResult> run_stages(const std::string& path, const MeshParams&
 
   if (tetrahedra) {
     if (auto s = add_volume_mesh(params, volume->geometry, context, result); !s.ok()) return s;
+  }
+  if (params.volume == VolumeMethod::kMixed) {
+    if (auto s = add_mixed_mesh(params, volume->geometry, context, result); !s.ok()) return s;
   }
   if (std::any_of(params.scene_formats.begin(), params.scene_formats.end(),
                   [](SceneFormat f) { return f != SceneFormat::kVtm; })) {

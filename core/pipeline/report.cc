@@ -12,6 +12,55 @@
 namespace labelmesh {
 namespace {
 
+void set_categories(const quality::QualitySummary& q, v1::QualityCategories& categories) {
+  categories.set_invalid(q.invalid);
+  categories.set_very_bad(q.very_bad);
+  categories.set_questionable(q.questionable);
+  categories.set_good(q.good);
+}
+
+v1::VolumeMeshSummary make_mixed_summary(const MixedVolumeResult& mixed) {
+  const auto& q = mixed.quality;
+  v1::VolumeMeshSummary entry;
+  entry.set_mesher("mixed_grid");
+  entry.set_nodes(mixed.mesh.points.size());
+  entry.set_hexahedra(q.hexahedra);
+  entry.set_pyramids(q.pyramids);
+  entry.set_prisms(q.wedges);
+  entry.set_tetrahedra(q.tetrahedra);
+  entry.set_steiner_points(mixed.figures.tetgen.steiner_points);
+  if (q.tetra_summary.count > 0) {
+    entry.set_tetra_quality_min(q.tetra_summary.min);
+    entry.set_tetra_quality_mean(q.tetra_summary.mean);
+    entry.set_min_dihedral_deg(q.tetra_summary.min_dihedral_deg);
+    entry.set_max_dihedral_deg(q.tetra_summary.max_dihedral_deg);
+  }
+  if (mixed.mesh.size() > 0) {
+    entry.set_jacobian_ratio_min(q.jacobian_ratio_min);
+    entry.set_jacobian_ratio_mean(q.jacobian_ratio_mean);
+  }
+  if (q.pyramid_aspect_ratio_min) entry.set_pyramid_aspect_ratio_min(*q.pyramid_aspect_ratio_min);
+  entry.set_inverted(q.invalid);
+  set_categories(q.cell_summary, *entry.mutable_categories());
+  entry.set_enclosed_volume_mm3(q.volume_mm3);
+  entry.set_surface_volume_mm3(mixed.surface_volume_mm3);
+  if (mixed.surface_volume_mm3 > 0)
+    entry.set_volume_change(q.volume_mm3 / mixed.surface_volume_mm3 - 1);
+  entry.set_hex_size_mm(mixed.cell_mm);
+  const auto& c = mixed.conformity;
+  auto* conformity = entry.mutable_conformity_check();
+  conformity->set_interior_faces(c.interior_faces);
+  conformity->set_boundary_faces(c.boundary_faces);
+  conformity->set_nonconforming_faces(c.nonconforming_faces);
+  conformity->set_duplicate_points(c.duplicate_points);
+  conformity->set_open_boundary_edges(c.open_boundary_edges);
+  // Labels are meshed apart: each label's cells conform, labels share no nodes.
+  entry.set_conforming(false);
+  entry.set_seconds(mixed.seconds);
+  for (const auto& file : mixed.files) entry.add_files(file);
+  return entry;
+}
+
 v1::VolumeMeshSummary make_volume_summary(const VolumeResult& volume) {
   v1::VolumeMeshSummary entry;
   entry.set_mesher(volume.mesher);
@@ -194,6 +243,7 @@ v1::Report make_report(const MeshResult& result, const MeshParams& params) {
     add_quality_figures(surface, *entry);
   }
   if (result.volume) *report.mutable_volume() = make_volume_summary(*result.volume);
+  if (result.mixed) *report.mutable_volume() = make_mixed_summary(*result.mixed);
   for (const auto& warning : result.warnings) {
     auto* entry = report.add_warnings();
     entry->set_label(warning.label);

@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "core/mixed_mesh/write_mixed_mesh.h"
 #include "core/pipeline/output_names.h"
 #include "core/pipeline/report.h"
 #include "core/pipeline/report_html.h"
@@ -101,13 +102,26 @@ absl::Status write_all(MeshResult& result, const MeshParams& params, const std::
     StageTimer timer(result.stages, "write_scene");
     if (auto s = write_scene(result, params, out_dir); !s.ok()) return s;
   }
+  volume_mesh::VolumeFileInfo info;
+  info.frame = params.frame;
+  for (const auto& description : result.input.descriptions)
+    if (!description.name.empty()) info.label_names[description.label] = description.name;
+  if (result.mixed) {
+    StageTimer timer(result.stages, "write_volume");
+    result.mixed->files.clear();
+    for (auto format : params.volume_formats) {
+      const std::string name = cat("volume.", volume_mesh::volume_format_name(format));
+      const auto path = (std::filesystem::path(out_dir) / name).string();
+      if (auto s = mixed_mesh::write_mixed_mesh(result.mixed->mesh, result.mixed->quality, path,
+                                                format, info);
+          !s.ok())
+        return s;
+      result.mixed->files.push_back(name);
+    }
+  }
   if (result.volume) {
     StageTimer timer(result.stages, "write_volume");
     result.volume->files.clear();
-    volume_mesh::VolumeFileInfo info;
-    info.frame = params.frame;
-    for (const auto& description : result.input.descriptions)
-      if (!description.name.empty()) info.label_names[description.label] = description.name;
     for (auto format : params.volume_formats) {
       const std::string name = cat("volume.", volume_mesh::volume_format_name(format));
       const auto path = (std::filesystem::path(out_dir) / name).string();

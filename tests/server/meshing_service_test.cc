@@ -13,6 +13,9 @@
 
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
+#include "core/pipeline/job_options.h"
+#include "core/pipeline/pipeline.h"
+#include "core/pipeline/report.h"
 #include "core/volume/label_volume.h"
 #include "core/volume/phantom.h"
 #include "core/volume/write_label_volume.h"
@@ -135,6 +138,38 @@ TEST_F(MeshingServiceTest, WholeJobFromUploadToFetchedArtifacts) {
   }
   EXPECT_NE(service.server().metrics().text().find("labelmesh_jobs_total{outcome=\"succeeded\"} 1"),
             std::string::npos);
+}
+
+// A mixed volume mesh from the service is the one this process makes.
+TEST_F(MeshingServiceTest, TheServiceMakesTheSameMixedMeshAsTheLibrary) {
+  ServiceHarness service(config_);
+  const fs::path input = write_phantom(dir_, volume::PhantomShape::kSphere);
+  v1::MeshOptions options = repaired_options();
+  options.set_volume(v1::VOLUME_METHOD_MIXED);
+  options.set_hex_size_mm(2);
+  options.add_formats("stl");
+  options.add_formats("vtu");
+  v1::SubmitReply reply;
+  ASSERT_TRUE(service.submit(input, options, &reply).ok());
+  service.watch(reply.job_id());
+  const v1::Job job = service.get(reply.job_id());
+  ASSERT_EQ(job.state(), v1::JOB_STATE_SUCCEEDED) << job.error().message();
+  const v1::VolumeMeshSummary& served = job.report().volume();
+
+  auto params = params_from_options(options);
+  ASSERT_TRUE(params.ok());
+  auto local = run_pipeline(input.string(), *params, {});
+  ASSERT_TRUE(local.ok()) << local.status();
+  const v1::VolumeMeshSummary mine = make_report(*local, *params).volume();
+  EXPECT_EQ(served.mesher(), "mixed_grid");
+  EXPECT_GT(served.hexahedra(), 0u);
+  EXPECT_EQ(served.hexahedra(), mine.hexahedra());
+  EXPECT_EQ(served.pyramids(), mine.pyramids());
+  EXPECT_EQ(served.tetrahedra(), mine.tetrahedra());
+  EXPECT_EQ(served.nodes(), mine.nodes());
+  EXPECT_EQ(served.enclosed_volume_mm3(), mine.enclosed_volume_mm3());
+  EXPECT_EQ(served.inverted(), 0u);
+  EXPECT_EQ(served.files_size(), 1);
 }
 
 TEST_F(MeshingServiceTest, FullQueueRefusesWithResourceExhausted) {

@@ -1,0 +1,78 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+#include "core/mixed_mesh/mixed_mesher.h"
+
+#include <chrono>
+#include <map>
+
+#include "core/util/text.h"
+
+namespace labelmesh::mixed_mesh {
+namespace {
+
+// The surface and the core's shell as one boundary: TetGen fills what lies
+// between, and carves the shell's inside (the core) out as a cavity.
+surface::TriangleMesh layer_boundary(const surface::TriangleMesh& surface, const HexCore& core) {
+  surface::TriangleMesh boundary = surface;
+  const auto offset = static_cast<uint32_t>(boundary.points.size());
+  boundary.points.insert(boundary.points.end(), core.mesh.points.begin(), core.mesh.points.end());
+  for (const auto& t : core.shell)
+    boundary.triangles.push_back({t[0] + offset, t[1] + offset, t[2] + offset});
+  return boundary;
+}
+
+}  // namespace
+
+absl::StatusOr<MixedMesh> mesh_mixed(const surface::TriangleMesh& surface, int32_t label,
+                                     const MixedParams& params, const RunContext& context,
+                                     MixedFigures& figures) {
+  const auto start = std::chrono::steady_clock::now();
+  auto oracle = SurfaceOracle::build(surface);
+  if (!oracle.ok())
+    return absl::InvalidArgumentError(
+        cat("label ", label, ": ", std::string(oracle.status().message())));
+  auto core = build_hex_core(*oracle, surface, label, params.core, context);
+  if (!core.ok()) return core.status();
+  figures.grid_cells = core->grid_cells;
+  figures.depth_queries = core->depth_queries;
+  figures.core_cells_removed = core->cells_removed;
+  figures.core_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+
+  auto tets = volume_mesh::tetrahedralize(layer_boundary(surface, *core), label, params.tetgen,
+                                          context, figures.tetgen);
+  if (!tets.ok()) return tets.status();
+  if (params.improve.target_quality > 0) {
+    volume_mesh::ImproveParams improve = params.improve;
+    improve.max_peel_depth_mm = 0;
+    if (auto s = volume_mesh::improve_tet_mesh(*tets, improve, context, figures.improve); !s.ok())
+      return s;
+  }
+
+  // TetGen keeps input points exactly: the shell's points are found again by
+  // their coordinates, so the tetrahedra share the pyramids' nodes.
+  MixedMesh mesh = std::move(core->mesh);
+  std::map<std::array<double, 3>, uint32_t> shared;
+  for (const auto& t : core->shell)
+    for (uint32_t v : t) shared.emplace(mesh.points[v], v);
+  std::vector<uint32_t> index(tets->points.size());
+  size_t matched = 0;
+  for (size_t i = 0; i < tets->points.size(); ++i) {
+    if (const auto found = shared.find(tets->points[i]); found != shared.end()) {
+      index[i] = found->second;
+      ++matched;
+    } else {
+      index[i] = static_cast<uint32_t>(mesh.points.size());
+      mesh.points.push_back(tets->points[i]);
+    }
+  }
+  if (matched != shared.size()) {
+    return absl::InternalError(
+        cat("label ", label, ": ", shared.size() - matched,
+            " of the core's boundary points are missing from TetGen's mesh"));
+  }
+  for (const auto& t : tets->tetrahedra)
+    mesh.add(CellType::kTetra, {index[t[0]], index[t[1]], index[t[2]], index[t[3]]}, label);
+  return mesh;
+}
+
+}  // namespace labelmesh::mixed_mesh

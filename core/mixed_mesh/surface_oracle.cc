@@ -1,0 +1,64 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+#include "core/mixed_mesh/surface_oracle.h"
+
+#include <cmath>
+#include <thread>
+
+#include <CGAL/AABB_face_graph_triangle_primitive.h>
+#include <CGAL/AABB_traits.h>
+#include <CGAL/AABB_tree.h>
+#include <CGAL/Side_of_triangle_mesh.h>
+
+#include "core/surface/cgal/cgal_mesh.h"
+
+namespace labelmesh::mixed_mesh {
+
+namespace cgal = surface::cgal;
+using Primitive = CGAL::AABB_face_graph_triangle_primitive<cgal::Mesh>;
+using Tree = CGAL::AABB_tree<CGAL::AABB_traits<cgal::Kernel, Primitive>>;
+using Side = CGAL::Side_of_triangle_mesh<cgal::Mesh, cgal::Kernel, CGAL::Default, Tree>;
+
+struct SurfaceOracle::Impl {
+  cgal::Mesh mesh;
+  Tree tree;
+  std::unique_ptr<Side> side;
+};
+
+absl::StatusOr<SurfaceOracle> SurfaceOracle::build(const surface::TriangleMesh& surface) {
+  auto mesh = cgal::to_surface_mesh(surface);
+  if (!mesh || !CGAL::is_closed(*mesh)) {
+    return absl::InvalidArgumentError("the surface is not a closed, oriented manifold");
+  }
+  auto impl = std::make_shared<Impl>();
+  impl->mesh = std::move(*mesh);
+  impl->tree.insert(faces(impl->mesh).first, faces(impl->mesh).second, impl->mesh);
+  impl->tree.build();
+  impl->tree.accelerate_distance_queries();
+  impl->side = std::make_unique<Side>(impl->tree);
+  SurfaceOracle oracle;
+  oracle.impl_ = std::move(impl);
+  return oracle;
+}
+
+double SurfaceOracle::depth(const std::array<double, 3>& point) const {
+  const cgal::Point p(point[0], point[1], point[2]);
+  const double distance = std::sqrt(CGAL::to_double(impl_->tree.squared_distance(p)));
+  const CGAL::Bounded_side side = (*impl_->side)(p);
+  return side == CGAL::ON_BOUNDED_SIDE ? distance : -distance;
+}
+
+std::vector<double> SurfaceOracle::depths(const std::vector<std::array<double, 3>>& points,
+                                          unsigned threads) const {
+  std::vector<double> result(points.size());
+  threads = std::max(1u, threads);
+  std::vector<std::thread> workers;
+  for (unsigned t = 0; t < threads; ++t) {
+    workers.emplace_back([&, t] {
+      for (size_t i = t; i < points.size(); i += threads) result[i] = depth(points[i]);
+    });
+  }
+  for (auto& worker : workers) worker.join();
+  return result;
+}
+
+}  // namespace labelmesh::mixed_mesh

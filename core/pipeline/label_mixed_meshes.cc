@@ -1,0 +1,71 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+#include "core/pipeline/label_mixed_meshes.h"
+
+#include <chrono>
+
+#include "core/surface/surface_statistics.h"
+#include "core/util/text.h"
+
+namespace labelmesh {
+namespace {
+
+void add_figures(mixed_mesh::MixedFigures& sum, const mixed_mesh::MixedFigures& part) {
+  sum.grid_cells += part.grid_cells;
+  sum.depth_queries += part.depth_queries;
+  sum.core_cells_removed += part.core_cells_removed;
+  sum.core_seconds += part.core_seconds;
+  sum.tetgen.input_points += part.tetgen.input_points;
+  sum.tetgen.input_triangles += part.tetgen.input_triangles;
+  sum.tetgen.steiner_points += part.tetgen.steiner_points;
+  sum.tetgen.tetrahedra += part.tetgen.tetrahedra;
+  sum.tetgen.seconds += part.tetgen.seconds;
+  sum.improve.flips_2_3 += part.improve.flips_2_3;
+  sum.improve.flips_3_2 += part.improve.flips_3_2;
+  sum.improve.vertices_moved += part.improve.vertices_moved;
+  sum.improve.vertices_inserted += part.improve.vertices_inserted;
+  sum.improve.seconds += part.improve.seconds;
+}
+
+void add_conformity(mixed_mesh::Conformity& sum, const mixed_mesh::Conformity& part) {
+  sum.interior_faces += part.interior_faces;
+  sum.boundary_faces += part.boundary_faces;
+  sum.nonconforming_faces += part.nonconforming_faces;
+  sum.duplicate_points += part.duplicate_points;
+  sum.open_boundary_edges += part.open_boundary_edges;
+}
+
+}  // namespace
+
+absl::StatusOr<MixedVolumeResult> mesh_labels_mixed(const std::vector<LabelBoundary>& boundaries,
+                                                    const mixed_mesh::MixedParams& params,
+                                                    const RunContext& context) {
+  const auto start = std::chrono::steady_clock::now();
+  MixedVolumeResult result;
+  result.cell_mm = params.core.cell_mm;
+  for (size_t i = 0; i < boundaries.size(); ++i) {
+    const LabelBoundary& boundary = boundaries[i];
+    context.report("mixed_mesh", double(i) / double(boundaries.size()));
+    mixed_mesh::MixedFigures figures;
+    auto mesh = mixed_mesh::mesh_mixed(*boundary.surface, boundary.label, params, context, figures);
+    if (!mesh.ok()) {
+      if (mesh.status().code() == absl::StatusCode::kCancelled) return mesh.status();
+      return absl::Status(mesh.status().code(), cat("label ", boundary.label, ": ",
+                                                    std::string(mesh.status().message())));
+    }
+    if (auto s = mixed_mesh::check_mixed_mesh(*mesh); !s.ok()) {
+      return absl::InternalError(cat("label ", boundary.label, ": ", std::string(s.message())));
+    }
+    // Per label: labels are meshed apart, and where two touch their
+    // surfaces may share points that are rightly two nodes.
+    add_conformity(result.conformity, mixed_mesh::check_conformity(*mesh));
+    result.mesh.append(*mesh);
+    add_figures(result.figures, figures);
+    result.surface_volume_mm3 += surface::compute_surface_statistics(*boundary.surface).volume_mm3;
+  }
+  context.report("mixed_mesh", 1);
+  result.quality = mixed_mesh::measure_mixed_mesh(result.mesh);
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return result;
+}
+
+}  // namespace labelmesh
