@@ -250,6 +250,28 @@ class CoreBuilder {
     }
   }
 
+  // The centre of one cube of each face-connected piece of the core.
+  void find_cavities(HexCore& core) const {
+    std::vector<uint8_t> seen(in_core_.size(), 0);
+    std::vector<int64_t> stack;
+    for (int64_t c = 0; c < grid_.cells(); ++c) {
+      if (!in_core_[c] || seen[c]) continue;
+      core.cavity_points.push_back(grid_.centre(grid_.index(c)));
+      seen[c] = 1;
+      stack.push_back(c);
+      while (!stack.empty()) {
+        const Index cell = grid_.index(stack.back());
+        stack.pop_back();
+        for (const Face& face : kFaces) {
+          const Index next = plus(cell, face.direction);
+          if (!core_at(next) || seen[grid_.cell(next)]) continue;
+          seen[grid_.cell(next)] = 1;
+          stack.push_back(grid_.cell(next));
+        }
+      }
+    }
+  }
+
   void emit(int32_t label, HexCore& core) const {
     const double h = grid_.h;
     std::vector<int32_t> node_id(
@@ -344,6 +366,7 @@ absl::StatusOr<HexCore> build_hex_core(const SurfaceOracle& oracle,
   if (auto s = builder.classify(core); !s.ok()) return s;
   if (auto s = builder.trim(core); !s.ok()) return s;
   builder.emit(label, core);
+  builder.find_cavities(core);
   return core;
 }
 

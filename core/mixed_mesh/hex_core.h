@@ -36,6 +36,9 @@ struct HexCore {
   // The pyramids' side triangles, on mesh.points' indices, wound towards the
   // core: the inner boundary of the region the tetrahedra fill.
   std::vector<std::array<uint32_t, 3>> shell;
+  // A point inside each face-connected piece of the core: the cavities the
+  // tetrahedra leave.
+  std::vector<std::array<double, 3>> cavity_points;
   // Grid cells examined, and those that needed an exact depth.
   uint64_t grid_cells = 0;
   uint64_t depth_queries = 0;

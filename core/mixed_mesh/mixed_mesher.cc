@@ -20,6 +20,26 @@ surface::TriangleMesh layer_boundary(const surface::TriangleMesh& surface, const
   return boundary;
 }
 
+// Whether every triangle of `surface` is reachable from the first through
+// shared corners.
+bool one_piece(const surface::TriangleMesh& surface) {
+  std::vector<uint32_t> parent(surface.points.size());
+  for (uint32_t i = 0; i < parent.size(); ++i) parent[i] = i;
+  auto root = [&](uint32_t v) {
+    while (parent[v] != v) v = parent[v] = parent[parent[v]];
+    return v;
+  };
+  for (const auto& t : surface.triangles) {
+    parent[root(t[1])] = root(t[0]);
+    parent[root(t[2])] = root(t[0]);
+  }
+  if (surface.triangles.empty()) return true;
+  const uint32_t first = root(surface.triangles.front()[0]);
+  for (const auto& t : surface.triangles)
+    if (root(t[0]) != first) return false;
+  return true;
+}
+
 }  // namespace
 
 absl::StatusOr<MixedMesh> mesh_mixed(const surface::TriangleMesh& surface, int32_t label,
@@ -38,15 +58,13 @@ absl::StatusOr<MixedMesh> mesh_mixed(const surface::TriangleMesh& surface, int32
   figures.core_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
-  auto tets = volume_mesh::tetrahedralize(layer_boundary(surface, *core), label, params.tetgen,
-                                          context, figures.tetgen);
+  // The core's pieces are known cavities, and TetGen needs no run to find
+  // them, unless the surface has cavities of its own (nested shells).
+  const bool known = !core->cavity_points.empty() && one_piece(surface);
+  auto tets = volume_mesh::tetrahedralize_around(
+      layer_boundary(surface, *core), label, params.tetgen, known ? &core->cavity_points : nullptr,
+      context, figures.tetgen);
   if (!tets.ok()) return tets.status();
-  if (params.improve.target_quality > 0) {
-    volume_mesh::ImproveParams improve = params.improve;
-    improve.max_peel_depth_mm = 0;
-    if (auto s = volume_mesh::improve_tet_mesh(*tets, improve, context, figures.improve); !s.ok())
-      return s;
-  }
 
   // TetGen keeps input points exactly: the shell's points are found again by
   // their coordinates, so the tetrahedra share the pyramids' nodes.

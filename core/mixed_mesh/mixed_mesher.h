@@ -15,17 +15,16 @@
 #include "core/mixed_mesh/mixed_mesh.h"
 #include "core/surface/triangle_mesh.h"
 #include "core/util/run_context.h"
-#include "core/volume_mesh/improve_tet_mesh.h"
 #include "core/volume_mesh/tetrahedralize.h"
 
 namespace labelmesh::mixed_mesh {
 
 struct MixedParams {
   HexCoreParams core;
-  // For the tetrahedra of the layer. The improvement pass keeps both of
-  // the layer's boundaries (peeling is always off).
+  // For the tetrahedra of the layer. The improvement pass does not run: with
+  // both of the layer's boundaries fixed it lifted none of the liver's worst
+  // tetrahedra, which sit where two pyramids meet at a concave edge.
   volume_mesh::TetgenParams tetgen;
-  volume_mesh::ImproveParams improve;
 };
 
 struct MixedFigures {
@@ -33,7 +32,6 @@ struct MixedFigures {
   uint64_t depth_queries = 0;
   uint64_t core_cells_removed = 0;
   volume_mesh::TetgenFigures tetgen;
-  volume_mesh::ImproveFigures improve;
   double core_seconds = 0;
 };
 

@@ -19,11 +19,6 @@ void add_figures(mixed_mesh::MixedFigures& sum, const mixed_mesh::MixedFigures& 
   sum.tetgen.steiner_points += part.tetgen.steiner_points;
   sum.tetgen.tetrahedra += part.tetgen.tetrahedra;
   sum.tetgen.seconds += part.tetgen.seconds;
-  sum.improve.flips_2_3 += part.improve.flips_2_3;
-  sum.improve.flips_3_2 += part.improve.flips_3_2;
-  sum.improve.vertices_moved += part.improve.vertices_moved;
-  sum.improve.vertices_inserted += part.improve.vertices_inserted;
-  sum.improve.seconds += part.improve.seconds;
 }
 
 void add_conformity(mixed_mesh::Conformity& sum, const mixed_mesh::Conformity& part) {

@@ -259,7 +259,6 @@ absl::Status add_mixed_mesh(const MeshParams& params, const volume::ImageGeometr
   mixed.core.cell_mm = params.hex_size_mm > 0 ? params.hex_size_mm : 3 * voxel_size_mm(geometry);
   mixed.core.threads = label_threads(params, 2);
   mixed.tetgen = params.tetgen;
-  mixed.improve = improve_params_for(params, geometry);
   StageTimer timer(result.stages, "mixed_mesh");
   auto meshes = mesh_labels_mixed(boundaries, mixed, context);
   if (!meshes.ok()) return meshes.status();

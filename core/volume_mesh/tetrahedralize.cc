@@ -312,8 +312,8 @@ absl::StatusOr<std::vector<Vec3>> cavity_points(const Boundary& boundary, const 
 }
 
 absl::StatusOr<TetMesh> run(const surface::TriangleMesh& mesh, int32_t label,
-                            const TetgenParams& params, const RunContext& context,
-                            TetgenFigures& figures) {
+                            const TetgenParams& params, const std::vector<Vec3>* known_holes,
+                            const RunContext& context, TetgenFigures& figures) {
   if (auto status = check_params(params); !status.ok()) return status;
   auto boundary = used_boundary(mesh, label);
   if (!boundary.ok()) return boundary.status();
@@ -343,10 +343,15 @@ absl::StatusOr<TetMesh> run(const surface::TriangleMesh& mesh, int32_t label,
   if (auto status = context.check_stop(); !status.ok()) return status;
   context.report(kStage, 0.2);
 
-  if (component_count(*boundary) > 1) {
-    tetgenio cdt;
-    if (auto status = run_tetgen("pzQ", in, cdt, label); !status.ok()) return status;
-    auto holes = cavity_points(*boundary, cdt, label);
+  if (known_holes != nullptr || component_count(*boundary) > 1) {
+    absl::StatusOr<std::vector<Vec3>> holes;
+    if (known_holes != nullptr) {
+      holes = *known_holes;
+    } else {
+      tetgenio cdt;
+      if (auto status = run_tetgen("pzQ", in, cdt, label); !status.ok()) return status;
+      holes = cavity_points(*boundary, cdt, label);
+    }
     if (!holes.ok()) return holes.status();
     if (!holes->empty()) {
       in.holelist = new REAL[3 * holes->size()];
@@ -417,11 +422,18 @@ absl::StatusOr<TetMesh> run(const surface::TriangleMesh& mesh, int32_t label,
 absl::StatusOr<TetMesh> tetrahedralize(const surface::TriangleMesh& boundary, int32_t label,
                                        const TetgenParams& params, const RunContext& context,
                                        TetgenFigures& figures) {
+  return tetrahedralize_around(boundary, label, params, nullptr, context, figures);
+}
+
+absl::StatusOr<TetMesh> tetrahedralize_around(const surface::TriangleMesh& boundary, int32_t label,
+                                              const TetgenParams& params,
+                                              const std::vector<std::array<double, 3>>* holes,
+                                              const RunContext& context, TetgenFigures& figures) {
   const auto start = std::chrono::steady_clock::now();
   figures = TetgenFigures{};
   absl::StatusOr<TetMesh> result;
   try {
-    result = run(boundary, label, params, context, figures);
+    result = run(boundary, label, params, holes, context, figures);
   } catch (const std::bad_alloc&) {
     result = absl::ResourceExhaustedError(
         cat("out of memory tetrahedralizing the surface of label ", label));

@@ -6,8 +6,10 @@
 // TetGen is included only in tetrahedralize.cc, so its licence and compile cost stay there.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
+#include <vector>
 
 #include "absl/status/statusor.h"
 #include "core/surface/triangle_mesh.h"
@@ -80,5 +82,13 @@ struct TetgenFigures {
 absl::StatusOr<TetMesh> tetrahedralize(const surface::TriangleMesh& boundary, int32_t label,
                                        const TetgenParams& params, const RunContext& context,
                                        TetgenFigures& figures);
+
+// tetrahedralize() when the caller knows the cavities: `holes` (non-null)
+// holds a point inside each, and TetGen carves them out without the extra
+// run that finds them.
+absl::StatusOr<TetMesh> tetrahedralize_around(const surface::TriangleMesh& boundary, int32_t label,
+                                              const TetgenParams& params,
+                                              const std::vector<std::array<double, 3>>* holes,
+                                              const RunContext& context, TetgenFigures& figures);
 
 }  // namespace labelmesh::volume_mesh
