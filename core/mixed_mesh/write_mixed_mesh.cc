@@ -27,13 +27,19 @@
 #include "core/util/text.h"
 #include "core/util/text_file.h"
 #include "core/util/vtk_error_flag.h"
+#include "core/volume_mesh/mesh_file_parts.h"
 
 namespace labelmesh::mixed_mesh {
 namespace {
 
+using volume_mesh::add_label_fields;
+using volume_mesh::check_positive_labels;
+using volume_mesh::distinct_labels;
 using volume_mesh::label_group_name;
+using volume_mesh::upper_case;
 using volume_mesh::VolumeFileInfo;
 using volume_mesh::VolumeFormat;
+using volume_mesh::write_msh_head;
 
 constexpr std::array<CellType, 4> kTypes{CellType::kHexahedron, CellType::kWedge,
                                          CellType::kPyramid, CellType::kTetra};
@@ -66,30 +72,6 @@ std::array<uint32_t, 8> solver_order(CellType type, const std::array<uint32_t, 8
   return {nodes[0], nodes[2], nodes[1], nodes[3], nodes[5], nodes[4], 0, 0};
 }
 
-std::vector<int32_t> distinct_labels(const MixedMesh& mesh) {
-  std::vector<int32_t> labels = mesh.labels;
-  std::sort(labels.begin(), labels.end());
-  labels.erase(std::unique(labels.begin(), labels.end()), labels.end());
-  return labels;
-}
-
-absl::Status check_positive_labels(const MixedMesh& mesh, const std::string& path,
-                                   std::string_view format) {
-  for (int32_t label : mesh.labels) {
-    if (label <= 0) {
-      return absl::InvalidArgumentError(
-          cat(path, ": label ", label, " is not positive; ", format, " needs labels above 0"));
-    }
-  }
-  return absl::OkStatus();
-}
-
-std::string upper_case(std::string text) {
-  for (char& c : text)
-    if (c >= 'a' && c <= 'z') c = char(c - 'a' + 'A');
-  return text;
-}
-
 void add_cell_array(vtkUnstructuredGrid* grid, const char* name,
                     const std::vector<double>& values) {
   if (values.empty()) return;
@@ -98,21 +80,6 @@ void add_cell_array(vtkUnstructuredGrid* grid, const char* name,
   array->SetNumberOfValues(static_cast<vtkIdType>(values.size()));
   for (size_t i = 0; i < values.size(); ++i) array->SetValue(static_cast<vtkIdType>(i), values[i]);
   grid->GetCellData()->AddArray(array);
-}
-
-// Labels and frame as numeric field data, as the tetrahedral VTU has them (meshio refuses
-// string arrays).
-void add_label_fields(const MixedMesh& mesh, const VolumeFileInfo& info, vtkFieldData* fields) {
-  for (int32_t label : distinct_labels(mesh)) {
-    vtkNew<vtkIntArray> array;
-    array->SetName(label_group_name(label, info).c_str());
-    array->InsertNextValue(label);
-    fields->AddArray(array);
-  }
-  vtkNew<vtkIntArray> space;
-  space->SetName(cat("SPACE=", frame_name(info.frame)).c_str());
-  space->InsertNextValue(1);
-  fields->AddArray(space);
 }
 
 vtkSmartPointer<vtkUnstructuredGrid> make_grid(const MixedMesh& mesh, const VolumeFileInfo& info) {
@@ -140,7 +107,7 @@ vtkSmartPointer<vtkUnstructuredGrid> make_grid(const MixedMesh& mesh, const Volu
   grid->SetCells(types.data(), cells);
   grid->GetCellData()->AddArray(labels);
   grid->GetCellData()->AddArray(element_types);
-  add_label_fields(mesh, info, grid->GetFieldData());
+  add_label_fields(mesh.labels, info, grid->GetFieldData());
   return grid;
 }
 
@@ -149,19 +116,7 @@ absl::Status write_vtu(const MixedMesh& mesh, const MixedQuality& quality,
   const auto grid = make_grid(mesh, info);
   add_cell_array(grid, "jacobian_ratio", quality.jacobian_ratio);
   add_cell_array(grid, "quality", quality.quality);
-  vtkNew<vtkXMLUnstructuredGridWriter> writer;
-  writer->SetInputData(grid);
-  writer->SetFileName(path.c_str());
-  writer->SetDataModeToAppended();
-  writer->SetCompressorTypeToZLib();
-  vtkNew<VtkErrorFlag> flag;
-  writer->AddObserver(vtkCommand::ErrorEvent, flag);
-  // The pipeline reports a failed write too; observed, it stays off stderr.
-  writer->GetExecutive()->AddObserver(vtkCommand::ErrorEvent, flag);
-  if (writer->Write() != 1 || flag->raised) {
-    return absl::InternalError(cat(path, ": could not write the volume mesh"));
-  }
-  return absl::OkStatus();
+  return volume_mesh::write_vtu_grid(grid, path);
 }
 
 // MSH 2.2 element type numbers (Gmsh reference manual, "MSH file format version 2").
@@ -183,20 +138,9 @@ int gmsh_type(CellType type) {
 // No $ElementData: meshio's MSH 2.2 reader fails on element data over more than one cell type
 // (its issue #1257), and FE users read MSH with meshio; the VTU has the qualities.
 absl::Status write_msh(const MixedMesh& mesh, const VolumeFileInfo& info, const std::string& path) {
-  if (auto status = check_positive_labels(mesh, path, "MSH"); !status.ok()) return status;
-  const auto labels = distinct_labels(mesh);
+  if (auto status = check_positive_labels(mesh.labels, path, "MSH"); !status.ok()) return status;
   TextFile file(path, "the volume mesh");
-  file << "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n";
-  file << "$PhysicalNames\n" << labels.size() << '\n';
-  for (int32_t label : labels)
-    file << "3 " << label << " \"" << label_group_name(label, info) << "\"\n";
-  file << "$EndPhysicalNames\n";
-  file << "$Nodes\n" << mesh.points.size() << '\n';
-  for (size_t i = 0; i < mesh.points.size(); ++i) {
-    const auto p = in_frame(mesh.points[i], info.frame);
-    file << i + 1 << ' ' << p[0] << ' ' << p[1] << ' ' << p[2] << '\n';
-  }
-  file << "$EndNodes\n";
+  write_msh_head(file, mesh.labels, mesh.points, info);
   file << "$Elements\n" << mesh.size() << '\n';
   for (size_t c = 0; c < mesh.size(); ++c) {
     const CellType type = mesh.types[c];
@@ -243,15 +187,7 @@ absl::Status write_medit(const MixedMesh& mesh, const VolumeFileInfo& info,
                          const std::string& path) {
   const auto faces = label_boundary_faces(mesh);
   TextFile file(path, "the volume mesh");
-  file << "MeshVersionFormatted 2\n\nDimension 3\n\n";
-  file << "# labelmesh: coordinates in mm, SPACE=" << frame_name(info.frame) << '\n';
-  for (int32_t label : distinct_labels(mesh))
-    file << "# ref " << label << ": " << label_group_name(label, info) << '\n';
-  file << "Vertices\n" << mesh.points.size() << '\n';
-  for (const auto& lps : mesh.points) {
-    const auto p = in_frame(lps, info.frame);
-    file << p[0] << ' ' << p[1] << ' ' << p[2] << " 0\n";
-  }
+  volume_mesh::write_medit_head(file, mesh.labels, mesh.points, info);
   write_medit_faces(file, mesh, faces, 3);
   write_medit_faces(file, mesh, faces, 4);
   for (CellType type : kTypes) {
@@ -314,7 +250,7 @@ void write_abaqus_elements(TextFile& file, const MixedMesh& mesh, CellType type)
 // but meshio keeps only the last block's.
 absl::Status write_abaqus(const MixedMesh& mesh, const VolumeFileInfo& info,
                           const std::string& path) {
-  if (auto status = check_positive_labels(mesh, path, "INP"); !status.ok()) return status;
+  if (auto status = check_positive_labels(mesh.labels, path, "INP"); !status.ok()) return status;
   const auto faces = label_boundary_faces(mesh);
   TextFile file(path, "the volume mesh");
   file << "** labelmesh mixed-element mesh: coordinates in mm, SPACE=" << frame_name(info.frame)
@@ -326,7 +262,7 @@ absl::Status write_abaqus(const MixedMesh& mesh, const VolumeFileInfo& info,
     file << i + 1 << ", " << p[0] << ", " << p[1] << ", " << p[2] << '\n';
   }
   for (CellType type : kTypes) write_abaqus_elements(file, mesh, type);
-  for (int32_t label : distinct_labels(mesh)) {
+  for (int32_t label : distinct_labels(mesh.labels)) {
     const std::string group = upper_case(label_group_name(label, info));
     std::vector<size_t> elements;
     for (size_t c = 0; c < mesh.size(); ++c)

@@ -27,53 +27,14 @@
 #include "core/util/text.h"
 #include "core/util/text_file.h"
 #include "core/util/vtk_error_flag.h"
+#include "core/volume_mesh/mesh_file_parts.h"
 
 namespace labelmesh::volume_mesh {
 namespace {
 
-std::vector<int32_t> distinct_labels(const TetMesh& mesh) {
-  std::vector<int32_t> labels = mesh.labels;
-  std::sort(labels.begin(), labels.end());
-  labels.erase(std::unique(labels.begin(), labels.end()), labels.end());
-  return labels;
-}
-
-absl::Status check_positive_labels(const TetMesh& mesh, const std::string& path,
-                                   std::string_view format) {
-  for (int32_t label : mesh.labels) {
-    if (label <= 0) {
-      return absl::InvalidArgumentError(
-          cat(path, ": label ", label, " is not positive; ", format, " needs labels above 0"));
-    }
-  }
-  return absl::OkStatus();
-}
-
-std::string upper_case(std::string text) {
-  for (char& c : text)
-    if (c >= 'a' && c <= 'z') c = char(c - 'a' + 'A');
-  return text;
-}
-
 std::string name_of(int32_t label, const VolumeFileInfo& info) {
   const auto found = info.label_names.find(label);
   return found == info.label_names.end() ? std::string() : found->second;
-}
-
-// The labels present and the frame, as numeric field data, which meshio reads
-// too (it refuses string arrays): one array per label, named by its group name
-// and holding the label, and "SPACE=LPS" (or RAS) holding 1.
-void add_label_fields(const TetMesh& mesh, const VolumeFileInfo& info, vtkFieldData* fields) {
-  for (int32_t label : distinct_labels(mesh)) {
-    vtkNew<vtkIntArray> array;
-    array->SetName(label_group_name(label, info).c_str());
-    array->InsertNextValue(label);
-    fields->AddArray(array);
-  }
-  vtkNew<vtkIntArray> space;
-  space->SetName(cat("SPACE=", frame_name(info.frame)).c_str());
-  space->InsertNextValue(1);
-  fields->AddArray(space);
 }
 
 absl::Status write_vtu(const TetMesh& mesh, const std::vector<double>& quality,
@@ -99,7 +60,7 @@ absl::Status write_vtu(const TetMesh& mesh, const std::vector<double>& quality,
   for (size_t i = 0; i < mesh.labels.size(); ++i)
     labels->SetValue(static_cast<vtkIdType>(i), mesh.labels[i]);
   grid->GetCellData()->AddArray(labels);
-  add_label_fields(mesh, info, grid->GetFieldData());
+  add_label_fields(mesh.labels, info, grid->GetFieldData());
   if (!quality.empty()) {
     vtkNew<vtkDoubleArray> values;
     values->SetName("quality");
@@ -108,38 +69,15 @@ absl::Status write_vtu(const TetMesh& mesh, const std::vector<double>& quality,
       values->SetValue(static_cast<vtkIdType>(i), quality[i]);
     grid->GetCellData()->AddArray(values);
   }
-  vtkNew<vtkXMLUnstructuredGridWriter> writer;
-  writer->SetInputData(grid);
-  writer->SetFileName(path.c_str());
-  writer->SetDataModeToAppended();
-  writer->SetCompressorTypeToZLib();
-  vtkNew<VtkErrorFlag> flag;
-  writer->AddObserver(vtkCommand::ErrorEvent, flag);
-  // The pipeline reports a failed write too; observed, it stays off stderr.
-  writer->GetExecutive()->AddObserver(vtkCommand::ErrorEvent, flag);
-  if (writer->Write() != 1 || flag->raised) {
-    return absl::InternalError(cat(path, ": could not write the volume mesh"));
-  }
-  return absl::OkStatus();
+  return write_vtu_grid(grid, path);
 }
 
 // Gmsh MSH 2.2 ASCII (Gmsh reference manual, "Legacy formats: MSH file format version 2").
 absl::Status write_msh(const TetMesh& mesh, const std::vector<double>& quality,
                        const VolumeFileInfo& info, const std::string& path) {
-  if (auto status = check_positive_labels(mesh, path, "MSH"); !status.ok()) return status;
-  const auto labels = distinct_labels(mesh);
+  if (auto status = check_positive_labels(mesh.labels, path, "MSH"); !status.ok()) return status;
   TextFile file(path, "the volume mesh");
-  file << "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n";
-  file << "$PhysicalNames\n" << labels.size() << '\n';
-  for (int32_t label : labels)
-    file << "3 " << label << " \"" << label_group_name(label, info) << "\"\n";
-  file << "$EndPhysicalNames\n";
-  file << "$Nodes\n" << mesh.points.size() << '\n';
-  for (size_t i = 0; i < mesh.points.size(); ++i) {
-    const auto p = in_frame(mesh.points[i], info.frame);
-    file << i + 1 << ' ' << p[0] << ' ' << p[1] << ' ' << p[2] << '\n';
-  }
-  file << "$EndNodes\n";
+  write_msh_head(file, mesh.labels, mesh.points, info);
   file << "$Elements\n" << mesh.tetrahedra.size() << '\n';
   for (size_t i = 0; i < mesh.tetrahedra.size(); ++i) {
     const auto& t = mesh.tetrahedra[i];
@@ -164,15 +102,7 @@ absl::Status write_msh(const TetMesh& mesh, const std::vector<double>& quality,
 absl::Status write_medit(const TetMesh& mesh, const VolumeFileInfo& info, const std::string& path) {
   const auto faces = label_boundary_faces(mesh);
   TextFile file(path, "the volume mesh");
-  file << "MeshVersionFormatted 2\n\nDimension 3\n\n";
-  file << "# labelmesh: coordinates in mm, SPACE=" << frame_name(info.frame) << '\n';
-  for (int32_t label : distinct_labels(mesh))
-    file << "# ref " << label << ": " << label_group_name(label, info) << '\n';
-  file << "Vertices\n" << mesh.points.size() << '\n';
-  for (const auto& lps : mesh.points) {
-    const auto p = in_frame(lps, info.frame);
-    file << p[0] << ' ' << p[1] << ' ' << p[2] << " 0\n";
-  }
+  write_medit_head(file, mesh.labels, mesh.points, info);
   file << "\nTriangles\n" << faces.size() << '\n';
   for (const auto& face : faces) {
     for (uint32_t v : face.points) file << v + 1 << ' ';
@@ -194,9 +124,9 @@ absl::Status write_medit(const TetMesh& mesh, const VolumeFileInfo& info, const 
 // S1 = 1-2-3, S2 = 1-4-2, S3 = 2-4-3, S4 = 3-4-1; indexed here by the omitted local node.
 absl::Status write_abaqus(const TetMesh& mesh, const VolumeFileInfo& info,
                           const std::string& path) {
-  if (auto status = check_positive_labels(mesh, path, "INP"); !status.ok()) return status;
+  if (auto status = check_positive_labels(mesh.labels, path, "INP"); !status.ok()) return status;
   static constexpr std::array<int, 4> kFaceByOmittedNode{3, 4, 2, 1};
-  const auto labels = distinct_labels(mesh);
+  const auto labels = distinct_labels(mesh.labels);
   const auto faces = label_boundary_faces(mesh);
   TextFile file(path, "the volume mesh");
   file << "** labelmesh tetrahedral mesh: coordinates in mm, SPACE=" << frame_name(info.frame)

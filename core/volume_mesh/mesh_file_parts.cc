@@ -1,0 +1,102 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+#include "core/volume_mesh/mesh_file_parts.h"
+
+#include <algorithm>
+
+#include <vtkExecutive.h>
+#include <vtkFieldData.h>
+#include <vtkIntArray.h>
+#include <vtkNew.h>
+#include <vtkUnstructuredGrid.h>
+#include <vtkXMLUnstructuredGridWriter.h>
+
+#include "core/util/text.h"
+#include "core/util/vtk_error_flag.h"
+
+namespace labelmesh::volume_mesh {
+
+std::vector<int32_t> distinct_labels(const std::vector<int32_t>& labels) {
+  std::vector<int32_t> distinct = labels;
+  std::sort(distinct.begin(), distinct.end());
+  distinct.erase(std::unique(distinct.begin(), distinct.end()), distinct.end());
+  return distinct;
+}
+
+absl::Status check_positive_labels(const std::vector<int32_t>& labels, const std::string& path,
+                                   std::string_view format) {
+  for (int32_t label : labels) {
+    if (label <= 0) {
+      return absl::InvalidArgumentError(
+          cat(path, ": label ", label, " is not positive; ", format, " needs labels above 0"));
+    }
+  }
+  return absl::OkStatus();
+}
+
+std::string upper_case(std::string text) {
+  for (char& c : text)
+    if (c >= 'a' && c <= 'z') c = char(c - 'a' + 'A');
+  return text;
+}
+
+void add_label_fields(const std::vector<int32_t>& labels, const VolumeFileInfo& info,
+                      vtkFieldData* fields) {
+  for (int32_t label : distinct_labels(labels)) {
+    vtkNew<vtkIntArray> array;
+    array->SetName(label_group_name(label, info).c_str());
+    array->InsertNextValue(label);
+    fields->AddArray(array);
+  }
+  vtkNew<vtkIntArray> space;
+  space->SetName(cat("SPACE=", frame_name(info.frame)).c_str());
+  space->InsertNextValue(1);
+  fields->AddArray(space);
+}
+
+absl::Status write_vtu_grid(vtkUnstructuredGrid* grid, const std::string& path) {
+  vtkNew<vtkXMLUnstructuredGridWriter> writer;
+  writer->SetInputData(grid);
+  writer->SetFileName(path.c_str());
+  writer->SetDataModeToAppended();
+  writer->SetCompressorTypeToZLib();
+  vtkNew<VtkErrorFlag> flag;
+  writer->AddObserver(vtkCommand::ErrorEvent, flag);
+  // The pipeline reports a failed write too; observed, it stays off stderr.
+  writer->GetExecutive()->AddObserver(vtkCommand::ErrorEvent, flag);
+  if (writer->Write() != 1 || flag->raised) {
+    return absl::InternalError(cat(path, ": could not write the volume mesh"));
+  }
+  return absl::OkStatus();
+}
+
+void write_msh_head(TextFile& file, const std::vector<int32_t>& labels,
+                    const std::vector<std::array<double, 3>>& points, const VolumeFileInfo& info) {
+  const auto groups = distinct_labels(labels);
+  file << "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n";
+  file << "$PhysicalNames\n" << groups.size() << '\n';
+  for (int32_t label : groups)
+    file << "3 " << label << " \"" << label_group_name(label, info) << "\"\n";
+  file << "$EndPhysicalNames\n";
+  file << "$Nodes\n" << points.size() << '\n';
+  for (size_t i = 0; i < points.size(); ++i) {
+    const auto p = in_frame(points[i], info.frame);
+    file << i + 1 << ' ' << p[0] << ' ' << p[1] << ' ' << p[2] << '\n';
+  }
+  file << "$EndNodes\n";
+}
+
+void write_medit_head(TextFile& file, const std::vector<int32_t>& labels,
+                      const std::vector<std::array<double, 3>>& points,
+                      const VolumeFileInfo& info) {
+  file << "MeshVersionFormatted 2\n\nDimension 3\n\n";
+  file << "# labelmesh: coordinates in mm, SPACE=" << frame_name(info.frame) << '\n';
+  for (int32_t label : distinct_labels(labels))
+    file << "# ref " << label << ": " << label_group_name(label, info) << '\n';
+  file << "Vertices\n" << points.size() << '\n';
+  for (const auto& lps : points) {
+    const auto p = in_frame(lps, info.frame);
+    file << p[0] << ' ' << p[1] << ' ' << p[2] << " 0\n";
+  }
+}
+
+}  // namespace labelmesh::volume_mesh
