@@ -13,6 +13,7 @@
 #include <unistd.h>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <new>
 #include <string>
 #include <string_view>
@@ -87,23 +88,23 @@ class StageEvents {
     return false;
   }
 
-  // A progress event for each label's stage as it starts, then when its
-  // percentage moves: at most one each 50 ms for labels, which interleave
-  // and report often, but always its end.
+  // A progress event for each stage (of each label) as it starts, then when
+  // its percentage moves: at most one each 50 ms for a label's stage, since
+  // labels interleave and report often, but always its end.
   void send_progress(const ProgressUpdate& update, Clock::time_point now) {
     const int percent = static_cast<int>(update.fraction * 100);
     const int32_t label = update.label ? update.label->label : 0;
-    const bool same = label == sent_label_ && update.stage == sent_stage_;
-    if (same && percent == sent_percent_) return;
-    if (same && label != 0 && percent < 100 && now - sent_at_ < std::chrono::milliseconds(50))
-      return;
-    sent_label_ = label;
-    sent_stage_ = std::string(update.stage);
-    sent_percent_ = percent;
-    sent_at_ = now;
+    const auto key = std::make_pair(label, std::string(update.stage));
+    const auto found = sent_.find(key);
+    if (found != sent_.end()) {
+      const Sent& last = found->second;
+      if (percent == last.percent) return;
+      if (label != 0 && percent < 100 && now - last.at < std::chrono::milliseconds(50)) return;
+    }
+    sent_[key] = {percent, now};
     v1::JobEvent event;
     auto* progress = event.mutable_progress();
-    progress->set_stage(sent_stage_);
+    progress->set_stage(key.second);
     progress->set_fraction(update.fraction);
     if (const LabelInProgress* in_progress = update.label) {
       progress->set_label(in_progress->label);
@@ -118,10 +119,12 @@ class StageEvents {
   int fd_;
   std::vector<OpenStage> open_;
   Clock::time_point last_report_;
-  int32_t sent_label_ = 0;
-  std::string sent_stage_;
-  int sent_percent_ = -1;
-  Clock::time_point sent_at_;
+  struct Sent {
+    int percent;
+    Clock::time_point at;
+  };
+  // The last event sent for each (label, stage).
+  std::map<std::pair<int32_t, std::string>, Sent> sent_;
 };
 
 void send_failure(int fd, const absl::Status& status, const std::string& job_dir) {

@@ -55,7 +55,8 @@ Grid make_grid(const surface::TriangleMesh& surface, double h) {
   if (surface.points.empty()) return grid;
   for (int a = 0; a < 3; ++a) {
     grid.origin[a] = lo[a];
-    grid.n[a] = static_cast<int64_t>(std::ceil((hi[a] - lo[a]) / h));
+    // Capped so that the cast cannot overflow; the caller refuses such grids.
+    grid.n[a] = static_cast<int64_t>(std::min(std::ceil((hi[a] - lo[a]) / h), 1e12));
   }
   return grid;
 }
@@ -346,15 +347,24 @@ class CoreBuilder {
 absl::StatusOr<HexCore> build_hex_core(const SurfaceOracle& oracle,
                                        const surface::TriangleMesh& surface, int32_t label,
                                        const HexCoreParams& params, const RunContext& context) {
-  if (!(params.cell_mm > 0) || !(params.apex_height > 0 && params.apex_height <= 0.5) ||
+  // At half the edge the apexes of two pyramids meeting at a concave edge coincide.
+  if (!(params.cell_mm > 0) || !(params.apex_height > 0 && params.apex_height <= 0.45) ||
       !(params.margin >= 0 && params.margin <= 1)) {
     return absl::InvalidArgumentError(cat("hex core: cell ", params.cell_mm, " mm, apex ",
                                           params.apex_height, ", margin ", params.margin,
                                           " out of range"));
   }
+  // About 10 bytes a cube; node ids are 32-bit.
+  constexpr int64_t kMostCells = int64_t{1} << 28;
+  for (const auto& p : surface.points) {
+    for (int a = 0; a < 3; ++a) {
+      if (!std::isfinite(p[a]))
+        return absl::InvalidArgumentError("hex core: a surface point is not finite");
+    }
+  }
   const Grid grid = make_grid(surface, params.cell_mm);
-  constexpr int64_t kMostCells = int64_t{1} << 31;
-  if (grid.n[0] * grid.n[1] * grid.n[2] > kMostCells) {
+  if (grid.n[0] > kMostCells || grid.n[1] > kMostCells || grid.n[2] > kMostCells ||
+      grid.n[0] * grid.n[1] > kMostCells || grid.n[0] * grid.n[1] * grid.n[2] > kMostCells) {
     return absl::InvalidArgumentError(cat(
         "hex core: ", params.cell_mm, " mm cubes over the surface's bounding box make more than ",
         kMostCells, " cells; choose larger ones"));

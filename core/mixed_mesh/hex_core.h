@@ -20,7 +20,8 @@ namespace labelmesh::mixed_mesh {
 struct HexCoreParams {
   // Edge of the cubes, mm.
   double cell_mm = 2;
-  // Pyramid apex height over its base, as a fraction of the edge. Lower
+  // Pyramid apex height over its base, as a fraction of the edge, at most
+  // 0.45 (at 0.5 two pyramids at a concave edge share their apex). Lower
   // opens the gap where two pyramids meet at a concave edge of the core
   // (their triangles there lie atan(2a) and 90° - atan(2a) off one face).
   double apex_height = 0.3;

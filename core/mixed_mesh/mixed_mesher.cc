@@ -47,9 +47,7 @@ absl::StatusOr<MixedMesh> mesh_mixed(const surface::TriangleMesh& surface, int32
                                      MixedFigures& figures) {
   const auto start = std::chrono::steady_clock::now();
   auto oracle = SurfaceOracle::build(surface);
-  if (!oracle.ok())
-    return absl::InvalidArgumentError(
-        cat("label ", label, ": ", std::string(oracle.status().message())));
+  if (!oracle.ok()) return absl::FailedPreconditionError(oracle.status().message());
   auto core = build_hex_core(*oracle, surface, label, params.core, context);
   if (!core.ok()) return core.status();
   figures.grid_cells = core->grid_cells;

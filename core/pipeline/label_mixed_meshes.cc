@@ -39,9 +39,24 @@ absl::StatusOr<MixedVolumeResult> mesh_labels_mixed(const std::vector<LabelBound
   result.cell_mm = params.core.cell_mm;
   for (size_t i = 0; i < boundaries.size(); ++i) {
     const LabelBoundary& boundary = boundaries[i];
-    context.report("mixed_mesh", double(i) / double(boundaries.size()));
+    // TetGen's own stage reports count as this stage's, label by label.
+    const double count = double(boundaries.size());
+    RunContext label_context = context;
+    if (context.progress) {
+      label_context.progress = [&context, i, count](const ProgressUpdate& update) {
+        context.progress({"mixed_mesh", (double(i) + update.fraction) / count, nullptr});
+      };
+    }
+    label_context.report("mixed_mesh", 0);
+    if (boundary.self_intersections.value_or(0) > 0) {
+      return absl::FailedPreconditionError(
+          cat("label ", boundary.label, ": its surface has ", *boundary.self_intersections,
+              " pairs of crossing triangles; a volume mesh needs a surface that does not "
+              "intersect itself"));
+    }
     mixed_mesh::MixedFigures figures;
-    auto mesh = mixed_mesh::mesh_mixed(*boundary.surface, boundary.label, params, context, figures);
+    auto mesh =
+        mixed_mesh::mesh_mixed(*boundary.surface, boundary.label, params, label_context, figures);
     if (!mesh.ok()) {
       if (mesh.status().code() == absl::StatusCode::kCancelled) return mesh.status();
       return absl::Status(mesh.status().code(), cat("label ", boundary.label, ": ",

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <limits>
 #include <mutex>
 #include <thread>
 
@@ -257,8 +258,11 @@ absl::Status add_mixed_mesh(const MeshParams& params, const volume::ImageGeometr
   }
   mixed_mesh::MixedParams mixed;
   mixed.core.cell_mm = params.hex_size_mm > 0 ? params.hex_size_mm : 3 * voxel_size_mm(geometry);
-  mixed.core.threads = label_threads(params, 2);
+  mixed.core.threads = label_threads(params, std::numeric_limits<size_t>::max());
   mixed.tetgen = params.tetgen;
+  // Points TetGen added on the pyramids' triangles would leave their squares
+  // facing split triangles: the layer's boundaries are always kept.
+  mixed.tetgen.keep_boundary = true;
   StageTimer timer(result.stages, "mixed_mesh");
   auto meshes = mesh_labels_mixed(boundaries, mixed, context);
   if (!meshes.ok()) return meshes.status();

@@ -43,13 +43,13 @@ absl::Status write_scene(MeshResult& result, const MeshParams& params, const std
       }
       if (auto s = surface::write_surface_scene(meshes, infos, path); !s.ok()) return s;
       result.scene_files.push_back(name);
-      // VTK writes the blocks to a directory named after the file.
-      std::vector<std::string> blocks;
-      for (const auto& entry :
-           std::filesystem::directory_iterator(std::filesystem::path(out_dir) / "surfaces"))
-        blocks.push_back(cat("surfaces/", entry.path().filename().string()));
-      std::sort(blocks.begin(), blocks.end());
-      result.scene_files.insert(result.scene_files.end(), blocks.begin(), blocks.end());
+      // VTK writes block i to surfaces/surfaces_<i>.vtp, beside the file.
+      for (size_t block = 0; block < meshes.size(); ++block) {
+        const std::string piece = cat("surfaces/surfaces_", block, ".vtp");
+        if (!std::filesystem::exists(std::filesystem::path(out_dir) / piece))
+          return absl::InternalError(cat(path, ": VTK wrote no ", piece));
+        result.scene_files.push_back(piece);
+      }
       continue;
     }
     if (!result.label_image)
