@@ -39,6 +39,7 @@ using volume_mesh::label_group_name;
 using volume_mesh::upper_case;
 using volume_mesh::VolumeFileInfo;
 using volume_mesh::VolumeFormat;
+using volume_mesh::write_id_lines;
 using volume_mesh::write_msh_head;
 
 constexpr std::array<CellType, 4> kTypes{CellType::kHexahedron, CellType::kWedge,
@@ -206,12 +207,6 @@ absl::Status write_medit(const MixedMesh& mesh, const VolumeFileInfo& info,
 }
 
 // Writes ids as Abaqus data lines of at most 16 entries.
-void write_id_lines(TextFile& file, const std::vector<size_t>& ids) {
-  for (size_t i = 0; i < ids.size(); ++i) {
-    file << ids[i] << (i + 1 == ids.size() || i % 16 == 15 ? "\n" : ", ");
-  }
-}
-
 void write_abaqus_elements(TextFile& file, const MixedMesh& mesh, CellType type) {
   if (mesh.count(type) == 0) return;
   static constexpr std::array<int, 8> kCollapsedPyramid{0, 1, 2, 3, 4, 4, 4, 4};
@@ -253,14 +248,7 @@ absl::Status write_abaqus(const MixedMesh& mesh, const VolumeFileInfo& info,
   if (auto status = check_positive_labels(mesh.labels, path, "INP"); !status.ok()) return status;
   const auto faces = label_boundary_faces(mesh);
   TextFile file(path, "the volume mesh");
-  file << "** labelmesh mixed-element mesh: coordinates in mm, SPACE=" << frame_name(info.frame)
-       << ", one ELSET per label\n";
-  file << "*HEADING\nlabelmesh volume mesh\n";
-  file << "*NODE\n";
-  for (size_t i = 0; i < mesh.points.size(); ++i) {
-    const auto p = in_frame(mesh.points[i], info.frame);
-    file << i + 1 << ", " << p[0] << ", " << p[1] << ", " << p[2] << '\n';
-  }
+  volume_mesh::write_abaqus_head(file, "mixed-element mesh", mesh.points, info);
   for (CellType type : kTypes) write_abaqus_elements(file, mesh, type);
   for (int32_t label : distinct_labels(mesh.labels)) {
     const std::string group = upper_case(label_group_name(label, info));

@@ -48,12 +48,7 @@ absl::StatusOr<MixedVolumeResult> mesh_labels_mixed(const std::vector<LabelBound
       };
     }
     label_context.report("mixed_mesh", 0);
-    if (boundary.self_intersections.value_or(0) > 0) {
-      return absl::FailedPreconditionError(
-          cat("label ", boundary.label, ": its surface has ", *boundary.self_intersections,
-              " pairs of crossing triangles; a volume mesh needs a surface that does not "
-              "intersect itself"));
-    }
+    if (auto s = check_fillable(boundary); !s.ok()) return s;
     mixed_mesh::MixedFigures figures;
     auto mesh =
         mixed_mesh::mesh_mixed(*boundary.surface, boundary.label, params, label_context, figures);

@@ -34,12 +34,7 @@ absl::StatusOr<VolumeResult> measure_and_join(const std::vector<LabelBoundary>& 
   VolumeResult result;
   for (const auto& boundary : boundaries) {
     // TetGen's own -d check would say the same, less precisely and later.
-    if (boundary.self_intersections.value_or(0) > 0) {
-      return absl::FailedPreconditionError(
-          cat("label ", boundary.label, ": its surface has ", *boundary.self_intersections,
-              " pairs of crossing triangles; a volume mesh needs a surface that does not "
-              "intersect itself"));
-    }
+    if (auto s = check_fillable(boundary); !s.ok()) return s;
     volume_mesh::TetgenFigures figures;
     auto tets =
         volume_mesh::tetrahedralize(*boundary.surface, boundary.label, params, context, figures);
@@ -84,6 +79,14 @@ absl::Status improve_volume(VolumeResult& volume, const volume_mesh::ImprovePara
   }
   volume.improvement = improvement;
   return absl::OkStatus();
+}
+
+absl::Status check_fillable(const LabelBoundary& boundary) {
+  if (boundary.self_intersections.value_or(0) == 0) return absl::OkStatus();
+  return absl::FailedPreconditionError(
+      cat("label ", boundary.label, ": its surface has ", *boundary.self_intersections,
+          " pairs of crossing triangles; a volume mesh needs a surface that does not "
+          "intersect itself"));
 }
 
 }  // namespace labelmesh

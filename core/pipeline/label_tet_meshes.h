@@ -45,6 +45,10 @@ struct LabelBoundary {
   std::optional<uint64_t> self_intersections;
 };
 
+// FAILED_PRECONDITION naming the label when the surface checks found its
+// triangles crossing: no volume mesher can fill such a surface.
+absl::Status check_fillable(const LabelBoundary& boundary);
+
 // Tetrahedralizes each boundary with TetGen and measures every element.
 // Errors: FAILED_PRECONDITION naming the label when its surface intersects
 // itself or TetGen refuses it; INVALID_ARGUMENT for bad TetGen options or a

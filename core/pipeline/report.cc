@@ -269,8 +269,4 @@ std::string to_json(const google::protobuf::Message& message) {
   return json;
 }
 
-std::string report_json(const MeshResult& result, const MeshParams& params) {
-  return to_json(make_report(result, params));
-}
-
 }  // namespace labelmesh

@@ -20,6 +20,5 @@ v1::Report make_report(const MeshResult& result, const MeshParams& params);
 
 // Protobuf JSON with the proto field names (snake_case), every field printed.
 std::string to_json(const google::protobuf::Message& message);
-std::string report_json(const MeshResult& result, const MeshParams& params);
 
 }  // namespace labelmesh

@@ -99,4 +99,23 @@ void write_medit_head(TextFile& file, const std::vector<int32_t>& labels,
   }
 }
 
+void write_abaqus_head(TextFile& file, std::string_view what,
+                       const std::vector<std::array<double, 3>>& points,
+                       const VolumeFileInfo& info) {
+  file << "** labelmesh " << what << ": coordinates in mm, SPACE=" << frame_name(info.frame)
+       << ", one ELSET per label\n";
+  file << "*HEADING\nlabelmesh volume mesh\n";
+  file << "*NODE\n";
+  for (size_t i = 0; i < points.size(); ++i) {
+    const auto p = in_frame(points[i], info.frame);
+    file << i + 1 << ", " << p[0] << ", " << p[1] << ", " << p[2] << '\n';
+  }
+}
+
+void write_id_lines(TextFile& file, const std::vector<size_t>& ids) {
+  for (size_t i = 0; i < ids.size(); ++i) {
+    file << ids[i] << (i + 1 == ids.size() || i % 16 == 15 ? "\n" : ", ");
+  }
+}
+
 }  // namespace labelmesh::volume_mesh

@@ -53,4 +53,14 @@ void write_msh_head(TextFile& file, const std::vector<int32_t>& labels,
 void write_medit_head(TextFile& file, const std::vector<int32_t>& labels,
                       const std::vector<std::array<double, 3>>& points, const VolumeFileInfo& info);
 
+// The start of an Abaqus/CalculiX .inp file up to its elements: a comment
+// naming the frame and what the mesh holds, the heading, and the nodes
+// (numbered from 1, in info.frame).
+void write_abaqus_head(TextFile& file, std::string_view what,
+                       const std::vector<std::array<double, 3>>& points,
+                       const VolumeFileInfo& info);
+
+// Abaqus/CalculiX data lines of ids: at most 16 to a line.
+void write_id_lines(TextFile& file, const std::vector<size_t>& ids);
+
 }  // namespace labelmesh::volume_mesh

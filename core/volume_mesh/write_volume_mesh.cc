@@ -129,14 +129,7 @@ absl::Status write_abaqus(const TetMesh& mesh, const VolumeFileInfo& info,
   const auto labels = distinct_labels(mesh.labels);
   const auto faces = label_boundary_faces(mesh);
   TextFile file(path, "the volume mesh");
-  file << "** labelmesh tetrahedral mesh: coordinates in mm, SPACE=" << frame_name(info.frame)
-       << ", one ELSET per label\n";
-  file << "*HEADING\nlabelmesh volume mesh\n";
-  file << "*NODE\n";
-  for (size_t i = 0; i < mesh.points.size(); ++i) {
-    const auto p = in_frame(mesh.points[i], info.frame);
-    file << i + 1 << ", " << p[0] << ", " << p[1] << ", " << p[2] << '\n';
-  }
+  write_abaqus_head(file, "tetrahedral mesh", mesh.points, info);
   for (int32_t label : labels) {
     file << "*ELEMENT, TYPE=C3D4, ELSET=" << upper_case(label_group_name(label, info)) << '\n';
     for (size_t i = 0; i < mesh.tetrahedra.size(); ++i) {
@@ -150,23 +143,14 @@ absl::Status write_abaqus(const TetMesh& mesh, const VolumeFileInfo& info,
   for (size_t begin = 0; begin < faces.size();) {
     const int32_t label = faces[begin].label;
     size_t end = begin;
-    std::set<uint32_t> nodes;
+    std::set<size_t> nodes;
     while (end < faces.size() && faces[end].label == label) {
-      nodes.insert(faces[end].points.begin(), faces[end].points.end());
+      for (uint32_t point : faces[end].points) nodes.insert(point + size_t{1});
       ++end;
     }
     const std::string group = upper_case(label_group_name(label, info));
     file << "*NSET, NSET=" << group << "_BOUNDARY\n";
-    size_t on_line = 0;
-    for (uint32_t node : nodes) {
-      // At most 16 entries per data line.
-      file << (on_line == 0 ? "" : ", ") << node + 1;
-      if (++on_line == 16) {
-        file << '\n';
-        on_line = 0;
-      }
-    }
-    if (on_line != 0) file << '\n';
+    write_id_lines(file, std::vector<size_t>(nodes.begin(), nodes.end()));
     file << "*SURFACE, TYPE=ELEMENT, NAME=" << group << "_SURFACE\n";
     for (size_t i = begin; i < end; ++i)
       file << faces[i].tet + 1 << ", S" << kFaceByOmittedNode[faces[i].across] << '\n';
