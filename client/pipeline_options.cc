@@ -123,13 +123,15 @@ void add_pipeline_flags(CLI::App& command, PipelineFlags& flags) {
       ->capture_default_str();
   command
       .add_option("--volume", flags.volume,
-                  "Volume mesh: none; tet (TetGen on each label's output surface); or mixed "
-                  "(hexahedra inside each label, pyramids and tetrahedra out to its surface)")
-      ->check(CLI::IsMember({"none", "tet", "mixed"}))
+                  "Volume mesh: none; tet (TetGen on each label's output surface); mixed "
+                  "(hexahedra inside each label and out to its surface, with pyramids and "
+                  "tetrahedra where hexahedra cannot be valid); or hex (hexahedra only; labels "
+                  "where they cannot be valid are left out and reported)")
+      ->check(CLI::IsMember({"none", "tet", "mixed", "hex"}))
       ->capture_default_str();
   command
       .add_option("--hex-size", flags.hex_size_mm,
-                  "Mixed: the hexahedra's edge, mm; 0 for three voxels")
+                  "Mixed and hex: the hexahedra's edge, mm; 0 for three voxels")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   auto& tetgen = flags.tetgen;
@@ -245,8 +247,10 @@ absl::StatusOr<v1::MeshOptions> to_mesh_options(const PipelineFlags& flags) {
   proto.set_point_reduction(flags.point_reduction == "hierarchy" ? v1::POINT_REDUCTION_HIERARCHY
                             : flags.point_reduction == "none"    ? v1::POINT_REDUCTION_NONE
                                                                  : v1::POINT_REDUCTION_GRID);
-  if (flags.volume == "tet" || flags.volume == "mixed") {
-    proto.set_volume(flags.volume == "mixed" ? v1::VOLUME_METHOD_MIXED : v1::VOLUME_METHOD_TETGEN);
+  if (flags.volume == "tet" || flags.volume == "mixed" || flags.volume == "hex") {
+    proto.set_volume(flags.volume == "mixed" ? v1::VOLUME_METHOD_MIXED
+                     : flags.volume == "hex" ? v1::VOLUME_METHOD_HEX
+                                             : v1::VOLUME_METHOD_TETGEN);
     proto.set_hex_size_mm(flags.hex_size_mm);
     proto.set_tet_radius_edge(flags.tetgen.radius_edge_ratio);
     proto.set_tet_min_dihedral_deg(flags.tetgen.min_dihedral_deg);

@@ -51,7 +51,7 @@ std::string report_table(const v1::Report& report) {
                  s.stage().c_str(), s.nodes(), s.min_angle_deg(), s.max_angle_deg(), s.volume_mm3(),
                  hausdorff.c_str(), warnings[s.label()].c_str());
   }
-  if (report.has_volume() && report.volume().hexahedra() > 0) {
+  if (report.has_volume() && report.volume().mesher() != "tetgen") {
     const auto& v = report.volume();
     table +=
         row("volume (%s, %.2f mm): %llu nodes, %llu hexahedra, %llu pyramids, %llu tetrahedra; "

@@ -247,10 +247,14 @@ MixedQuality measure_mixed_mesh(const MixedMesh& mesh) {
   for (size_t c = 0; c < mesh.size(); ++c) {
     CellFigures figures{};
     switch (mesh.types[c]) {
-      case CellType::kHexahedron:
-        figures = measure_hexahedron(cell_points<8>(mesh, c));
+      case CellType::kHexahedron: {
+        const auto p = cell_points<8>(mesh, c);
+        figures = measure_hexahedron(p);
+        const double scaled = quality::hexahedron_scaled_jacobian(p);
+        result.scaled_jacobian_min = std::min(result.scaled_jacobian_min.value_or(scaled), scaled);
         ++result.hexahedra;
         break;
+      }
       case CellType::kWedge:
         figures = measure_wedge(cell_points<6>(mesh, c));
         ++result.wedges;

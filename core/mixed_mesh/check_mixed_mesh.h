@@ -77,6 +77,8 @@ struct MixedQuality {
   double jacobian_ratio_mean = 0.0;
   // Smallest quality::pyramid_signed_aspect_ratio over the pyramids; empty when there are none.
   std::optional<double> pyramid_aspect_ratio_min;
+  // Smallest quality::hexahedron_scaled_jacobian over the hexahedra; empty when there are none.
+  std::optional<double> scaled_jacobian_min;
   // Tetrahedra only: Q (min, mean) and the dihedral range in degrees.
   quality::QualitySummary tetra_summary;
   // `quality` over all cells: min, mean and the Table 1 categories.

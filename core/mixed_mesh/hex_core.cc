@@ -197,7 +197,13 @@ class CoreBuilder {
         if (!in_core_[c]) continue;
         const Index cell = grid_.index(c);
         if (!on_boundary(cell)) continue;
-        if (depth_[c] < sure_depth_) {
+        int open_faces = 0;
+        for (const Face& face : kFaces) open_faces += !core_at(plus(cell, face.direction));
+        if (open_faces > params_.max_open_faces) {
+          remove.push_back(c);
+          continue;
+        }
+        if (params_.pyramids && depth_[c] < sure_depth_) {
           for (int f = 0; f < 6; ++f) {
             if (core_at(plus(cell, kFaces[f].direction))) continue;
             if (!pyramid_fits(c, cell, f, core)) {
@@ -291,6 +297,7 @@ class CoreBuilder {
       std::array<uint32_t, 8> hex{};
       for (int k = 0; k < 8; ++k) hex[k] = node(plus(cell, kHexCorners[k]));
       core.mesh.add(CellType::kHexahedron, hex, label);
+      if (!params_.pyramids) continue;
       for (const Face& face : kFaces) {
         if (core_at(plus(cell, face.direction))) continue;
         std::array<uint32_t, 8> pyramid{};

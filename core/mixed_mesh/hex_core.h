@@ -28,6 +28,12 @@ struct HexCoreParams {
   // Room left between the core and its pyramids and the surface, as a
   // fraction of the edge, for the tetrahedra to fill.
   double margin = 0.1;
+  // Whether each boundary square gets its pyramid and shell triangles; off
+  // when a layer of hexahedra (hex_layer.h) covers the core instead.
+  bool pyramids = true;
+  // Cubes with more boundary faces than this are trimmed too: a cube
+  // sticking out on four sides makes poor layer cells around it.
+  int max_open_faces = 6;
   unsigned threads = 1;
 };
 

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <map>
 
+#include "core/surface/surface_statistics.h"
 #include "core/util/text.h"
 
 namespace labelmesh::mixed_mesh {
@@ -40,6 +41,36 @@ bool one_piece(const surface::TriangleMesh& surface) {
   return true;
 }
 
+// The core without pyramids, trimmed of cubes that stick out on four sides,
+// and the hexahedral layer on it. FAILED_PRECONDITION, with the reason, when
+// there is no core or the layer misses its floors.
+absl::StatusOr<MixedMesh> mesh_with_hex_layer(const SurfaceOracle& oracle,
+                                              const surface::TriangleMesh& surface, int32_t label,
+                                              const MixedParams& params, const RunContext& context,
+                                              MixedFigures& figures) {
+  HexCoreParams core_params = params.core;
+  core_params.pyramids = false;
+  core_params.max_open_faces = 3;
+  auto core = build_hex_core(oracle, surface, label, core_params, context);
+  if (!core.ok()) return core.status();
+  figures.grid_cells += core->grid_cells;
+  figures.depth_queries += core->depth_queries;
+  figures.core_cells_removed += core->cells_removed;
+  if (core->mesh.size() == 0) {
+    return absl::FailedPreconditionError(
+        cat("too thin for a single ", params.core.cell_mm, " mm cube"));
+  }
+  HexLayerParams layer_params = params.layer;
+  layer_params.cell_mm = params.core.cell_mm;
+  layer_params.split = params.layer.split && !params.hexahedra_only;
+  const double surface_volume = surface::compute_surface_statistics(surface).volume_mm3;
+  HexLayerFigures layer;
+  auto mesh =
+      add_hex_layer(oracle, surface_volume, std::move(core->mesh), layer_params, context, layer);
+  figures.layer = layer;
+  return mesh;
+}
+
 }  // namespace
 
 absl::StatusOr<MixedMesh> mesh_mixed(const surface::TriangleMesh& surface, int32_t label,
@@ -48,11 +79,24 @@ absl::StatusOr<MixedMesh> mesh_mixed(const surface::TriangleMesh& surface, int32
   const auto start = std::chrono::steady_clock::now();
   auto oracle = SurfaceOracle::build(surface);
   if (!oracle.ok()) return absl::FailedPreconditionError(oracle.status().message());
+  auto layered = params.hexahedral_layer || params.hexahedra_only
+                     ? mesh_with_hex_layer(*oracle, surface, label, params, context, figures)
+                     : absl::FailedPreconditionError("the hexahedral layer was not asked for");
+  if (layered.ok() || layered.status().code() != absl::StatusCode::kFailedPrecondition) {
+    figures.core_seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return layered;
+  }
+  figures.layer_refused = std::string(layered.status().message());
+  if (params.hexahedra_only) {
+    figures.left_out = true;
+    return MixedMesh{};
+  }
   auto core = build_hex_core(*oracle, surface, label, params.core, context);
   if (!core.ok()) return core.status();
-  figures.grid_cells = core->grid_cells;
-  figures.depth_queries = core->depth_queries;
-  figures.core_cells_removed = core->cells_removed;
+  figures.grid_cells += core->grid_cells;
+  figures.depth_queries += core->depth_queries;
+  figures.core_cells_removed += core->cells_removed;
   figures.core_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 

@@ -47,6 +47,33 @@ double SurfaceOracle::depth(const std::array<double, 3>& point) const {
   return side == CGAL::ON_BOUNDED_SIDE ? distance : -distance;
 }
 
+std::array<double, 3> SurfaceOracle::closest(const std::array<double, 3>& point) const {
+  const cgal::Point p = impl_->tree.closest_point(cgal::Point(point[0], point[1], point[2]));
+  return {CGAL::to_double(p.x()), CGAL::to_double(p.y()), CGAL::to_double(p.z())};
+}
+
+std::optional<std::array<double, 3>> SurfaceOracle::first_hit(
+    const std::array<double, 3>& from, const std::array<double, 3>& direction) const {
+  if (direction[0] == 0 && direction[1] == 0 && direction[2] == 0) return std::nullopt;
+  const cgal::Kernel::Ray_3 ray(cgal::Point(from[0], from[1], from[2]),
+                                cgal::Kernel::Vector_3(direction[0], direction[1], direction[2]));
+  const auto hit = impl_->tree.first_intersection(ray);
+  if (!hit) return std::nullopt;
+  // A ray grazing a triangle meets it in a segment: its nearer end counts.
+  cgal::Point point;
+  if (const auto* segment = boost::get<cgal::Kernel::Segment_3>(&hit->first)) {
+    const bool source_nearer = CGAL::squared_distance(segment->source(), ray.source()) <=
+                               CGAL::squared_distance(segment->target(), ray.source());
+    point = source_nearer ? segment->source() : segment->target();
+  } else if (const auto* single = boost::get<cgal::Point>(&hit->first)) {
+    point = *single;
+  } else {
+    return std::nullopt;
+  }
+  return std::array<double, 3>{CGAL::to_double(point.x()), CGAL::to_double(point.y()),
+                               CGAL::to_double(point.z())};
+}
+
 std::vector<double> SurfaceOracle::depths(const std::vector<std::array<double, 3>>& points,
                                           unsigned threads) const {
   std::vector<double> result(points.size());

@@ -7,6 +7,7 @@
 
 #include <array>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "absl/status/statusor.h"
@@ -25,6 +26,12 @@ class SurfaceOracle {
   // depth() of each point, on up to `threads` threads.
   std::vector<double> depths(const std::vector<std::array<double, 3>>& points,
                              unsigned threads) const;
+  // The nearest point of the surface.
+  std::array<double, 3> closest(const std::array<double, 3>& point) const;
+  // Where the ray from `from` along `direction` first meets the surface;
+  // none when it misses (or `direction` is zero).
+  std::optional<std::array<double, 3>> first_hit(const std::array<double, 3>& from,
+                                                 const std::array<double, 3>& direction) const;
 
  private:
   struct Impl;

@@ -262,6 +262,9 @@ absl::Status read_volume_options(const v1::MeshOptions& options, MeshParams& par
     case v1::VOLUME_METHOD_MIXED:
       params.volume = VolumeMethod::kMixed;
       break;
+    case v1::VOLUME_METHOD_HEX:
+      params.volume = VolumeMethod::kHex;
+      break;
     default:
       return absl::InvalidArgumentError("volume: unknown volume method");
   }
@@ -350,6 +353,7 @@ v1::MeshOptions make_options(const MeshParams& params) {
     options.add_formats(std::string(surface::surface_format_name(format)));
   if (params.volume != VolumeMethod::kNone) {
     options.set_volume(params.volume == VolumeMethod::kMixed ? v1::VOLUME_METHOD_MIXED
+                       : params.volume == VolumeMethod::kHex ? v1::VOLUME_METHOD_HEX
                                                              : v1::VOLUME_METHOD_TETGEN);
     options.set_hex_size_mm(params.hex_size_mm);
     for (auto format : params.volume_formats)
@@ -435,7 +439,7 @@ absl::StatusOr<MeshParams> params_from_options(const v1::MeshOptions& options) {
       }
       params.volume_formats = std::move(volume_formats);
     }
-    if (params.volume == VolumeMethod::kMixed &&
+    if ((params.volume == VolumeMethod::kMixed || params.volume == VolumeMethod::kHex) &&
         std::count(params.volume_formats.begin(), params.volume_formats.end(),
                    volume_mesh::VolumeFormat::kTetgen) > 0) {
       return absl::InvalidArgumentError(

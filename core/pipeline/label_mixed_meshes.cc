@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 #include "core/pipeline/label_mixed_meshes.h"
 
+#include <algorithm>
 #include <chrono>
 
 #include "core/surface/surface_statistics.h"
@@ -14,6 +15,10 @@ void add_figures(mixed_mesh::MixedFigures& sum, const mixed_mesh::MixedFigures& 
   sum.depth_queries += part.depth_queries;
   sum.core_cells_removed += part.core_cells_removed;
   sum.core_seconds += part.core_seconds;
+  sum.layer.layer_hexahedra += part.layer.layer_hexahedra;
+  sum.layer.split_hexahedra += part.layer.split_hexahedra;
+  sum.layer.boundary_distance_max_mm =
+      std::max(sum.layer.boundary_distance_max_mm, part.layer.boundary_distance_max_mm);
   sum.tetgen.input_points += part.tetgen.input_points;
   sum.tetgen.input_triangles += part.tetgen.input_triangles;
   sum.tetgen.steiner_points += part.tetgen.steiner_points;
@@ -37,6 +42,7 @@ absl::StatusOr<MixedVolumeResult> mesh_labels_mixed(const std::vector<LabelBound
   const auto start = std::chrono::steady_clock::now();
   MixedVolumeResult result;
   result.cell_mm = params.core.cell_mm;
+  result.hexahedra_only = params.hexahedra_only;
   for (size_t i = 0; i < boundaries.size(); ++i) {
     const LabelBoundary& boundary = boundaries[i];
     // TetGen's own stage reports count as this stage's, label by label.
@@ -57,6 +63,12 @@ absl::StatusOr<MixedVolumeResult> mesh_labels_mixed(const std::vector<LabelBound
       return absl::Status(mesh.status().code(), cat("label ", boundary.label, ": ",
                                                     std::string(mesh.status().message())));
     }
+    if (figures.left_out) {
+      result.labels_left_out.push_back({boundary.label, figures.layer_refused});
+      continue;
+    }
+    if (!figures.layer_refused.empty())
+      result.tetrahedral_layer_labels.push_back({boundary.label, figures.layer_refused});
     if (auto s = mixed_mesh::check_mixed_mesh(*mesh); !s.ok()) {
       return absl::InternalError(cat("label ", boundary.label, ": ", std::string(s.message())));
     }

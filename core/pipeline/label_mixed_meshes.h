@@ -21,8 +21,19 @@ struct MixedVolumeResult {
   mixed_mesh::Conformity conformity;
   // The cube edge used, mm.
   double cell_mm = 0;
-  // Summed over the labels.
+  // Hexahedra only (VolumeMethod::kHex).
+  bool hexahedra_only = false;
+  // Summed over the labels (the layer's boundary distance: the largest).
   mixed_mesh::MixedFigures figures;
+  // A label and why its hexahedral layer was refused.
+  struct Refusal {
+    int32_t label = 0;
+    std::string reason;
+  };
+  // Labels that got the tetrahedral layer instead.
+  std::vector<Refusal> tetrahedral_layer_labels;
+  // Labels with no volume mesh (hexahedra only).
+  std::vector<Refusal> labels_left_out;
   // Volume the labels' surfaces enclose, mm³.
   double surface_volume_mm3 = 0;
   double seconds = 0;
@@ -31,7 +42,8 @@ struct MixedVolumeResult {
 };
 
 // Meshes each boundary on its own (labels do not share nodes), checks each
-// label's conformity (summed in `conformity`), then measures the whole.
+// label's conformity (summed in `conformity`), then measures the whole. A
+// label left out (hexahedra only) is listed, not an error.
 // Errors: those of mixed_mesh::mesh_mixed, naming the label; INTERNAL when
 // a label's mesh fails check_mixed_mesh.
 absl::StatusOr<MixedVolumeResult> mesh_labels_mixed(const std::vector<LabelBoundary>& boundaries,

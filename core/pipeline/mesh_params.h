@@ -97,6 +97,9 @@ enum class VolumeMethod {
   // Hexahedra inside each label, pyramids and tetrahedra out to its surface
   // (paper §2.4.3-2.4.4; mixed_mesh/mixed_mesher.h).
   kMixed,
+  // Hexahedra only, where they can be valid; other labels are left out and
+  // the report says why.
+  kHex,
 };
 
 // The guard on what is delivered: each label's output surface is compared

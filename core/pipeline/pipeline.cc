@@ -259,6 +259,7 @@ absl::Status add_mixed_mesh(const MeshParams& params, const volume::ImageGeometr
   mixed_mesh::MixedParams mixed;
   mixed.core.cell_mm = params.hex_size_mm > 0 ? params.hex_size_mm : 3 * voxel_size_mm(geometry);
   mixed.core.threads = label_threads(params, std::numeric_limits<size_t>::max());
+  mixed.hexahedra_only = params.volume == VolumeMethod::kHex;
   mixed.tetgen = params.tetgen;
   // Points TetGen added on the pyramids' triangles would leave their squares
   // facing split triangles: the layer's boundaries are always kept.
@@ -266,6 +267,8 @@ absl::Status add_mixed_mesh(const MeshParams& params, const volume::ImageGeometr
   StageTimer timer(result.stages, "mixed_mesh");
   auto meshes = mesh_labels_mixed(boundaries, mixed, context);
   if (!meshes.ok()) return meshes.status();
+  for (const auto& left_out : meshes->labels_left_out)
+    result.warnings.push_back({left_out.label, cat("no volume mesh: ", left_out.reason)});
   result.mixed = std::move(*meshes);
   return absl::OkStatus();
 }
@@ -412,7 +415,7 @@ absl::StatusOr<MeshResult> run_stages(const std::string& path, const MeshParams&
   if (tetrahedra) {
     if (auto s = add_volume_mesh(params, volume->geometry, context, result); !s.ok()) return s;
   }
-  if (params.volume == VolumeMethod::kMixed) {
+  if (params.volume == VolumeMethod::kMixed || params.volume == VolumeMethod::kHex) {
     if (auto s = add_mixed_mesh(params, volume->geometry, context, result); !s.ok()) return s;
   }
   if (std::any_of(params.scene_formats.begin(), params.scene_formats.end(),

@@ -22,7 +22,7 @@ void set_categories(const quality::QualitySummary& q, v1::QualityCategories& cat
 v1::VolumeMeshSummary make_mixed_summary(const MixedVolumeResult& mixed) {
   const auto& q = mixed.quality;
   v1::VolumeMeshSummary entry;
-  entry.set_mesher("mixed_grid");
+  entry.set_mesher(mixed.hexahedra_only ? "hex_grid" : "mixed_grid");
   entry.set_nodes(mixed.mesh.points.size());
   entry.set_hexahedra(q.hexahedra);
   entry.set_pyramids(q.pyramids);
@@ -40,6 +40,19 @@ v1::VolumeMeshSummary make_mixed_summary(const MixedVolumeResult& mixed) {
     entry.set_jacobian_ratio_mean(q.jacobian_ratio_mean);
   }
   if (q.pyramid_aspect_ratio_min) entry.set_pyramid_aspect_ratio_min(*q.pyramid_aspect_ratio_min);
+  if (q.scaled_jacobian_min) entry.set_scaled_jacobian_min(*q.scaled_jacobian_min);
+  entry.set_split_hexahedra(mixed.figures.layer.split_hexahedra);
+  entry.set_boundary_node_distance_max_mm(mixed.figures.layer.boundary_distance_max_mm);
+  for (const auto& refused : mixed.tetrahedral_layer_labels) {
+    auto* item = entry.add_tetrahedral_layer_labels();
+    item->set_label(refused.label);
+    item->set_reason(refused.reason);
+  }
+  for (const auto& left_out : mixed.labels_left_out) {
+    auto* item = entry.add_labels_left_out();
+    item->set_label(left_out.label);
+    item->set_reason(left_out.reason);
+  }
   entry.set_inverted(q.invalid);
   set_categories(q.cell_summary, *entry.mutable_categories());
   entry.set_enclosed_volume_mm3(q.volume_mm3);

@@ -106,7 +106,8 @@ absl::Status write_all(MeshResult& result, const MeshParams& params, const std::
   info.frame = params.frame;
   for (const auto& description : result.input.descriptions)
     if (!description.name.empty()) info.label_names[description.label] = description.name;
-  if (result.mixed) {
+  // No file for a mesh of no cells: every label was left out.
+  if (result.mixed && result.mixed->mesh.size() > 0) {
     StageTimer timer(result.stages, "write_volume");
     result.mixed->files.clear();
     for (auto format : params.volume_formats) {

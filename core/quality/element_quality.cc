@@ -96,6 +96,24 @@ double hexahedron_jacobian_ratio(const Hex& p) {
   return jacobian_ratio(hexahedron_corner_jacobians(p));
 }
 
+double hexahedron_scaled_jacobian(const Hex& p) {
+  static constexpr int kNode[2][2][2] = {{{0, 4}, {3, 7}}, {{1, 5}, {2, 6}}};
+  double lowest = 1.0;
+  for (int r = 0; r < 2; ++r) {
+    for (int s = 0; s < 2; ++s) {
+      for (int t = 0; t < 2; ++t) {
+        const Point dr = sub(p[kNode[1][s][t]], p[kNode[0][s][t]]);
+        const Point ds = sub(p[kNode[r][1][t]], p[kNode[r][0][t]]);
+        const Point dt = sub(p[kNode[r][s][1]], p[kNode[r][s][0]]);
+        const double lengths = norm(dr) * norm(ds) * norm(dt);
+        if (!(lengths > 0.0)) return 0.0;
+        lowest = std::min(lowest, triple(dr, ds, dt) / lengths);
+      }
+    }
+  }
+  return lowest;
+}
+
 std::array<double, 6> wedge_corner_jacobians(const Wedge& p) {
   std::array<double, 6> jacobians{};
   for (int node = 0; node < 6; ++node) {

@@ -60,6 +60,12 @@ std::array<double, 8> hexahedron_corner_jacobians(const Hex& p);
 // negative when any corner is inverted. §2.4.1, JR_e.
 double hexahedron_jacobian_ratio(const Hex& p);
 
+// Scaled Jacobian of a hexahedron, dimensionless, in [-1, 1]: the smallest corner Jacobian
+// divided by the product of the lengths of its three edges (Verdict's definition). Unlike the
+// Jacobian ratio it falls with shear: a parallelepiped with a 30° angle scores 0.5. 1 for a
+// cube; 0 when an edge has zero length.
+double hexahedron_scaled_jacobian(const Hex& p);
+
 // Corner Jacobians of a wedge, in length³, indexed by node: the triple product of the two
 // triangle edges and the vertical edge leaving the node, ordered so that a valid wedge in VTK's
 // ordering is positive. This is the NEGATED determinant of VTK's own isoparametric map at the node:

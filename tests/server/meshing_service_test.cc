@@ -168,6 +168,8 @@ TEST_F(MeshingServiceTest, TheServiceMakesTheSameMixedMeshAsTheLibrary) {
   EXPECT_EQ(served.tetrahedra(), mine.tetrahedra());
   EXPECT_EQ(served.nodes(), mine.nodes());
   EXPECT_EQ(served.enclosed_volume_mm3(), mine.enclosed_volume_mm3());
+  EXPECT_EQ(served.jacobian_ratio_min(), mine.jacobian_ratio_min());
+  EXPECT_EQ(served.tetrahedral_layer_labels_size(), mine.tetrahedral_layer_labels_size());
   EXPECT_EQ(served.inverted(), 0u);
   EXPECT_EQ(served.files_size(), 1);
 }

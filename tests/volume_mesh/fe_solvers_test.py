@@ -1,8 +1,9 @@
 #!/usr/bin/env python3
 # SPDX-License-Identifier: AGPL-3.0-or-later
-"""The liver's tetrahedral mesh in solvers nobody here wrote.
+"""The liver's volume mesh in solvers nobody here wrote.
 
-`labelmesh mesh liver.inr.gz --labels 255 --volume tet --formats inp,msh`,
+`labelmesh mesh liver.inr.gz --labels 255 --volume tet --formats inp,msh`
+(or `--volume hex --hex-size 5` for hexahedra, C3D8 in the deck),
 with the label named "liver" by a label table, then:
 - Gmsh loads volume.msh and its coherence check (duplicate nodes and
   elements, isolated nodes) finds nothing, with the report's counts, and
@@ -78,9 +79,10 @@ def check_gmsh(work, report):
     volume = report["volume"]
     if not nodes or int(nodes.group(1)) != int(volume["nodes"]):
         fail(f"gmsh read {nodes and nodes.group(1)} nodes, the report has {volume['nodes']}")
-    if not elements or int(elements.group(1)) != int(volume["tetrahedra"]):
-        fail(f"gmsh read {elements and elements.group(1)} elements, "
-             f"the report has {volume['tetrahedra']}")
+    cells = sum(int(volume.get(kind, 0)) for kind in ("tetrahedra", "hexahedra", "prisms",
+                                                       "pyramids"))
+    if not elements or int(elements.group(1)) != cells:
+        fail(f"gmsh read {elements and elements.group(1)} elements, the report has {cells}")
     # Gmsh writes what it read: the physical group must come back with its name.
     run = subprocess.run(["gmsh", "-0", str(work / "volume.msh"), "-o", str(work / "gmsh.msh"),
                           "-format", "msh4"], capture_output=True, text=True, timeout=300)
@@ -130,17 +132,26 @@ def main():
     parser = argparse.ArgumentParser()
     parser.add_argument("--labelmesh", required=True)
     parser.add_argument("--data", required=True)
+    parser.add_argument("--volume", default="tet", choices=["tet", "mixed", "hex"])
+    parser.add_argument("--hex-size", default="0")
     args = parser.parse_args()
     with tempfile.TemporaryDirectory(prefix="labelmesh-fe-") as tmp:
         work = pathlib.Path(tmp)
         (work / "names.json").write_text('{"255": "liver"}')
         run = subprocess.run([args.labelmesh, "mesh", f"{args.data}/liver.inr.gz", "--labels", "255",
-                              "--volume", "tet", "--formats", "inp,msh", "--out", str(work),
+                              "--volume", args.volume, "--hex-size", args.hex_size,
+                              "--formats", "inp,msh", "--out", str(work),
                               "--label-names", str(work / "names.json"), "--json"],
                              capture_output=True, text=True, timeout=600)
         if run.returncode != 0:
             fail(f"labelmesh mesh exited {run.returncode}: {run.stderr[-2000:]}")
         report = json.loads(run.stdout)
+        volume = report["volume"]
+        if args.volume == "hex" and (int(volume.get("hexahedra", 0)) == 0 or
+                                     volume.get("labels_left_out")):
+            fail(f"no hexahedral mesh of the liver: {volume.get('labels_left_out')}")
+        if int(volume.get("inverted", 0)) != 0:
+            fail(f"{volume['inverted']} inverted cells")
         check_gmsh(work, report)
         nodes = read_nodes(work / "volume.inp")
         if len(nodes) != int(report["volume"]["nodes"]):
