@@ -134,6 +134,12 @@ void add_pipeline_flags(CLI::App& command, PipelineFlags& flags) {
                   "Mixed and hex: the hexahedra's edge, mm; 0 for three voxels")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
+  command
+      .add_option("--hex-interior-size", flags.hex_interior_size_mm,
+                  "Mixed: the largest octant's edge inside each label, mm (an octree: cubes of "
+                  "--hex-size under the surface, coarser deeper in); 0 for one size throughout")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
   auto& tetgen = flags.tetgen;
   command
       .add_option("--tet-radius-edge", tetgen.radius_edge_ratio,
@@ -252,6 +258,7 @@ absl::StatusOr<v1::MeshOptions> to_mesh_options(const PipelineFlags& flags) {
                      : flags.volume == "hex" ? v1::VOLUME_METHOD_HEX
                                              : v1::VOLUME_METHOD_TETGEN);
     proto.set_hex_size_mm(flags.hex_size_mm);
+    proto.set_hex_interior_size_mm(flags.hex_interior_size_mm);
     proto.set_tet_radius_edge(flags.tetgen.radius_edge_ratio);
     proto.set_tet_min_dihedral_deg(flags.tetgen.min_dihedral_deg);
     proto.set_tet_max_volume_mm3(flags.tetgen.max_volume_mm3);

@@ -25,6 +25,7 @@ struct PipelineFlags {
   bool keep_strands = false;
   std::string volume = "none";
   double hex_size_mm = 0;
+  double hex_interior_size_mm = 0;
   volume_mesh::TetgenParams tetgen;
   volume_mesh::ImproveParams improve;
   bool tet_split_boundary = false;

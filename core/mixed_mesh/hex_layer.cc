@@ -26,6 +26,8 @@ using geometry::sub;
 
 // Cells ranked below this are worth moving nodes for.
 constexpr double kComfortable = 0.45;
+// Table 1's "good" tetrahedra: Q above 0.2.
+constexpr double kTetraGood = 0.2;
 
 Point unit(const Point& v) {
   const double n = norm(v);
@@ -210,15 +212,19 @@ class LayerBuilder {
     size_t below = 0;
     double worst = 1;
     for (size_t c = 0; c < mesh_.size(); ++c) {
-      double jr = 1, aspect = 1;
+      double jr = 1, aspect = 1, tetra_q = 1;
       if (mesh_.types[c] == CellType::kHexahedron) {
         jr = quality::hexahedron_jacobian_ratio(corners<8>(mesh_, c));
       } else if (mesh_.types[c] == CellType::kPyramid) {
         jr = quality::pyramid_jacobian_ratio(corners<5>(mesh_, c));
         aspect = quality::pyramid_signed_aspect_ratio(corners<5>(mesh_, c));
+      } else if (mesh_.types[c] == CellType::kTetra) {
+        tetra_q = quality::tetra_quality(corners<4>(mesh_, c));
       }
       worst = std::min(worst, jr);
-      if (!(jr >= params_.jacobian_floor) || !(aspect >= params_.aspect_floor)) ++below;
+      if (!(jr >= params_.jacobian_floor) || !(aspect >= params_.aspect_floor) ||
+          !(tetra_q > kTetraGood))
+        ++below;
     }
     for (uint32_t o : outer_) {
       figures.boundary_distance_max_mm =
@@ -230,8 +236,8 @@ class LayerBuilder {
     if (below > 0) {
       return absl::FailedPreconditionError(
           cat("the hexahedral layer leaves ", below, " cells below Jacobian ratio ",
-              params_.jacobian_floor, " or pyramid aspect ratio ", params_.aspect_floor,
-              " (worst Jacobian ratio ", worst, ")"));
+              params_.jacobian_floor, ", pyramid aspect ratio ", params_.aspect_floor,
+              " or tetrahedron Q ", kTetraGood, " (worst Jacobian ratio ", worst, ")"));
     }
     if (!(std::abs(figures.volume_change) <= params_.volume_tolerance)) {
       return absl::FailedPreconditionError(
@@ -434,10 +440,6 @@ absl::StatusOr<MixedMesh> add_hex_layer(const SurfaceOracle& oracle, double surf
                                         MixedMesh core, const HexLayerParams& params,
                                         const RunContext& context, HexLayerFigures& figures) {
   if (core.size() == 0) return absl::FailedPreconditionError("the label has no hexahedral core");
-  for (CellType type : core.types) {
-    if (type != CellType::kHexahedron)
-      return absl::InvalidArgumentError("hex layer: the core holds cells other than hexahedra");
-  }
   LayerBuilder builder(oracle, std::move(core), params, context);
   if (auto s = builder.extrude(figures); !s.ok()) return s;
   if (auto s = builder.search(); !s.ok()) return s;

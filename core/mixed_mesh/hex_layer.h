@@ -27,7 +27,8 @@ struct HexLayerParams {
   double cell_mm = 2;
   // Least Jacobian ratio of any hexahedron or pyramid (paper §2.4.1).
   double jacobian_floor = 0.3;
-  // Least signed aspect ratio of a pyramid made by a split.
+  // Least signed aspect ratio of a pyramid. Tetrahedra (of an octree's
+  // transitions) must be Table 1 "good": Q above 0.2.
   double aspect_floor = 0.2;
   // Largest |volume / surface volume - 1|.
   double volume_tolerance = 0.01;
@@ -46,8 +47,9 @@ struct HexLayerFigures {
   double volume_change = 0;
 };
 
-// The core (hexahedra of one label, its boundary a manifold, as
-// build_hex_core makes it without pyramids) with the layer added, or
+// The core (cells of one label whose boundary faces are the squares of
+// build_hex_core's cubes, a manifold; octree_core.h may have coarsened its
+// inside) with the layer added, or
 // FAILED_PRECONDITION saying which floor the layer misses; CANCELLED when a
 // stop was requested. `surface_volume_mm3` is the volume the surface encloses.
 absl::StatusOr<MixedMesh> add_hex_layer(const SurfaceOracle& oracle, double surface_volume_mm3,

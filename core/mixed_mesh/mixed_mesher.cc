@@ -60,13 +60,20 @@ absl::StatusOr<MixedMesh> mesh_with_hex_layer(const SurfaceOracle& oracle,
     return absl::FailedPreconditionError(
         cat("too thin for a single ", params.core.cell_mm, " mm cube"));
   }
+  MixedMesh cells = std::move(core->mesh);
+  if (!params.hexahedra_only) {
+    OctreeParams octree = params.octree;
+    octree.cell_mm = params.core.cell_mm;
+    auto coarse = coarsen_core(cells, octree, figures.octree);
+    if (!coarse.ok()) return absl::InternalError(coarse.status().message());
+    cells = std::move(*coarse);
+  }
   HexLayerParams layer_params = params.layer;
   layer_params.cell_mm = params.core.cell_mm;
   layer_params.split = params.layer.split && !params.hexahedra_only;
   const double surface_volume = surface::compute_surface_statistics(surface).volume_mm3;
   HexLayerFigures layer;
-  auto mesh =
-      add_hex_layer(oracle, surface_volume, std::move(core->mesh), layer_params, context, layer);
+  auto mesh = add_hex_layer(oracle, surface_volume, std::move(cells), layer_params, context, layer);
   figures.layer = layer;
   return mesh;
 }
@@ -88,6 +95,9 @@ absl::StatusOr<MixedMesh> mesh_mixed(const surface::TriangleMesh& surface, int32
     return layered;
   }
   figures.layer_refused = std::string(layered.status().message());
+  // What the refused layer built is not in the mesh.
+  figures.octree = {};
+  figures.layer = {};
   if (params.hexahedra_only) {
     figures.left_out = true;
     return MixedMesh{};

@@ -16,6 +16,7 @@
 #include "core/mixed_mesh/hex_core.h"
 #include "core/mixed_mesh/hex_layer.h"
 #include "core/mixed_mesh/mixed_mesh.h"
+#include "core/mixed_mesh/octree_core.h"
 #include "core/surface/triangle_mesh.h"
 #include "core/util/run_context.h"
 #include "core/volume_mesh/tetrahedralize.h"
@@ -26,6 +27,9 @@ struct MixedParams {
   HexCoreParams core;
   // The hexahedral layer; its cell_mm is the core's.
   HexLayerParams layer;
+  // Coarser octants inside the hexahedral layer's core (its cell_mm is the
+  // core's); not with hexahedra_only, nor with the tetrahedral layer.
+  OctreeParams octree;
   // Hexahedra only: no split into pyramids, and no tetrahedral layer to fall
   // back to. A label whose layer misses the floors is left out.
   bool hexahedra_only = false;
@@ -41,6 +45,7 @@ struct MixedFigures {
   uint64_t grid_cells = 0;
   uint64_t depth_queries = 0;
   uint64_t core_cells_removed = 0;
+  OctreeFigures octree;
   HexLayerFigures layer;
   // Why the hexahedral layer was refused; empty when it was delivered.
   std::string layer_refused;

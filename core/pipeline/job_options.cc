@@ -272,6 +272,17 @@ absl::Status read_volume_options(const v1::MeshOptions& options, MeshParams& par
   if (!(params.hex_size_mm == 0 || (params.hex_size_mm >= 0.05 && params.hex_size_mm <= 1000)))
     return absl::InvalidArgumentError(
         cat("hex_size_mm: ", params.hex_size_mm, " is neither 0 nor in [0.05, 1000]"));
+  if (options.has_hex_interior_size_mm())
+    params.hex_interior_size_mm = options.hex_interior_size_mm();
+  if (!(params.hex_interior_size_mm == 0 ||
+        (params.hex_interior_size_mm > 0 && params.hex_interior_size_mm <= 1000)))
+    return absl::InvalidArgumentError(cat("hex_interior_size_mm: ", params.hex_interior_size_mm,
+                                          " is neither 0 nor in (0, 1000]"));
+  if (params.hex_interior_size_mm > 0 && params.hex_size_mm > 0 &&
+      params.hex_interior_size_mm < 2 * params.hex_size_mm)
+    return absl::InvalidArgumentError(cat("hex_interior_size_mm: ", params.hex_interior_size_mm,
+                                          " is less than twice hex_size_mm (", params.hex_size_mm,
+                                          "), so no octant is coarser"));
   auto& tetgen = params.tetgen;
   if (options.has_tet_radius_edge()) tetgen.radius_edge_ratio = options.tet_radius_edge();
   if (options.has_tet_min_dihedral_deg()) tetgen.min_dihedral_deg = options.tet_min_dihedral_deg();
@@ -356,6 +367,7 @@ v1::MeshOptions make_options(const MeshParams& params) {
                        : params.volume == VolumeMethod::kHex ? v1::VOLUME_METHOD_HEX
                                                              : v1::VOLUME_METHOD_TETGEN);
     options.set_hex_size_mm(params.hex_size_mm);
+    options.set_hex_interior_size_mm(params.hex_interior_size_mm);
     for (auto format : params.volume_formats)
       options.add_formats(std::string(volume_mesh::volume_format_name(format)));
   } else {

@@ -15,6 +15,10 @@ void add_figures(mixed_mesh::MixedFigures& sum, const mixed_mesh::MixedFigures& 
   sum.depth_queries += part.depth_queries;
   sum.core_cells_removed += part.core_cells_removed;
   sum.core_seconds += part.core_seconds;
+  for (size_t level = 0; level < std::size(sum.octree.octants); ++level)
+    sum.octree.octants[level] += part.octree.octants[level];
+  sum.octree.balance_splits += part.octree.balance_splits;
+  sum.octree.transition_octants += part.octree.transition_octants;
   sum.layer.layer_hexahedra += part.layer.layer_hexahedra;
   sum.layer.split_hexahedra += part.layer.split_hexahedra;
   sum.layer.boundary_distance_max_mm =
@@ -43,6 +47,7 @@ absl::StatusOr<MixedVolumeResult> mesh_labels_mixed(const std::vector<LabelBound
   MixedVolumeResult result;
   result.cell_mm = params.core.cell_mm;
   result.hexahedra_only = params.hexahedra_only;
+  result.interior_mm = params.octree.interior_mm;
   for (size_t i = 0; i < boundaries.size(); ++i) {
     const LabelBoundary& boundary = boundaries[i];
     // TetGen's own stage reports count as this stage's, label by label.

@@ -21,6 +21,8 @@ struct MixedVolumeResult {
   mixed_mesh::Conformity conformity;
   // The cube edge used, mm.
   double cell_mm = 0;
+  // The largest octant's edge asked for, mm; 0 for one size.
+  double interior_mm = 0;
   // Hexahedra only (VolumeMethod::kHex).
   bool hexahedra_only = false;
   // Summed over the labels (the layer's boundary distance: the largest).

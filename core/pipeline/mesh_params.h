@@ -134,6 +134,9 @@ struct MeshParams {
   // kMixed: the hexahedra's edge, mm; 0 for three voxels (the cube root of
   // the voxel volume).
   double hex_size_mm = 0;
+  // kMixed: the largest octant's edge inside a label, mm; 0 for hex_size_mm
+  // throughout (no octree).
+  double hex_interior_size_mm = 0;
   volume_mesh::TetgenParams tetgen;
   volume_mesh::ImproveParams improve;
   // Volume mesh files (when `volume` is not kNone).

@@ -260,6 +260,7 @@ absl::Status add_mixed_mesh(const MeshParams& params, const volume::ImageGeometr
   mixed.core.cell_mm = params.hex_size_mm > 0 ? params.hex_size_mm : 3 * voxel_size_mm(geometry);
   mixed.core.threads = label_threads(params, std::numeric_limits<size_t>::max());
   mixed.hexahedra_only = params.volume == VolumeMethod::kHex;
+  mixed.octree.interior_mm = params.hex_interior_size_mm;
   mixed.tetgen = params.tetgen;
   // Points TetGen added on the pyramids' triangles would leave their squares
   // facing split triangles: the layer's boundaries are always kept.

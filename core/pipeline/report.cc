@@ -42,6 +42,13 @@ v1::VolumeMeshSummary make_mixed_summary(const MixedVolumeResult& mixed) {
   if (q.pyramid_aspect_ratio_min) entry.set_pyramid_aspect_ratio_min(*q.pyramid_aspect_ratio_min);
   if (q.scaled_jacobian_min) entry.set_scaled_jacobian_min(*q.scaled_jacobian_min);
   entry.set_split_hexahedra(mixed.figures.layer.split_hexahedra);
+  entry.set_hex_interior_size_mm(mixed.interior_mm);
+  const auto& octants = mixed.figures.octree.octants;
+  size_t levels = std::size(octants);
+  while (levels > 0 && octants[levels - 1] == 0) --levels;
+  for (size_t level = 0; level < levels; ++level) entry.add_octants_per_level(octants[level]);
+  entry.set_balance_splits(mixed.figures.octree.balance_splits);
+  entry.set_transition_octants(mixed.figures.octree.transition_octants);
   entry.set_boundary_node_distance_max_mm(mixed.figures.layer.boundary_distance_max_mm);
   for (const auto& refused : mixed.tetrahedral_layer_labels) {
     auto* item = entry.add_tetrahedral_layer_labels();

@@ -126,6 +126,29 @@ TEST_P(MixedMesher, BothLayersAreValidAndFillTheSurface) {
     }
   }
   EXPECT_GT(outer_corners, 0u);
+  // The same with octants up to four cubes across inside: transitions in,
+  // the layer and its floors unchanged, no more nodes (the torus's tube is
+  // too thin for an octant that saves any).
+  MixedParams octree = hex_layer;
+  octree.octree.interior_mm = 4 * expect.cell_mm;
+  MixedFigures octree_figures;
+  auto coarse = mesh_mixed(surface, 7, octree, {}, octree_figures);
+  ASSERT_TRUE(coarse.ok()) << coarse.status();
+  ASSERT_EQ(octree_figures.layer_refused, "");
+  const MixedQuality oq = measure_mixed_mesh(*coarse);
+  EXPECT_EQ(oq.invalid, 0u);
+  EXPECT_GE(oq.jacobian_ratio_min, 0.3);
+  EXPECT_EQ(oq.cell_summary.good, int64_t(coarse->size()));
+  EXPECT_NEAR(oq.volume_mm3, enclosed, 0.01 * enclosed);
+  EXPECT_TRUE(check_conformity(*coarse).ok());
+  EXPECT_GT(octree_figures.octree.octants[1], 0u);
+  EXPECT_GT(octree_figures.octree.transition_octants, 0u);
+  EXPECT_LE(coarse->points.size(), mesh->points.size());
+  std::printf(
+      "%s with octants up to %.0f mm: %zu nodes (one size: %zu), %zu hexahedra, %zu "
+      "pyramids, %zu tetrahedra, JR min %.3f\n",
+      expect.name, 4 * expect.cell_mm, coarse->points.size(), mesh->points.size(), oq.hexahedra,
+      oq.pyramids, oq.tetrahedra, oq.jacobian_ratio_min);
   std::printf(
       "%s at %.1f mm, hexahedral layer: %zu hexahedra (%zu in the layer), %zu pyramids "
       "(%llu split), JR min %.3f mean %.3f, scaled Jacobian min %.3f, good %.2f %%, volume "
@@ -330,6 +353,18 @@ TEST(MixedVolumeStage, TetGenNodeFilesAreRefusedForMixedMeshes) {
   options.clear_formats();
   options.set_hex_size_mm(0.01);
   EXPECT_FALSE(params_from_options(options).ok());
+  // An interior size must leave room for one coarser level.
+  options.set_hex_size_mm(2);
+  options.set_hex_interior_size_mm(3);
+  auto refused = params_from_options(options);
+  ASSERT_FALSE(refused.ok());
+  EXPECT_NE(std::string(refused.status().message()).find("less than twice hex_size_mm"),
+            std::string::npos);
+  options.set_hex_interior_size_mm(8);
+  auto taken = params_from_options(options);
+  ASSERT_TRUE(taken.ok()) << taken.status();
+  EXPECT_EQ(taken->hex_interior_size_mm, 8);
+  EXPECT_EQ(make_options(*taken).hex_interior_size_mm(), 8);
 }
 
 }  // namespace

@@ -3,7 +3,8 @@
 """The liver's volume mesh in solvers nobody here wrote.
 
 `labelmesh mesh liver.inr.gz --labels 255 --volume tet --formats inp,msh`
-(or `--volume hex --hex-size 5` for hexahedra, C3D8 in the deck),
+(or `--volume hex --hex-size 5` for hexahedra, C3D8 in the deck, or `--volume mixed
+--hex-size 4 --hex-interior-size 16` for an octree's hexahedra, pyramids and tetrahedra),
 with the label named "liver" by a label table, then:
 - Gmsh loads volume.msh and its coherence check (duplicate nodes and
   elements, isolated nodes) finds nothing, with the report's counts, and
@@ -134,12 +135,14 @@ def main():
     parser.add_argument("--data", required=True)
     parser.add_argument("--volume", default="tet", choices=["tet", "mixed", "hex"])
     parser.add_argument("--hex-size", default="0")
+    parser.add_argument("--hex-interior-size", default="0")
     args = parser.parse_args()
     with tempfile.TemporaryDirectory(prefix="labelmesh-fe-") as tmp:
         work = pathlib.Path(tmp)
         (work / "names.json").write_text('{"255": "liver"}')
         run = subprocess.run([args.labelmesh, "mesh", f"{args.data}/liver.inr.gz", "--labels", "255",
                               "--volume", args.volume, "--hex-size", args.hex_size,
+                              "--hex-interior-size", args.hex_interior_size,
                               "--formats", "inp,msh", "--out", str(work),
                               "--label-names", str(work / "names.json"), "--json"],
                              capture_output=True, text=True, timeout=600)
