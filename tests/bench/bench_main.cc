@@ -1,12 +1,12 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-// labelmesh_bench [FILE... | --cancellation]: per-stage seconds, voxels per second and peak
-// RSS for reading and Marching Cubes, beside the baselines they are held to:
-// a plain decompress + scan of the voxels, and VTK's discrete flying edges
-// run directly on the whole volume. Then the quality-surface pipeline (MC,
-// repair, smoothing, Poisson solve and meshing, checks) on the liver's label
-// 255 and a 256^3 sphere, stage by stage; then TetGen and the improvement pass
-// on the liver with Q histograms before and after, and how fast a stop
-// request ends a run of the liver. Prints figures; never fails on time.
+// labelmesh_bench [FILE... | --cancellation | --volumes]: per-stage seconds, voxels per second and
+// peak RSS for reading and Marching Cubes, beside the baselines they are held to: a plain
+// decompress + scan of the voxels, and VTK's discrete flying edges run directly on the whole
+// volume. Then the quality-surface pipeline (MC, repair, smoothing, Poisson solve and meshing,
+// checks) on the liver's label 255 and a 256^3 sphere, stage by stage; then TetGen and the
+// improvement pass on the liver with Q histograms before and after, the mixed and hexahedral meshes
+// beside TetGen's, and how fast a stop request ends a run of the liver. Prints figures; never fails
+// on time.
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -26,6 +26,7 @@
 #include <vtkPolyData.h>
 
 #include "bench/mesh3_baseline.h"
+#include "core/pipeline/label_mixed_meshes.h"
 #include "core/pipeline/label_tet_meshes.h"
 #include "core/pipeline/pipeline.h"
 #include "core/surface/extract_surfaces.h"
@@ -265,6 +266,74 @@ int bench_tetrahedra(const std::string& path, const std::vector<int32_t>& labels
   return 0;
 }
 
+// Seconds of the named stages of a run.
+double stage_seconds(const labelmesh::MeshResult& result,
+                     std::initializer_list<const char*> names) {
+  double seconds = 0;
+  for (const auto& stage : result.stages)
+    for (const char* name : names)
+      if (stage.name == name) seconds += stage.seconds;
+  return seconds;
+}
+
+// One volume mesh of the liver's label 255, in this (child) process: the
+// volume stage's seconds, element counts, Jacobian ratio histogram and the
+// process's peak RSS, which the surface stages set before it.
+int bench_one_volume(const std::string& path, labelmesh::VolumeMethod method, double hex_mm,
+                     double interior_mm) {
+  labelmesh::MeshParams params;
+  params.labels = {255};
+  params.volume = method;
+  params.hex_size_mm = hex_mm;
+  params.hex_interior_size_mm = interior_mm;
+  auto result = labelmesh::run_pipeline(path, params, labelmesh::RunContext{});
+  if (!result.ok()) {
+    std::fprintf(stderr, "%s\n", std::string(result.status().message()).c_str());
+    return 1;
+  }
+  if (result->volume) {
+    const auto& v = *result->volume;
+    std::printf(
+        "  tet                %7.2f s  %zu tetrahedra, %zu nodes, Q min %.3f, good %lld, "
+        "peak RSS %.0f MiB\n",
+        stage_seconds(*result, {"tetgen", "tet_improve"}), v.mesh.tetrahedra.size(),
+        v.mesh.points.size(), v.summary.min, static_cast<long long>(v.summary.good),
+        peak_rss_mib());
+    return 0;
+  }
+  if (!result->mixed) return 1;
+  const auto& m = *result->mixed;
+  const auto& q = m.quality;
+  std::printf(
+      "  %s %.0f mm%s%-6s %7.2f s  %zu hexahedra (%.1f %%), %zu pyramids, %zu tetrahedra, %zu "
+      "nodes; JR min %.3f mean %.3f, scaled Jacobian min %.3f, good %lld, inverted %zu, volume "
+      "%+.3f %%, tetrahedral layer on %zu label(s), peak RSS %.0f MiB\n",
+      method == labelmesh::VolumeMethod::kHex ? "hex  " : "mixed", hex_mm,
+      interior_mm > 0 ? "/" : "", interior_mm > 0 ? std::to_string(int(interior_mm)).c_str() : "",
+      stage_seconds(*result, {"mixed_mesh"}), q.hexahedra,
+      100.0 * double(q.hexahedra) / double(std::max<size_t>(1, m.mesh.size())), q.pyramids,
+      q.tetrahedra, m.mesh.points.size(), q.jacobian_ratio_min, q.jacobian_ratio_mean,
+      q.scaled_jacobian_min.value_or(0), static_cast<long long>(q.cell_summary.good), q.invalid,
+      100 * (q.volume_mm3 / m.surface_volume_mm3 - 1), m.tetrahedral_layer_labels.size(),
+      peak_rss_mib());
+  static constexpr double kUpper[] = {0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 1.0 + 1e-12};
+  size_t counts[std::size(kUpper)] = {};
+  for (size_t c = 0; c < m.mesh.size(); ++c) {
+    if (m.mesh.types[c] == labelmesh::mixed_mesh::CellType::kTetra) continue;
+    size_t bin = 0;
+    while (bin + 1 < std::size(kUpper) && q.jacobian_ratio[c] > kUpper[bin]) ++bin;
+    ++counts[bin];
+  }
+  std::printf("    JR histogram (hexahedra, pyramids):");
+  double lower = -1;
+  for (size_t bin = 0; bin < std::size(kUpper); ++bin) {
+    std::printf(" (%.1f,%.1f] %zu", lower, std::min(kUpper[bin], 1.0), counts[bin]);
+    lower = kUpper[bin];
+  }
+  std::printf("\n");
+  return 0;
+}
+
 // Stops a run of the liver's label 255 (through TetGen) at one time after
 // another and prints how long each stop took to return, and in which stage
 // it came (each should take under 1 s).
@@ -332,6 +401,25 @@ bool in_child(F&& job) {
   return WIFEXITED(status) && WEXITSTATUS(status) == 0;
 }
 
+// The liver's volume meshes, each in its own process (its own peak RSS),
+// TetGen's and ours in turn, twice over, then the finer and hexahedral ones.
+int bench_volumes(const std::string& liver) {
+  using labelmesh::VolumeMethod;
+  std::printf("%s: volume meshes of label 255 (volume stage seconds)\n", liver.c_str());
+  std::fflush(stdout);
+  bool ok = true;
+  for (int round = 0; round < 2; ++round) {
+    ok &= in_child([&] { return bench_one_volume(liver, VolumeMethod::kTetgen, 0, 0); });
+    ok &= in_child([&] { return bench_one_volume(liver, VolumeMethod::kMixed, 2, 0); });
+    ok &= in_child([&] { return bench_one_volume(liver, VolumeMethod::kTetgen, 0, 0); });
+    ok &= in_child([&] { return bench_one_volume(liver, VolumeMethod::kMixed, 2, 8); });
+  }
+  ok &= in_child([&] { return bench_one_volume(liver, VolumeMethod::kHex, 2, 0); });
+  ok &= in_child([&] { return bench_one_volume(liver, VolumeMethod::kMixed, 1, 0); });
+  ok &= in_child([&] { return bench_one_volume(liver, VolumeMethod::kMixed, 1, 8); });
+  return ok ? 0 : 1;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -339,6 +427,8 @@ int main(int argc, char** argv) {
   // The cancellation figures alone: labelmesh_bench --cancellation.
   if (argc == 2 && std::string(argv[1]) == "--cancellation")
     return in_child([&] { return bench_cancellation(liver_path, {255}); }) ? 0 : 1;
+  // The volume meshes alone: labelmesh_bench --volumes.
+  if (argc == 2 && std::string(argv[1]) == "--volumes") return bench_volumes(liver_path);
   std::vector<std::string> files;
   for (int i = 1; i < argc; ++i) files.emplace_back(argv[i]);
   if (files.empty()) {
@@ -350,6 +440,7 @@ int main(int argc, char** argv) {
   }
   if (argc == 1) {
     const std::string liver = files[0];
+    if (bench_volumes(liver) != 0) ++failures;
     if (!in_child([&] { return bench_quality_surface(liver, {255}); })) ++failures;
     if (!in_child([&] { return bench_tetrahedra(liver, {255}); })) ++failures;
     if (!in_child([&] { return bench_cancellation(liver, {255}); })) ++failures;
