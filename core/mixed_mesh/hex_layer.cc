@@ -102,7 +102,7 @@ class LayerBuilder {
     outer_.resize(boundary_.size());
     std::vector<double> length(boundary_.size());
     for (size_t v = 0; v < boundary_.size(); ++v) {
-      const Point& from = mesh_.points[boundary_[v]];
+      const Point from = mesh_.points[boundary_[v]];  // a copy: points grow below
       const auto hit = oracle_.first_hit(from, normal[v]);
       if (!hit) {
         return absl::FailedPreconditionError(
@@ -173,16 +173,28 @@ class LayerBuilder {
         std::vector<uint32_t> next;
         for (uint32_t node : work) {
           if (!improve(node, step)) continue;
-          for (uint32_t c : cells_of_[node]) {
-            rank_[c] = layer_cell_rank(mesh_, c);
+          for (uint32_t c : cells_of_[node])
             for (int k = 0; k < node_count(mesh_.types[c]); ++k) next.push_back(mesh_.cells[c][k]);
-          }
         }
         std::sort(next.begin(), next.end());
         next.erase(std::unique(next.begin(), next.end()), next.end());
         work.clear();
         for (uint32_t node : next)
           if (is_poor(node)) work.push_back(node);
+      }
+    }
+    // Cells still below the floor: their nodes and their neighbours' try the
+    // diagonals too, a few rounds.
+    for (int round = 0; round < 4; ++round) {
+      const std::vector<uint32_t> stuck = stuck_neighbourhood();
+      if (stuck.empty()) break;
+      for (double step : {0.1 * h, 0.05 * h, 0.025 * h, 0.0125 * h, 0.00625 * h}) {
+        if (auto s = context_.check_stop(); !s.ok()) return s;
+        for (int sweep = 0; sweep < 8; ++sweep) {
+          bool moved = false;
+          for (uint32_t node : stuck) moved |= improve(node, step, true);
+          if (!moved) break;
+        }
       }
     }
     return absl::OkStatus();
@@ -283,42 +295,68 @@ class LayerBuilder {
     return nodes;
   }
 
+  // The nodes of cells ranked below the Jacobian floor and of every cell
+  // that shares a node with one, in order.
+  std::vector<uint32_t> stuck_neighbourhood() const {
+    std::vector<uint32_t> near, nodes;
+    for (size_t c = 0; c < mesh_.size(); ++c) {
+      if (rank_[c] >= params_.jacobian_floor) continue;
+      for (int k = 0; k < node_count(mesh_.types[c]); ++k) near.push_back(mesh_.cells[c][k]);
+    }
+    for (uint32_t node : near)
+      for (uint32_t c : cells_of_[node])
+        for (int k = 0; k < node_count(mesh_.types[c]); ++k) nodes.push_back(mesh_.cells[c][k]);
+    std::sort(nodes.begin(), nodes.end());
+    nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
+    return nodes;
+  }
+
   bool is_poor(uint32_t node) const {
     for (uint32_t c : cells_of_[node])
       if (rank_[c] < kComfortable) return true;
     return false;
   }
 
-  bool improve(uint32_t node, double step) {
+  // Tries steps of `step` from the node: along the axes, or with `wide`
+  // also along the diagonals (26 directions; 8 across an outer node's
+  // normal). Keeps the best that ranks the cells around higher.
+  bool improve(uint32_t node, double step, bool wide = false) {
     const Point from = mesh_.points[node];
     NodeRank best = rank(node);
     Point best_point = from;
-    // Outer nodes step along the surface: two directions across their
-    // normal, then back onto the surface.
-    std::array<Point, 3> axes{{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}};
-    int count = 3;
+    std::vector<Point> directions;
     if (on_surface_[node]) {
+      // Outer nodes step along the surface, then return to it.
       const Point& n = normal_[node];
       const Point other = std::abs(n[0]) < 0.6 ? Point{1, 0, 0} : Point{0, 1, 0};
-      axes[0] = unit(cross(n, other));
-      axes[1] = cross(n, axes[0]);
-      count = 2;
+      const Point u = unit(cross(n, other));
+      const Point v = cross(n, u);
+      for (int i = -1; i <= 1; ++i)
+        for (int j = -1; j <= 1; ++j)
+          if ((i || j) && (wide || !(i && j)))
+            directions.push_back(unit(add(scale(u, i), scale(v, j))));
+    } else {
+      for (int i = -1; i <= 1; ++i)
+        for (int j = -1; j <= 1; ++j)
+          for (int k = -1; k <= 1; ++k)
+            if ((i || j || k) && (wide || std::abs(i) + std::abs(j) + std::abs(k) == 1))
+              directions.push_back(unit(Point{double(i), double(j), double(k)}));
     }
-    for (int a = 0; a < count; ++a) {
-      for (double sign : {-1.0, 1.0}) {
-        Point candidate = add(from, scale(axes[a], sign * step));
-        if (on_surface_[node]) candidate = oracle_.closest(candidate);
-        if (norm(sub(candidate, from)) < 1e-9 * params_.cell_mm) continue;
-        mesh_.points[node] = candidate;
-        const NodeRank r = rank(node, &best);
-        if (r.better_than(best)) {
-          best = r;
-          best_point = candidate;
-        }
+    for (const Point& direction : directions) {
+      Point candidate = add(from, scale(direction, step));
+      if (on_surface_[node]) candidate = oracle_.closest(candidate);
+      if (norm(sub(candidate, from)) < 1e-9 * params_.cell_mm) continue;
+      mesh_.points[node] = candidate;
+      const NodeRank r = rank(node, &best);
+      if (r.better_than(best)) {
+        best = r;
+        best_point = candidate;
       }
     }
     mesh_.points[node] = best_point;
-    return best_point != from;
+    if (best_point == from) return false;
+    for (uint32_t c : cells_of_[node]) rank_[c] = layer_cell_rank(mesh_, c);
+    return true;
   }
 
   // Six pyramids for hexahedron c about an inner point, or none when they
@@ -376,8 +414,10 @@ double hexahedron_rank(const quality::Hex& p) {
       }
     }
   }
-  const double ratio = highest > 0 ? lowest / highest : -1;
-  return std::min(ratio, 2 * scaled);
+  // An inverted corner ranks below any valid cell, by how far the worst
+  // corner is folded: the ratio alone is flat (-1) once every corner is.
+  if (!(lowest > 0)) return 2 * scaled - 2;
+  return std::min(lowest / highest, 2 * scaled);
 }
 
 std::optional<Point> split_apex(const std::array<Point, 8>& hex, const HexLayerParams& params) {
