@@ -119,13 +119,6 @@ double quad_flux(const std::array<Vec3, 4>& p) {
   return sum / 3;
 }
 
-template <size_t N>
-std::array<Vec3, N> cell_points(const MixedMesh& mesh, size_t cell) {
-  std::array<Vec3, N> p;
-  for (size_t k = 0; k < N; ++k) p[k] = mesh.points[mesh.cells[cell][k]];
-  return p;
-}
-
 struct CellFigures {
   double jacobian_ratio;
   double quality;

@@ -34,13 +34,6 @@ Point unit(const Point& v) {
   return n > 0 ? scale(v, 1 / n) : v;
 }
 
-template <size_t N>
-std::array<Point, N> corners(const MixedMesh& mesh, size_t c) {
-  std::array<Point, N> p;
-  for (size_t k = 0; k < N; ++k) p[k] = mesh.points[mesh.cells[c][k]];
-  return p;
-}
-
 // How good the cells around a node are: the worst first, then how far the
 // others fall short of comfortable.
 struct NodeRank {
@@ -207,7 +200,7 @@ class LayerBuilder {
     out.points = mesh_.points;
     for (size_t c = 0; c < mesh_.size(); ++c) {
       if (mesh_.types[c] == CellType::kHexahedron &&
-          quality::hexahedron_jacobian_ratio(corners<8>(mesh_, c)) < params_.jacobian_floor) {
+          quality::hexahedron_jacobian_ratio(cell_points<8>(mesh_, c)) < params_.jacobian_floor) {
         if (auto pyramids = split_one(c, out.points)) {
           for (const auto& p : *pyramids) out.add(CellType::kPyramid, p, mesh_.labels[c]);
           ++figures.split_hexahedra;
@@ -226,12 +219,12 @@ class LayerBuilder {
     for (size_t c = 0; c < mesh_.size(); ++c) {
       double jr = 1, aspect = 1, tetra_q = 1;
       if (mesh_.types[c] == CellType::kHexahedron) {
-        jr = quality::hexahedron_jacobian_ratio(corners<8>(mesh_, c));
+        jr = quality::hexahedron_jacobian_ratio(cell_points<8>(mesh_, c));
       } else if (mesh_.types[c] == CellType::kPyramid) {
-        jr = quality::pyramid_jacobian_ratio(corners<5>(mesh_, c));
-        aspect = quality::pyramid_signed_aspect_ratio(corners<5>(mesh_, c));
+        jr = quality::pyramid_jacobian_ratio(cell_points<5>(mesh_, c));
+        aspect = quality::pyramid_signed_aspect_ratio(cell_points<5>(mesh_, c));
       } else if (mesh_.types[c] == CellType::kTetra) {
-        tetra_q = quality::tetra_quality(corners<4>(mesh_, c));
+        tetra_q = quality::tetra_quality(cell_points<4>(mesh_, c));
       }
       worst = std::min(worst, jr);
       if (!(jr >= params_.jacobian_floor) || !(aspect >= params_.aspect_floor) ||
@@ -363,7 +356,7 @@ class LayerBuilder {
   // miss a floor. Adds the apex to `points`.
   std::optional<std::array<std::array<uint32_t, 8>, 6>> split_one(size_t c,
                                                                   std::vector<Point>& points) {
-    const auto apex = split_apex(corners<8>(mesh_, c), params_);
+    const auto apex = split_apex(cell_points<8>(mesh_, c), params_);
     if (!apex) return std::nullopt;
     points.push_back(*apex);
     return pyramids_of(mesh_.cells[c], uint32_t(points.size() - 1));
@@ -398,21 +391,14 @@ std::array<std::array<uint32_t, 8>, 6> pyramids_of(const std::array<uint32_t, 8>
 // min(JR, 2 × scaled Jacobian) from one pass over the corners (the
 // layer's search calls it most).
 double hexahedron_rank(const quality::Hex& p) {
-  static constexpr int kNode[2][2][2] = {{{0, 4}, {3, 7}}, {{1, 5}, {2, 6}}};
+  const quality::HexCorners corners = quality::hexahedron_corners(p);
   double lowest = std::numeric_limits<double>::infinity(), highest = -lowest, scaled = 1;
-  for (int r = 0; r < 2; ++r) {
-    for (int s = 0; s < 2; ++s) {
-      for (int t = 0; t < 2; ++t) {
-        const Point dr = sub(p[kNode[1][s][t]], p[kNode[0][s][t]]);
-        const Point ds = sub(p[kNode[r][1][t]], p[kNode[r][0][t]]);
-        const Point dt = sub(p[kNode[r][s][1]], p[kNode[r][s][0]]);
-        const double j = geometry::dot(cross(dr, ds), dt);
-        lowest = std::min(lowest, j);
-        highest = std::max(highest, j);
-        const double lengths = norm(dr) * norm(ds) * norm(dt);
-        scaled = lengths > 0 ? std::min(scaled, j / lengths) : std::min(scaled, 0.0);
-      }
-    }
+  for (int k = 0; k < 8; ++k) {
+    const double j = corners.jacobian[k];
+    lowest = std::min(lowest, j);
+    highest = std::max(highest, j);
+    const double lengths = corners.edge_lengths[k];
+    scaled = std::min(scaled, lengths > 0 ? j / lengths : 0.0);
   }
   // An inverted corner ranks below any valid cell, by how far the worst
   // corner is folded: the ratio alone is flat (-1) once every corner is.
@@ -463,15 +449,15 @@ std::optional<Point> split_apex(const std::array<Point, 8>& hex, const HexLayerP
 double layer_cell_rank(const MixedMesh& mesh, size_t cell) {
   switch (mesh.types[cell]) {
     case CellType::kHexahedron:
-      return hexahedron_rank(corners<8>(mesh, cell));
+      return hexahedron_rank(cell_points<8>(mesh, cell));
     case CellType::kPyramid: {
-      const auto p = corners<5>(mesh, cell);
+      const auto p = cell_points<5>(mesh, cell);
       return std::min(quality::pyramid_jacobian_ratio(p), quality::pyramid_signed_aspect_ratio(p));
     }
     case CellType::kWedge:
-      return quality::wedge_jacobian_ratio(corners<6>(mesh, cell));
+      return quality::wedge_jacobian_ratio(cell_points<6>(mesh, cell));
     case CellType::kTetra:
-      return quality::tetra_quality(corners<4>(mesh, cell));
+      return quality::tetra_quality(cell_points<4>(mesh, cell));
   }
   return -1;
 }

@@ -35,4 +35,12 @@ struct MixedMesh {
   void append(const MixedMesh& other);
 };
 
+// The first N points of cell `cell`, in its node order.
+template <size_t N>
+std::array<std::array<double, 3>, N> cell_points(const MixedMesh& mesh, size_t cell) {
+  std::array<std::array<double, 3>, N> p;
+  for (size_t k = 0; k < N; ++k) p[k] = mesh.points[mesh.cells[cell][k]];
+  return p;
+}
+
 }  // namespace labelmesh::mixed_mesh

@@ -75,21 +75,26 @@ double jacobian_ratio(std::span<const double> corner_jacobians) {
   return *lo / *hi;
 }
 
-std::array<double, 8> hexahedron_corner_jacobians(const Hex& p) {
+HexCorners hexahedron_corners(const Hex& p) {
   // VTK node at parametric corner (r, s, t) ∈ {0,1}³.
   static constexpr int kNode[2][2][2] = {{{0, 4}, {3, 7}}, {{1, 5}, {2, 6}}};
-  std::array<double, 8> jacobians{};
+  HexCorners corners{};
   for (int r = 0; r < 2; ++r) {
     for (int s = 0; s < 2; ++s) {
       for (int t = 0; t < 2; ++t) {
         const Point dr = sub(p[kNode[1][s][t]], p[kNode[0][s][t]]);
         const Point ds = sub(p[kNode[r][1][t]], p[kNode[r][0][t]]);
         const Point dt = sub(p[kNode[r][s][1]], p[kNode[r][s][0]]);
-        jacobians[kNode[r][s][t]] = triple(dr, ds, dt);
+        corners.jacobian[kNode[r][s][t]] = triple(dr, ds, dt);
+        corners.edge_lengths[kNode[r][s][t]] = norm(dr) * norm(ds) * norm(dt);
       }
     }
   }
-  return jacobians;
+  return corners;
+}
+
+std::array<double, 8> hexahedron_corner_jacobians(const Hex& p) {
+  return hexahedron_corners(p).jacobian;
 }
 
 double hexahedron_jacobian_ratio(const Hex& p) {
@@ -97,19 +102,11 @@ double hexahedron_jacobian_ratio(const Hex& p) {
 }
 
 double hexahedron_scaled_jacobian(const Hex& p) {
-  static constexpr int kNode[2][2][2] = {{{0, 4}, {3, 7}}, {{1, 5}, {2, 6}}};
+  const HexCorners corners = hexahedron_corners(p);
   double lowest = 1.0;
-  for (int r = 0; r < 2; ++r) {
-    for (int s = 0; s < 2; ++s) {
-      for (int t = 0; t < 2; ++t) {
-        const Point dr = sub(p[kNode[1][s][t]], p[kNode[0][s][t]]);
-        const Point ds = sub(p[kNode[r][1][t]], p[kNode[r][0][t]]);
-        const Point dt = sub(p[kNode[r][s][1]], p[kNode[r][s][0]]);
-        const double lengths = norm(dr) * norm(ds) * norm(dt);
-        if (!(lengths > 0.0)) return 0.0;
-        lowest = std::min(lowest, triple(dr, ds, dt) / lengths);
-      }
-    }
+  for (int k = 0; k < 8; ++k) {
+    if (!(corners.edge_lengths[k] > 0.0)) return 0.0;
+    lowest = std::min(lowest, corners.jacobian[k] / corners.edge_lengths[k]);
   }
   return lowest;
 }

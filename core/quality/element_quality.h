@@ -56,6 +56,14 @@ double jacobian_ratio(std::span<const double> corner_jacobians);
 // 1 at every corner of the unit cube. §2.4.1, |J(ξ)| at the nodes.
 std::array<double, 8> hexahedron_corner_jacobians(const Hex& p);
 
+// Per corner of a hexahedron, indexed by node: its Jacobian (as hexahedron_corner_jacobians)
+// and the product of the lengths of the three edges leaving it, length³.
+struct HexCorners {
+  std::array<double, 8> jacobian;
+  std::array<double, 8> edge_lengths;
+};
+HexCorners hexahedron_corners(const Hex& p);
+
 // Jacobian ratio of a hexahedron, dimensionless (see jacobian_ratio). 1 for any parallelepiped,
 // negative when any corner is inverted. §2.4.1, JR_e.
 double hexahedron_jacobian_ratio(const Hex& p);
