@@ -174,6 +174,39 @@ TEST_F(MeshingServiceTest, TheServiceMakesTheSameMixedMeshAsTheLibrary) {
   EXPECT_EQ(served.files_size(), 1);
 }
 
+// Hexahedra only through the service: labels too thin for them are left out,
+// no empty file is written, and the job still succeeds, saying which and why.
+TEST_F(MeshingServiceTest, HexahedraOnlyJobsListTheLabelsLeftOut) {
+  ServiceHarness service(config_);
+  const fs::path input = write_phantom(dir_, volume::PhantomShape::kNestedSpheres);
+  v1::MeshOptions options = repaired_options();
+  options.set_volume(v1::VOLUME_METHOD_HEX);
+  options.set_hex_size_mm(2);
+  options.add_formats("vtu");
+  v1::SubmitReply reply;
+  ASSERT_TRUE(service.submit(input, options, &reply).ok());
+  service.watch(reply.job_id());
+  const v1::Job job = service.get(reply.job_id());
+  ASSERT_EQ(job.state(), v1::JOB_STATE_SUCCEEDED) << job.error().message();
+  const v1::VolumeMeshSummary& served = job.report().volume();
+  EXPECT_EQ(served.mesher(), "hex_grid");
+  // At 2 mm no label of the nested spheres keeps a valid hexahedral layer.
+  EXPECT_EQ(served.hexahedra() + served.pyramids() + served.tetrahedra(), 0u);
+  ASSERT_EQ(served.labels_left_out_size(), 3);
+  std::set<int32_t> left_out;
+  for (const auto& item : served.labels_left_out()) {
+    EXPECT_FALSE(item.reason().empty());
+    left_out.insert(item.label());
+  }
+  size_t warned = 0;
+  for (const auto& warning : job.report().warnings())
+    warned +=
+        left_out.count(warning.label()) && absl::StartsWith(warning.reason(), "no volume mesh: ");
+  EXPECT_EQ(warned, left_out.size());
+  EXPECT_EQ(left_out, (std::set<int32_t>{1, 2, 3}));
+  EXPECT_EQ(served.files_size(), 0);
+}
+
 TEST_F(MeshingServiceTest, FullQueueRefusesWithResourceExhausted) {
   config_.workers = 0;  // Nothing starts: the queue only fills.
   config_.queue_capacity = 2;
