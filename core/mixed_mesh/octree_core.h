@@ -25,7 +25,7 @@ struct OctreeParams {
   double interior_mm = 0;
   // Cubes of the surface size kept under the core's boundary before the
   // first coarser octant.
-  int surface_layers = 2;
+  int surface_layers = 3;
 };
 
 struct OctreeFigures {
