@@ -242,11 +242,13 @@ class LayerBuilder {
       return absl::FailedPreconditionError(
           cat("the hexahedral layer leaves ", below, " cells below Jacobian ratio ",
               params_.jacobian_floor, ", pyramid aspect ratio ", params_.aspect_floor,
-              " or tetrahedron Q ", kTetraGood, " (worst Jacobian ratio ", worst, ")"));
+              " or tetrahedron Q ", kTetraGood, " (worst Jacobian ratio ", format_fixed(worst, 3),
+              ")"));
     }
     if (!(std::abs(figures.volume_change) <= params_.volume_tolerance)) {
       return absl::FailedPreconditionError(
-          cat("the hexahedral layer's volume is ", 100 * std::abs(figures.volume_change), " % ",
+          cat("the hexahedral layer's volume is ",
+              format_fixed(100 * std::abs(figures.volume_change), 2), " % ",
               figures.volume_change < 0 ? "below" : "above", " the surface's (at most ",
               100 * params_.volume_tolerance, " % either way)"));
     }

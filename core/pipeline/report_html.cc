@@ -226,9 +226,15 @@ Chart surface_angle_chart(const v1::Report& report) {
   return chart;
 }
 
-// Tetrahedra per category of the paper's Table 1 (quality Q).
-Chart category_chart(const v1::QualityCategories& c) {
-  Chart chart{"Tetrahedra per quality category (Table 1)", "tetrahedra", 1, {}};
+// Cells per category of the paper's Table 1 (tetrahedra by Q, the other
+// cells of a mixed mesh by their Jacobian ratio).
+Chart category_chart(const v1::QualityCategories& c, bool tetrahedra_only) {
+  Chart chart{tetrahedra_only ? "Tetrahedra per quality category (Table 1)"
+                              : "Cells per quality category (Table 1: Jacobian ratio, Q for "
+                                "tetrahedra)",
+              tetrahedra_only ? "tetrahedra" : "cells",
+              1,
+              {}};
   chart.bars = {
       {"invalid (Q \xE2\x89\xA4 0.001)", 0, double(c.invalid()), cat(c.invalid()), "#b00020"},
       {"very bad (\xE2\x89\xA4 1/30)", 0, double(c.very_bad()), cat(c.very_bad()), "#e06000"},
@@ -239,7 +245,46 @@ Chart category_chart(const v1::QualityCategories& c) {
   return chart;
 }
 
+// The hexahedra, pyramids and tetrahedra of a mixed or hexahedral mesh, and
+// the labels that fell back or were left out, with why.
+std::string mixed_volume_section(const v1::VolumeMeshSummary& v) {
+  const auto row = [](std::string_view name, const std::string& value) {
+    return cat("<tr><th>", name, "</th><td class=\"num\">", value, "</td></tr>\n");
+  };
+  std::string html = cat(
+      "<h2>Volume mesh (", html_escape(v.mesher()), ")</h2>\n<table>\n",
+      row("Cube edge (mm)", fixed(v.hex_size_mm(), 2)),
+      v.hex_interior_size_mm() > 0 ? row("Largest octant (mm)", fixed(v.hex_interior_size_mm(), 2))
+                                   : "",
+      row("Nodes", cat(v.nodes())), row("Hexahedra", cat(v.hexahedra())),
+      row("Pyramids", cat(v.pyramids())), row("Prisms", cat(v.prisms())),
+      row("Tetrahedra", cat(v.tetrahedra())),
+      row("Jacobian ratio, min", fixed(v.jacobian_ratio_min(), 3)),
+      row("Jacobian ratio, mean", fixed(v.jacobian_ratio_mean(), 3)),
+      v.has_scaled_jacobian_min() ? row("Scaled Jacobian, min", fixed(v.scaled_jacobian_min(), 3))
+                                  : "",
+      v.has_pyramid_aspect_ratio_min()
+          ? row("Pyramid aspect ratio, min", fixed(v.pyramid_aspect_ratio_min(), 3))
+          : "",
+      row("Inverted cells", cat(v.inverted())),
+      row("Volume against the surfaces (%)", fixed(100 * v.volume_change(), 3)),
+      row("Outer nodes' distance to the surface, max (mm)",
+          fixed(v.boundary_node_distance_max_mm(), 6)),
+      "</table>\n");
+  const auto labels = [](std::string_view title, const auto& items) {
+    if (items.empty()) return std::string();
+    std::string list = cat("<h3>", title, "</h3>\n<ul>\n");
+    for (const auto& item : items)
+      list += cat("<li>label ", item.label(), ": ", html_escape(item.reason()), "</li>\n");
+    return list + "</ul>\n";
+  };
+  html += labels("Labels with a tetrahedral outer layer", v.tetrahedral_layer_labels());
+  html += labels("Labels left out", v.labels_left_out());
+  return html + svg_chart(category_chart(v.categories(), false));
+}
+
 std::string volume_section(const v1::VolumeMeshSummary& v) {
+  if (v.mesher() != "tetgen") return mixed_volume_section(v);
   const auto row = [](std::string_view name, const std::string& value) {
     return cat("<tr><th>", name, "</th><td class=\"num\">", value, "</td></tr>\n");
   };
@@ -251,7 +296,7 @@ std::string volume_section(const v1::VolumeMeshSummary& v) {
              row("Dihedral angle, min (&deg;)", fixed(v.min_dihedral_deg(), 2)),
              row("Dihedral angle, max (&deg;)", fixed(v.max_dihedral_deg(), 2)),
              row("Conforming across labels", v.conforming() ? "yes" : "no"), "</table>\n",
-             svg_chart(category_chart(v.categories())));
+             svg_chart(category_chart(v.categories(), true)));
 }
 
 }  // namespace

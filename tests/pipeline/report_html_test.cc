@@ -151,6 +151,37 @@ TEST(ReportHtml, ShowsEveryLabelsOutputFigures) {
   EXPECT_FALSE(absl::StrContains(html, ">9999<"));
 }
 
+// A mixed mesh's page shows its cells, Jacobian figures and the labels that
+// fell back or were left out, their reasons escaped.
+TEST(ReportHtml, ShowsAMixedMeshAndItsLabelsLeftOut) {
+  v1::Report report = sample_report();
+  auto* v = report.mutable_volume();
+  v->Clear();
+  v->set_mesher("mixed_grid");
+  v->set_hex_size_mm(2);
+  v->set_nodes(223487);
+  v->set_hexahedra(208388);
+  v->set_pyramids(12);
+  v->set_jacobian_ratio_min(0.408);
+  v->set_scaled_jacobian_min(0.204);
+  v->set_volume_change(-0.00088);
+  auto* refused = v->add_tetrahedral_layer_labels();
+  refused->set_label(4);
+  refused->set_reason("volume 3.9 % < surface's");
+  auto* left_out = v->add_labels_left_out();
+  left_out->set_label(5);
+  left_out->set_reason(kHostileName);
+  const std::string html = report_html(report);
+  for (const char* figure : {"Volume mesh (mixed_grid)", ">223487<", ">208388<", ">12<", ">0.408<",
+                             ">0.204<", ">-0.088<", "Labels with a tetrahedral outer layer",
+                             "label 4: volume 3.9 % &lt; surface&#39;s", "Labels left out",
+                             "Cells per quality category"})
+    EXPECT_TRUE(absl::StrContains(html, figure)) << figure;
+  EXPECT_TRUE(absl::StrContains(html, cat("label 5: ", kEscapedHostileName)));
+  EXPECT_FALSE(absl::StrContains(absl::AsciiStrToLower(html), "<script"));
+  EXPECT_FALSE(absl::StrContains(html, "Steiner points"));
+}
+
 TEST(ReportHtml, EscapesHostileNames) {
   const std::string html = report_html(sample_report());
   EXPECT_TRUE(absl::StrContains(html, kEscapedHostileName));
