@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 #include <optional>
+#include <span>
 #include <unordered_map>
 #include <vector>
 
@@ -32,6 +33,40 @@ constexpr double kTetraGood = 0.2;
 Point unit(const Point& v) {
   const double n = norm(v);
   return n > 0 ? scale(v, 1 / n) : v;
+}
+
+void sort_unique(std::vector<uint32_t>& values) {
+  std::sort(values.begin(), values.end());
+  values.erase(std::unique(values.begin(), values.end()), values.end());
+}
+
+// Unit steps: along the axes (6), or towards every neighbour of a grid
+// point (26, the diagonals too).
+std::vector<Point> grid_steps(bool diagonals) {
+  std::vector<Point> steps;
+  for (int i = -1; i <= 1; ++i)
+    for (int j = -1; j <= 1; ++j)
+      for (int k = -1; k <= 1; ++k)
+        if ((i || j || k) && (diagonals || std::abs(i) + std::abs(j) + std::abs(k) == 1))
+          steps.push_back(unit(Point{double(i), double(j), double(k)}));
+  return steps;
+}
+const std::vector<Point> kAxisSteps = grid_steps(false);
+const std::vector<Point> kWideSteps = grid_steps(true);
+
+// Unit steps across `normal`: four along two perpendicular directions, and
+// with `diagonals` the four between them too, written into `steps`.
+std::span<const Point> tangent_steps(const Point& normal, bool diagonals,
+                                     std::array<Point, 8>& steps) {
+  const Point other = std::abs(normal[0]) < 0.6 ? Point{1, 0, 0} : Point{0, 1, 0};
+  const Point u = unit(cross(normal, other));
+  const Point v = cross(normal, u);
+  size_t count = 0;
+  for (int i = -1; i <= 1; ++i)
+    for (int j = -1; j <= 1; ++j)
+      if ((i || j) && (diagonals || !(i && j)))
+        steps[count++] = unit(add(scale(u, i), scale(v, j)));
+  return {steps.data(), count};
 }
 
 // How good the cells around a node are: the worst first, then how far the
@@ -160,17 +195,15 @@ class LayerBuilder {
     const double h = params_.cell_mm;
     for (double step : {0.2 * h, 0.1 * h, 0.05 * h, 0.025 * h, 0.0125 * h}) {
       // A node is tried again only when it or a neighbour moved.
-      std::vector<uint32_t> work = poor_nodes();
+      std::vector<uint32_t> work = nodes_below(kComfortable);
       for (int sweep = 0; sweep < 12 && !work.empty(); ++sweep) {
         if (auto s = context_.check_stop(); !s.ok()) return s;
         std::vector<uint32_t> next;
         for (uint32_t node : work) {
           if (!improve(node, step)) continue;
-          for (uint32_t c : cells_of_[node])
-            for (int k = 0; k < node_count(mesh_.types[c]); ++k) next.push_back(mesh_.cells[c][k]);
+          for (uint32_t c : cells_of_[node]) add_nodes_of(c, next);
         }
-        std::sort(next.begin(), next.end());
-        next.erase(std::unique(next.begin(), next.end()), next.end());
+        sort_unique(next);
         work.clear();
         for (uint32_t node : next)
           if (is_poor(node)) work.push_back(node);
@@ -215,14 +248,16 @@ class LayerBuilder {
   // Every cell against the floors, the volume against the surface's.
   absl::Status verify(double surface_volume_mm3, HexLayerFigures& figures) const {
     size_t below = 0;
-    double worst = 1;
+    double worst = 1, volume = 0;
     for (size_t c = 0; c < mesh_.size(); ++c) {
+      volume += cell_signed_volume(mesh_, c);
       double jr = 1, aspect = 1, tetra_q = 1;
       if (mesh_.types[c] == CellType::kHexahedron) {
         jr = quality::hexahedron_jacobian_ratio(cell_points<8>(mesh_, c));
       } else if (mesh_.types[c] == CellType::kPyramid) {
-        jr = quality::pyramid_jacobian_ratio(cell_points<5>(mesh_, c));
-        aspect = quality::pyramid_signed_aspect_ratio(cell_points<5>(mesh_, c));
+        const auto p = cell_points<5>(mesh_, c);
+        jr = quality::pyramid_jacobian_ratio(p);
+        aspect = quality::pyramid_signed_aspect_ratio(p);
       } else if (mesh_.types[c] == CellType::kTetra) {
         tetra_q = quality::tetra_quality(cell_points<4>(mesh_, c));
       }
@@ -235,8 +270,6 @@ class LayerBuilder {
       figures.boundary_distance_max_mm =
           std::max(figures.boundary_distance_max_mm, std::abs(oracle_.depth(mesh_.points[o])));
     }
-    double volume = 0;
-    for (size_t c = 0; c < mesh_.size(); ++c) volume += cell_signed_volume(mesh_, c);
     figures.volume_change = surface_volume_mm3 > 0 ? volume / surface_volume_mm3 - 1 : 0;
     if (below > 0) {
       return absl::FailedPreconditionError(
@@ -278,31 +311,26 @@ class LayerBuilder {
     return r;
   }
 
-  // The nodes of cells ranked below comfortable, in order.
-  std::vector<uint32_t> poor_nodes() const {
+  void add_nodes_of(uint32_t cell, std::vector<uint32_t>& nodes) const {
+    for (int k = 0; k < node_count(mesh_.types[cell]); ++k) nodes.push_back(mesh_.cells[cell][k]);
+  }
+
+  // The nodes of the cells ranked below `bar`, in order, each once.
+  std::vector<uint32_t> nodes_below(double bar) const {
     std::vector<uint32_t> nodes;
-    for (size_t c = 0; c < mesh_.size(); ++c) {
-      if (rank_[c] >= kComfortable) continue;
-      for (int k = 0; k < node_count(mesh_.types[c]); ++k) nodes.push_back(mesh_.cells[c][k]);
-    }
-    std::sort(nodes.begin(), nodes.end());
-    nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
+    for (size_t c = 0; c < mesh_.size(); ++c)
+      if (rank_[c] < bar) add_nodes_of(uint32_t(c), nodes);
+    sort_unique(nodes);
     return nodes;
   }
 
   // The nodes of cells ranked below the Jacobian floor and of every cell
   // that shares a node with one, in order.
   std::vector<uint32_t> stuck_neighbourhood() const {
-    std::vector<uint32_t> near, nodes;
-    for (size_t c = 0; c < mesh_.size(); ++c) {
-      if (rank_[c] >= params_.jacobian_floor) continue;
-      for (int k = 0; k < node_count(mesh_.types[c]); ++k) near.push_back(mesh_.cells[c][k]);
-    }
-    for (uint32_t node : near)
-      for (uint32_t c : cells_of_[node])
-        for (int k = 0; k < node_count(mesh_.types[c]); ++k) nodes.push_back(mesh_.cells[c][k]);
-    std::sort(nodes.begin(), nodes.end());
-    nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
+    std::vector<uint32_t> nodes;
+    for (uint32_t node : nodes_below(params_.jacobian_floor))
+      for (uint32_t c : cells_of_[node]) add_nodes_of(c, nodes);
+    sort_unique(nodes);
     return nodes;
   }
 
@@ -319,24 +347,11 @@ class LayerBuilder {
     const Point from = mesh_.points[node];
     NodeRank best = rank(node);
     Point best_point = from;
-    std::vector<Point> directions;
-    if (on_surface_[node]) {
-      // Outer nodes step along the surface, then return to it.
-      const Point& n = normal_[node];
-      const Point other = std::abs(n[0]) < 0.6 ? Point{1, 0, 0} : Point{0, 1, 0};
-      const Point u = unit(cross(n, other));
-      const Point v = cross(n, u);
-      for (int i = -1; i <= 1; ++i)
-        for (int j = -1; j <= 1; ++j)
-          if ((i || j) && (wide || !(i && j)))
-            directions.push_back(unit(add(scale(u, i), scale(v, j))));
-    } else {
-      for (int i = -1; i <= 1; ++i)
-        for (int j = -1; j <= 1; ++j)
-          for (int k = -1; k <= 1; ++k)
-            if ((i || j || k) && (wide || std::abs(i) + std::abs(j) + std::abs(k) == 1))
-              directions.push_back(unit(Point{double(i), double(j), double(k)}));
-    }
+    // Outer nodes step along the surface, then return to it.
+    std::array<Point, 8> across{};
+    const std::span<const Point> directions =
+        on_surface_[node] ? tangent_steps(normal_[node], wide, across)
+                          : std::span<const Point>(wide ? kWideSteps : kAxisSteps);
     for (const Point& direction : directions) {
       Point candidate = add(from, scale(direction, step));
       if (on_surface_[node]) candidate = oracle_.closest(candidate);
@@ -380,11 +395,10 @@ class LayerBuilder {
 
 std::array<std::array<uint32_t, 8>, 6> pyramids_of(const std::array<uint32_t, 8>& hex,
                                                    uint32_t apex) {
-  static constexpr int kBases[6][4] = {{0, 1, 2, 3}, {4, 7, 6, 5}, {0, 4, 5, 1},
-                                       {1, 5, 6, 2}, {2, 6, 7, 3}, {3, 7, 4, 0}};
   std::array<std::array<uint32_t, 8>, 6> pyramids{};
   for (int f = 0; f < 6; ++f) {
-    for (int k = 0; k < 4; ++k) pyramids[f][k] = hex[kBases[f][k]];
+    const auto base = hexahedron_face_inward(f);
+    for (int k = 0; k < 4; ++k) pyramids[f][k] = hex[base[k]];
     pyramids[f][4] = apex;
   }
   return pyramids;

@@ -35,6 +35,11 @@ std::span<const LocalFace> local_faces(CellType type) {
   return {};
 }
 
+std::array<uint8_t, 4> hexahedron_face_inward(int f) {
+  const auto& outward = kHexahedron[f].nodes;
+  return {outward[3], outward[2], outward[1], outward[0]};
+}
+
 std::array<uint32_t, 4> CellFace::key() const {
   std::array<uint32_t, 4> sorted = points;
   if (size == 3) sorted[3] = kNone;

@@ -24,6 +24,10 @@ struct LocalFace {
 // pyramid the base quad then 4 triangles; tetrahedron 4 triangles.
 std::span<const LocalFace> local_faces(CellType type);
 
+// The corners of hexahedron face `f` (local_faces order) wound the other way, so that the
+// right-hand normal points into the cell: the base of a pyramid whose apex is inside.
+std::array<uint8_t, 4> hexahedron_face_inward(int f);
+
 // One face of one cell, with mesh point indices.
 struct CellFace {
   uint32_t cell;  // index into the mesh's cells

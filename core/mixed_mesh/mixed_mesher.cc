@@ -71,9 +71,9 @@ absl::StatusOr<MixedMesh> mesh_with_hex_layer(const SurfaceOracle& oracle,
   HexLayerParams layer_params = params.layer;
   layer_params.cell_mm = params.core.cell_mm;
   layer_params.split = params.layer.split && !params.hexahedra_only;
-  const double surface_volume = surface::compute_surface_statistics(surface).volume_mm3;
   HexLayerFigures layer;
-  auto mesh = add_hex_layer(oracle, surface_volume, std::move(cells), layer_params, context, layer);
+  auto mesh = add_hex_layer(oracle, figures.surface_volume_mm3, std::move(cells), layer_params,
+                            context, layer);
   figures.layer = layer;
   return mesh;
 }
@@ -86,21 +86,22 @@ absl::StatusOr<MixedMesh> mesh_mixed(const surface::TriangleMesh& surface, int32
   const auto start = std::chrono::steady_clock::now();
   auto oracle = SurfaceOracle::build(surface);
   if (!oracle.ok()) return absl::FailedPreconditionError(oracle.status().message());
-  auto layered = params.hexahedral_layer || params.hexahedra_only
-                     ? mesh_with_hex_layer(*oracle, surface, label, params, context, figures)
-                     : absl::FailedPreconditionError("the hexahedral layer was not asked for");
-  if (layered.ok() || layered.status().code() != absl::StatusCode::kFailedPrecondition) {
-    figures.core_seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    return layered;
-  }
-  figures.layer_refused = std::string(layered.status().message());
-  // What the refused layer built is not in the mesh.
-  figures.octree = {};
-  figures.layer = {};
-  if (params.hexahedra_only) {
-    figures.left_out = true;
-    return MixedMesh{};
+  figures.surface_volume_mm3 = surface::signed_volume(surface);
+  if (params.hexahedral_layer || params.hexahedra_only) {
+    auto layered = mesh_with_hex_layer(*oracle, surface, label, params, context, figures);
+    if (layered.ok() || layered.status().code() != absl::StatusCode::kFailedPrecondition) {
+      figures.core_seconds =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      return layered;
+    }
+    figures.layer_refused = std::string(layered.status().message());
+    // What the refused layer built is not in the mesh.
+    figures.octree = {};
+    figures.layer = {};
+    if (params.hexahedra_only) {
+      figures.left_out = true;
+      return MixedMesh{};
+    }
   }
   auto core = build_hex_core(*oracle, surface, label, params.core, context);
   if (!core.ok()) return core.status();

@@ -45,6 +45,8 @@ struct MixedFigures {
   uint64_t grid_cells = 0;
   uint64_t depth_queries = 0;
   uint64_t core_cells_removed = 0;
+  // Volume the surface encloses, mm³.
+  double surface_volume_mm3 = 0;
   OctreeFigures octree;
   HexLayerFigures layer;
   // Why the hexahedral layer was refused; empty when it was delivered.

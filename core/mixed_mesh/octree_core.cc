@@ -9,6 +9,7 @@
 #include <unordered_set>
 #include <vector>
 
+#include "core/mixed_mesh/mixed_faces.h"
 #include "core/util/text.h"
 
 namespace labelmesh::mixed_mesh {
@@ -20,10 +21,6 @@ using Point = std::array<double, 3>;
 // VTK_HEXAHEDRON's corners as offsets from the lowest one.
 constexpr std::array<Index, 8> kCorners{
     {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}}};
-// Each face of a VTK_HEXAHEDRON wound towards the inside (its normal points
-// to the centre), as in pyramids_of (hex_layer.h).
-constexpr int kInwardFaces[6][4] = {{0, 1, 2, 3}, {4, 7, 6, 5}, {0, 4, 5, 1},
-                                    {1, 5, 6, 2}, {2, 6, 7, 3}, {3, 7, 4, 0}};
 constexpr int kEdges[12][2] = {{0, 1}, {1, 2}, {2, 3}, {3, 0}, {4, 5}, {5, 6},
                                {6, 7}, {7, 4}, {0, 4}, {1, 5}, {2, 6}, {3, 7}};
 constexpr int kLevels = 8;
@@ -75,7 +72,10 @@ class OctantMesher {
     bool hanging = false;
     if (level > 0) {
       for (const auto& e : kEdges) hanging |= is_corner(mid(c[e[0]], c[e[1]]));
-      for (const auto& f : kInwardFaces) hanging |= is_corner(mid(c[f[0]], c[f[2]]));
+      for (int f = 0; f < 6; ++f) {
+        const auto face = hexahedron_face_inward(f);
+        hanging |= is_corner(mid(c[face[0]], c[face[2]]));
+      }
     }
     if (!hanging) {
       std::array<uint32_t, 8> hex{};
@@ -85,8 +85,9 @@ class OctantMesher {
     }
     ++figures_.transition_octants;
     const uint32_t centre = node(mid(c[0], c[6]));
-    for (const auto& f : kInwardFaces) {
-      const std::array<Index, 4> b{c[f[0]], c[f[1]], c[f[2]], c[f[3]]};
+    for (int f = 0; f < 6; ++f) {
+      const auto face = hexahedron_face_inward(f);
+      const std::array<Index, 4> b{c[face[0]], c[face[1]], c[face[2]], c[face[3]]};
       const Index face_centre = mid(b[0], b[2]);
       std::array<Index, 4> m;
       for (int k = 0; k < 4; ++k) m[k] = mid(b[k], b[(k + 1) % 4]);

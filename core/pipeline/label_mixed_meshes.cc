@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <chrono>
 
-#include "core/surface/surface_statistics.h"
 #include "core/util/text.h"
 
 namespace labelmesh {
@@ -15,6 +14,7 @@ void add_figures(mixed_mesh::MixedFigures& sum, const mixed_mesh::MixedFigures& 
   sum.depth_queries += part.depth_queries;
   sum.core_cells_removed += part.core_cells_removed;
   sum.core_seconds += part.core_seconds;
+  sum.surface_volume_mm3 += part.surface_volume_mm3;
   for (size_t level = 0; level < std::size(sum.octree.octants); ++level)
     sum.octree.octants[level] += part.octree.octants[level];
   sum.octree.balance_splits += part.octree.balance_splits;
@@ -82,9 +82,9 @@ absl::StatusOr<MixedVolumeResult> mesh_labels_mixed(const std::vector<LabelBound
     add_conformity(result.conformity, mixed_mesh::check_conformity(*mesh));
     result.mesh.append(*mesh);
     add_figures(result.figures, figures);
-    result.surface_volume_mm3 += surface::compute_surface_statistics(*boundary.surface).volume_mm3;
   }
   context.report("mixed_mesh", 1);
+  result.surface_volume_mm3 = result.figures.surface_volume_mm3;
   result.quality = mixed_mesh::measure_mixed_mesh(result.mesh);
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;

@@ -19,6 +19,15 @@ void set_categories(const quality::QualitySummary& q, v1::QualityCategories& cat
   categories.set_good(q.good);
 }
 
+void add_refusals(const std::vector<MixedVolumeResult::Refusal>& refusals,
+                  google::protobuf::RepeatedPtrField<v1::LabelWarning>& out) {
+  for (const auto& refusal : refusals) {
+    auto* item = out.Add();
+    item->set_label(refusal.label);
+    item->set_reason(refusal.reason);
+  }
+}
+
 v1::VolumeMeshSummary make_mixed_summary(const MixedVolumeResult& mixed) {
   const auto& q = mixed.quality;
   v1::VolumeMeshSummary entry;
@@ -50,16 +59,8 @@ v1::VolumeMeshSummary make_mixed_summary(const MixedVolumeResult& mixed) {
   entry.set_balance_splits(mixed.figures.octree.balance_splits);
   entry.set_transition_octants(mixed.figures.octree.transition_octants);
   entry.set_boundary_node_distance_max_mm(mixed.figures.layer.boundary_distance_max_mm);
-  for (const auto& refused : mixed.tetrahedral_layer_labels) {
-    auto* item = entry.add_tetrahedral_layer_labels();
-    item->set_label(refused.label);
-    item->set_reason(refused.reason);
-  }
-  for (const auto& left_out : mixed.labels_left_out) {
-    auto* item = entry.add_labels_left_out();
-    item->set_label(left_out.label);
-    item->set_reason(left_out.reason);
-  }
+  add_refusals(mixed.tetrahedral_layer_labels, *entry.mutable_tetrahedral_layer_labels());
+  add_refusals(mixed.labels_left_out, *entry.mutable_labels_left_out());
   entry.set_inverted(q.invalid);
   set_categories(q.cell_summary, *entry.mutable_categories());
   entry.set_enclosed_volume_mm3(q.volume_mm3);

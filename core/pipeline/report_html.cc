@@ -245,12 +245,14 @@ Chart category_chart(const v1::QualityCategories& c, bool tetrahedra_only) {
   return chart;
 }
 
+// A table row: a name and a number.
+std::string row(std::string_view name, const std::string& value) {
+  return cat("<tr><th>", name, "</th><td class=\"num\">", value, "</td></tr>\n");
+}
+
 // The hexahedra, pyramids and tetrahedra of a mixed or hexahedral mesh, and
 // the labels that fell back or were left out, with why.
 std::string mixed_volume_section(const v1::VolumeMeshSummary& v) {
-  const auto row = [](std::string_view name, const std::string& value) {
-    return cat("<tr><th>", name, "</th><td class=\"num\">", value, "</td></tr>\n");
-  };
   std::string html = cat(
       "<h2>Volume mesh (", html_escape(v.mesher()), ")</h2>\n<table>\n",
       row("Cube edge (mm)", fixed(v.hex_size_mm(), 2)),
@@ -285,9 +287,6 @@ std::string mixed_volume_section(const v1::VolumeMeshSummary& v) {
 
 std::string volume_section(const v1::VolumeMeshSummary& v) {
   if (v.mesher() != "tetgen") return mixed_volume_section(v);
-  const auto row = [](std::string_view name, const std::string& value) {
-    return cat("<tr><th>", name, "</th><td class=\"num\">", value, "</td></tr>\n");
-  };
   return cat("<h2>Volume mesh (", html_escape(v.mesher()), ")</h2>\n<table>\n",
              row("Nodes", cat(v.nodes())), row("Tetrahedra", cat(v.tetrahedra())),
              row("Steiner points", cat(v.steiner_points())),

@@ -17,6 +17,7 @@
 #include <cstdio>
 #include <iterator>
 #include <mutex>
+#include <span>
 #include <string>
 #include <thread>
 #include <vector>
@@ -170,21 +171,30 @@ int bench_quality_surface(const std::string& path, const std::vector<int32_t>& l
 }
 
 // Counts of `quality` in the Table 1 bins, with the good ones split further.
-void print_quality_histogram(const char* name, const std::vector<double>& quality) {
-  static constexpr double kUpper[] = {0.001, 1.0 / 30, 0.1, 0.2, 0.3, 0.5, 0.7, 0.9, 1.0 + 1e-12};
-  size_t counts[std::size(kUpper)] = {};
-  for (double q : quality) {
+// Prints `title`, then how many of `values` fall in each bin (lower, upper];
+// the last bound reaches just past 1 so that 1 counts.
+void print_histogram(const std::string& title, const std::vector<double>& values,
+                     std::span<const double> upper) {
+  std::vector<size_t> counts(upper.size(), 0);
+  for (double value : values) {
     size_t bin = 0;
-    while (bin + 1 < std::size(kUpper) && q > kUpper[bin]) ++bin;
+    while (bin + 1 < upper.size() && value > upper[bin]) ++bin;
     ++counts[bin];
   }
-  std::printf("  %-10s Q histogram:", name);
+  std::printf("%s", title.c_str());
   double lower = -1;
-  for (size_t bin = 0; bin < std::size(kUpper); ++bin) {
-    std::printf(" (%.3g,%.3g] %zu", lower, std::min(kUpper[bin], 1.0), counts[bin]);
-    lower = kUpper[bin];
+  for (size_t bin = 0; bin < upper.size(); ++bin) {
+    std::printf(" (%.3g,%.3g] %zu", lower, std::min(upper[bin], 1.0), counts[bin]);
+    lower = upper[bin];
   }
   std::printf("\n");
+}
+
+void print_quality_histogram(const char* name, const std::vector<double>& quality) {
+  static constexpr double kUpper[] = {0.001, 1.0 / 30, 0.1, 0.2, 0.3, 0.5, 0.7, 0.9, 1.0 + 1e-12};
+  char title[64];
+  std::snprintf(title, sizeof title, "  %-10s Q histogram:", name);
+  print_histogram(title, quality, kUpper);
 }
 
 // TetGen on the liver's Poisson surface, then the improvement pass: time,
@@ -317,20 +327,11 @@ int bench_one_volume(const std::string& path, labelmesh::VolumeMethod method, do
       100 * (q.volume_mm3 / m.surface_volume_mm3 - 1), m.tetrahedral_layer_labels.size(),
       peak_rss_mib());
   static constexpr double kUpper[] = {0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 1.0 + 1e-12};
-  size_t counts[std::size(kUpper)] = {};
-  for (size_t c = 0; c < m.mesh.size(); ++c) {
-    if (m.mesh.types[c] == labelmesh::mixed_mesh::CellType::kTetra) continue;
-    size_t bin = 0;
-    while (bin + 1 < std::size(kUpper) && q.jacobian_ratio[c] > kUpper[bin]) ++bin;
-    ++counts[bin];
-  }
-  std::printf("    JR histogram (hexahedra, pyramids):");
-  double lower = -1;
-  for (size_t bin = 0; bin < std::size(kUpper); ++bin) {
-    std::printf(" (%.1f,%.1f] %zu", lower, std::min(kUpper[bin], 1.0), counts[bin]);
-    lower = kUpper[bin];
-  }
-  std::printf("\n");
+  std::vector<double> ratios;
+  for (size_t c = 0; c < m.mesh.size(); ++c)
+    if (m.mesh.types[c] != labelmesh::mixed_mesh::CellType::kTetra)
+      ratios.push_back(q.jacobian_ratio[c]);
+  print_histogram("    JR histogram (hexahedra, pyramids):", ratios, kUpper);
   return 0;
 }
 

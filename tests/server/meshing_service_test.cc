@@ -56,6 +56,15 @@ class MeshingServiceTest : public ::testing::Test {
                           reply);
   }
 
+  // Submits `input` with `options` and waits for the job to end.
+  v1::Job finished_job(ServiceHarness& service, const fs::path& input,
+                       const v1::MeshOptions& options) {
+    v1::SubmitReply reply;
+    EXPECT_TRUE(service.submit(input, options, &reply).ok());
+    service.watch(reply.job_id());
+    return service.get(reply.job_id());
+  }
+
   size_t uploads_left() const { return count_files(spool_ / "uploads"); }
   size_t job_dirs() const {
     size_t count = 0;
@@ -149,10 +158,7 @@ TEST_F(MeshingServiceTest, TheServiceMakesTheSameMixedMeshAsTheLibrary) {
   options.set_hex_size_mm(2);
   options.add_formats("stl");
   options.add_formats("vtu");
-  v1::SubmitReply reply;
-  ASSERT_TRUE(service.submit(input, options, &reply).ok());
-  service.watch(reply.job_id());
-  const v1::Job job = service.get(reply.job_id());
+  const v1::Job job = finished_job(service, input, options);
   ASSERT_EQ(job.state(), v1::JOB_STATE_SUCCEEDED) << job.error().message();
   const v1::VolumeMeshSummary& served = job.report().volume();
 
@@ -183,10 +189,7 @@ TEST_F(MeshingServiceTest, HexahedraOnlyJobsListTheLabelsLeftOut) {
   options.set_volume(v1::VOLUME_METHOD_HEX);
   options.set_hex_size_mm(2);
   options.add_formats("vtu");
-  v1::SubmitReply reply;
-  ASSERT_TRUE(service.submit(input, options, &reply).ok());
-  service.watch(reply.job_id());
-  const v1::Job job = service.get(reply.job_id());
+  const v1::Job job = finished_job(service, input, options);
   ASSERT_EQ(job.state(), v1::JOB_STATE_SUCCEEDED) << job.error().message();
   const v1::VolumeMeshSummary& served = job.report().volume();
   EXPECT_EQ(served.mesher(), "hex_grid");
