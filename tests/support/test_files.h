@@ -11,6 +11,8 @@
 #include <string_view>
 #include <vector>
 
+#include <gtest/gtest.h>
+
 namespace labelmesh::testing {
 
 // ../shared/data beside the checkout: the real segmentations.
@@ -19,9 +21,13 @@ inline std::string shared_data(std::string_view name) {
 }
 
 // A fresh directory for one test, removed by the next run of the same test.
-inline std::filesystem::path scratch_dir(std::string_view test_name) {
-  const auto dir =
-      std::filesystem::temp_directory_path() / "labelmesh-tests" / std::string(test_name);
+// It sits under the running test's own name, so tests that ctest runs side by
+// side never share one, whatever name they pass.
+inline std::filesystem::path scratch_dir(std::string_view name) {
+  auto dir = std::filesystem::temp_directory_path() / "labelmesh-tests";
+  if (const auto* test = ::testing::UnitTest::GetInstance()->current_test_info())
+    dir /= std::string(test->test_suite_name()) + "." + test->name();
+  dir /= std::string(name);
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   return dir;
