@@ -16,11 +16,7 @@
 #include "core/util/disjoint_sets.h"
 #include "core/util/text.h"
 #include "core/util/vec3.h"
-
-// TetGen's library interface: errors are thrown as ints instead of ending the process. The
-// library itself is built this way, so its inline functions must be seen the same way here.
-#define TETLIBRARY
-#include <tetgen.h>
+#include "core/volume_mesh/tetgen_call.h"
 
 namespace labelmesh::volume_mesh {
 namespace {
@@ -35,31 +31,6 @@ struct Boundary {
   std::vector<Vec3> points;
   std::vector<std::array<uint32_t, 3>> triangles;
 };
-
-absl::Status check_params(const TetgenParams& params) {
-  const double ratio = params.radius_edge_ratio;
-  if (!std::isfinite(ratio) || ratio < 1.0 || ratio > 100.0) {
-    return absl::InvalidArgumentError(
-        cat("tet-radius-edge: is ", ratio,
-            "; it must be in [1, 100] (TetGen may not terminate below 1)"));
-  }
-  const double angle = params.min_dihedral_deg;
-  if (!std::isfinite(angle) || angle < 0.0 || angle > 30.0) {
-    return absl::InvalidArgumentError(
-        cat("tet-min-dihedral: is ", angle, " degrees; it must be in [0, 30] (0: no bound)"));
-  }
-  const double max_angle = params.max_dihedral_deg;
-  if (!std::isfinite(max_angle) || max_angle < 90.0 || max_angle > 179.0) {
-    return absl::InvalidArgumentError(
-        cat("tet-max-dihedral: is ", max_angle, " degrees; it must be in [90, 179]"));
-  }
-  const double volume = params.max_volume_mm3;
-  if (!std::isfinite(volume) || (volume != 0.0 && (volume < 1e-6 || volume > 1e12))) {
-    return absl::InvalidArgumentError(
-        cat("tet-max-volume: is ", volume, " mm³; it must be 0 (no bound) or in [1e-6, 1e12]"));
-  }
-  return absl::OkStatus();
-}
 
 absl::StatusOr<Boundary> used_boundary(const surface::TriangleMesh& mesh, int32_t label) {
   const std::string what = cat("the surface of label ", label);
@@ -142,58 +113,6 @@ void fill_plc(const Boundary& boundary, tetgenio& in) {
     for (int k = 0; k < 3; ++k) polygon.vertexlist[k] = static_cast<int>(boundary.triangles[i][k]);
     in.facetmarkerlist[i] = static_cast<int>(i) + 1;
   }
-}
-
-// A number as TetGen's switch parser reads it: plain decimal, no exponent.
-std::string switch_number(double value) {
-  char buffer[64];
-  const auto result =
-      std::to_chars(buffer, buffer + sizeof buffer, value, std::chars_format::fixed);
-  return std::string(buffer, result.ptr);
-}
-
-absl::Status tetgen_error(int code, int32_t label) {
-  const std::string what = cat("the surface of label ", label);
-  switch (code) {
-    case 1:
-      return absl::ResourceExhaustedError(cat("tetgen: ran out of memory meshing ", what));
-    case 2:
-      return absl::InternalError(cat("tetgen: internal error while meshing ", what));
-    case 3:
-      return absl::FailedPreconditionError(cat("tetgen: ", what, " intersects itself"));
-    case 4:
-      return absl::FailedPreconditionError(
-          cat("tetgen: ", what, " has a feature below TetGen's tolerance (1e-8 of its size)"));
-    case 5:
-      return absl::FailedPreconditionError(
-          cat("tetgen: ", what, " has two facets that nearly coincide"));
-    case 10:
-      return absl::FailedPreconditionError(cat("tetgen: rejected ", what, " as invalid input"));
-    default:
-      return absl::InternalError(cat("tetgen: failed with code ", code, " meshing ", what));
-  }
-}
-
-// Runs TetGen; nothing it throws gets past here.
-absl::Status run_tetgen(const std::string& switches, tetgenio& in, tetgenio& out, int32_t label) {
-  try {
-    tetgenbehavior behavior;
-    std::string buffer = switches;
-    if (!behavior.parse_commandline(buffer.data())) {
-      return absl::InternalError(cat("tetgen: rejected the switches '", switches, "'"));
-    }
-    ::tetrahedralize(&behavior, &in, &out);
-  } catch (int code) {
-    return tetgen_error(code, label);
-  } catch (const std::bad_alloc&) {
-    return tetgen_error(1, label);
-  } catch (const std::exception& e) {
-    return absl::InternalError(
-        cat("tetgen: ", e.what(), " while meshing the surface of label ", label));
-  } catch (...) {
-    return absl::InternalError(cat("tetgen: unknown failure meshing the surface of label ", label));
-  }
-  return absl::OkStatus();
 }
 
 Vec3 out_point(const tetgenio& out, int index) {
@@ -314,7 +233,8 @@ absl::StatusOr<std::vector<Vec3>> cavity_points(const Boundary& boundary, const 
 absl::StatusOr<TetMesh> run(const surface::TriangleMesh& mesh, int32_t label,
                             const TetgenParams& params, const std::vector<Vec3>* known_holes,
                             const RunContext& context, TetgenFigures& figures) {
-  if (auto status = check_params(params); !status.ok()) return status;
+  if (auto status = check_tetgen_params(params); !status.ok()) return status;
+  const std::string what = cat("the surface of label ", label);
   auto boundary = used_boundary(mesh, label);
   if (!boundary.ok()) return boundary.status();
   figures.input_points = boundary->points.size();
@@ -333,7 +253,7 @@ absl::StatusOr<TetMesh> run(const surface::TriangleMesh& mesh, int32_t label,
   // -d reports intersecting facets instead of failing, which TetGen 1.5.0 cannot do safely.
   {
     tetgenio check;
-    if (auto status = run_tetgen("pdzQ", in, check, label); !status.ok()) return status;
+    if (auto status = run_tetgen("pdzQ", in, check, what); !status.ok()) return status;
     if (check.numberoftrifaces > 0) {
       return absl::FailedPreconditionError(cat("tetgen: the surface of label ", label,
                                                " intersects itself (", check.numberoftrifaces,
@@ -349,7 +269,7 @@ absl::StatusOr<TetMesh> run(const surface::TriangleMesh& mesh, int32_t label,
       holes = *known_holes;
     } else {
       tetgenio cdt;
-      if (auto status = run_tetgen("pzQ", in, cdt, label); !status.ok()) return status;
+      if (auto status = run_tetgen("pzQ", in, cdt, what); !status.ok()) return status;
       holes = cavity_points(*boundary, cdt, label);
     }
     if (!holes.ok()) return holes.status();
@@ -364,13 +284,9 @@ absl::StatusOr<TetMesh> run(const surface::TriangleMesh& mesh, int32_t label,
     context.report(kStage, 0.4);
   }
 
-  std::string switches = cat("pq", switch_number(params.radius_edge_ratio), "/",
-                             switch_number(params.min_dihedral_deg));
-  if (params.max_volume_mm3 > 0) switches += cat("a", switch_number(params.max_volume_mm3));
-  if (params.keep_boundary) switches += "Y";
-  switches += cat("o/", switch_number(params.max_dihedral_deg), "zQ");
+  const std::string switches = tetgen_quality_switches(params) + "zQ";
   tetgenio out;
-  if (auto status = run_tetgen(switches, in, out, label); !status.ok()) return status;
+  if (auto status = run_tetgen(switches, in, out, what); !status.ok()) return status;
   if (auto status = context.check_stop(); !status.ok()) return status;
 
   if (out.numberofcorners != 4 || out.numberoftetrahedra <= 0 || out.tetrahedronlist == nullptr) {

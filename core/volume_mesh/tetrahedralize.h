@@ -49,6 +49,9 @@ struct TetgenFigures {
   double seconds = 0;          // wall time of the whole call
 };
 
+// INVALID_ARGUMENT naming the option when a parameter is out of range.
+absl::Status check_tetgen_params(const TetgenParams& params);
+
 // Meshes the region inside `boundary` with tetrahedra labelled `label`.
 //
 // `boundary` must be closed and wound outwards (normals point out of the material). It may have

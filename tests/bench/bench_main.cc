@@ -27,6 +27,7 @@
 #include <vtkPolyData.h>
 
 #include "bench/mesh3_baseline.h"
+#include "core/conforming/conforming_mesher.h"
 #include "core/pipeline/label_mixed_meshes.h"
 #include "core/pipeline/label_tet_meshes.h"
 #include "core/pipeline/pipeline.h"
@@ -421,6 +422,124 @@ int bench_volumes(const std::string& liver) {
   return ok ? 0 : 1;
 }
 
+// The shared multi-label volumes.
+std::vector<std::string> conforming_examples() {
+  const std::string data = LABELMESH_SHARED_DATA;
+  return {data + "/totalseg_example_seg_fast_force_split.nii.gz",
+          data + "/iso2mesh_brain_seg_converted.nii.gz", data + "/MRIcrop-seg_converted.nii.gz",
+          data + "/msd_prostate_mask_00.nii", data + "/liver.inr.gz"};
+}
+
+// Percentile q (0-1) of `values` (sorted in place); 0 when empty.
+double percentile(std::vector<double>& values, double q) {
+  if (values.empty()) return 0;
+  std::sort(values.begin(), values.end());
+  return values[static_cast<size_t>(q * double(values.size() - 1) + 0.5)];
+}
+
+// |volume change| of labels of at least 1,000 voxels, percent.
+std::vector<double> volume_errors_percent(
+    const std::vector<labelmesh::conforming::LabelVolumeFigures>& labels) {
+  std::vector<double> errors;
+  for (const auto& l : labels) {
+    if (l.voxels >= 1000) errors.push_back(100 * std::abs(l.volume_change()));
+  }
+  return errors;
+}
+
+// One conforming mesh of every label of `path`, in this (child) process.
+int bench_conforming_file(const std::string& path) {
+  using namespace labelmesh;
+  auto volume = volume::read_label_volume(path, {}, {});
+  if (!volume.ok()) {
+    std::fprintf(stderr, "%s\n", std::string(volume.status().message()).c_str());
+    return 1;
+  }
+  conforming::ConformingParams params;
+  if (getenv("LM_KEEP")) params.tetgen.keep_boundary = atoi(getenv("LM_KEEP"));
+  if (getenv("LM_ROUNDS")) params.interfaces.smoothing_rounds = atoi(getenv("LM_ROUNDS"));
+  if (getenv("LM_ANGLE")) params.tetgen.min_dihedral_deg = atof(getenv("LM_ANGLE"));
+  conforming::ConformingFigures figures;
+  volume_mesh::ImproveFigures improve;
+  const auto start = Clock::now();
+  auto mesh = conforming::mesh_conforming(*volume, {}, params, RunContext{}, figures, improve);
+  const double seconds = seconds_since(start);
+  if (!mesh.ok()) {
+    std::fprintf(stderr, "%s: %s\n", path.c_str(), std::string(mesh.status().message()).c_str());
+    return 1;
+  }
+  quality::QualitySummary summary;
+  for (size_t t = 0; t < mesh->tetrahedra.size(); ++t) {
+    const auto& v = mesh->tetrahedra[t];
+    const quality::Tet tet{mesh->points[v[0]], mesh->points[v[1]], mesh->points[v[2]],
+                           mesh->points[v[3]]};
+    summary.add(quality::tetra_quality(tet));
+    summary.add_dihedral_range(quality::tetra_dihedral_range_deg(tet));
+  }
+  {
+    size_t bad = 0, bad_all_surface = 0, bad_three = 0;
+    const size_t ns = figures.interfaces.points;
+    for (size_t t = 0; t < mesh->tetrahedra.size(); ++t) {
+      const auto& v = mesh->tetrahedra[t];
+      const quality::Tet tet{mesh->points[v[0]], mesh->points[v[1]], mesh->points[v[2]],
+                             mesh->points[v[3]]};
+      const auto range = quality::tetra_dihedral_range_deg(tet);
+      if (quality::tetra_quality(tet) >= 0.2 && range.first >= 10) continue;
+      ++bad;
+      int on = 0;
+      for (auto p : v) on += p < ns;
+      bad_all_surface += on == 4;
+      bad_three += on == 3;
+    }
+    std::printf("  bad (Q<0.2 or dihedral<10): %zu, all four on the surface %zu, three %zu\n", bad,
+                bad_all_surface, bad_three);
+  }
+  auto errors = volume_errors_percent(figures.labels);
+  const double median = percentile(errors, 0.5), p90 = percentile(errors, 0.9);
+  const auto& i = figures.interfaces;
+  const auto& c = figures.conformity;
+  std::printf("%s: conforming mesh of %zu labels\n", path.c_str(), figures.labels.size());
+  std::printf(
+      "  interfaces   %8.3f s  %zu points (%zu on junctions, %zu fixed), %zu triangles, "
+      "max offset %.2f mm\n",
+      i.seconds, i.points, i.junction_points, i.fixed_points, i.triangles, i.max_offset_mm);
+  std::printf("  crossings    repairs %d, points restored %zu, staircase only %d\n",
+              figures.crossing_repairs, figures.restored_points, int(figures.staircase_only));
+  std::printf(
+      "  tetgen       %8.3f s  %zu tetrahedra, %zu Steiner points, %zu regions (%zu outside)\n",
+      figures.tetgen.seconds, figures.tetgen.tetrahedra, figures.tetgen.steiner_points,
+      figures.regions.regions, figures.regions.outside_regions);
+  std::printf("  improvement  %8.3f s  Q min %.3f -> %.3f\n", improve.seconds,
+              improve.quality_min_before, improve.quality_min_after);
+  std::printf("  slides       %8.3f s  %zu points moved; below targets %zu -> %zu\n",
+              figures.slide.seconds, figures.slide.points_moved,
+              figures.slide.tetrahedra_below_before, figures.slide.tetrahedra_below_after);
+  std::printf(
+      "  mesh         %zu tetrahedra, %zu points, Q min %.3f mean %.3f, dihedral %.1f-%.1f\n",
+      mesh->tetrahedra.size(), mesh->points.size(), summary.min, summary.mean,
+      summary.min_dihedral_deg, summary.max_dihedral_deg);
+  std::printf(
+      "  conformity   %s; %zu interfaces, %zu interface faces, %zu outer faces, "
+      "volume gap %.2e\n",
+      c.ok() ? "ok" : c.failures().c_str(), c.interfaces, c.interface_faces, c.outer_faces,
+      c.volume_gap_fraction());
+  const size_t counted = errors.size();
+  std::printf(
+      "  volume error labels >= 1000 voxels (%zu): median %.2f %%, p90 %.2f %%, max %.2f %%\n",
+      counted, percentile(errors, 0.5), percentile(errors, 0.9),
+      errors.empty() ? 0.0 : errors.back());
+  std::printf("  total        %8.3f s, peak RSS %.1f MiB\n", seconds, peak_rss_mib());
+  return 0;
+}
+
+int bench_conforming(const std::vector<std::string>& files) {
+  int failures = 0;
+  for (const auto& file : files) {
+    if (!in_child([&] { return bench_conforming_file(file); })) ++failures;
+  }
+  return failures == 0 ? 0 : 1;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -431,7 +550,13 @@ int main(int argc, char** argv) {
   // The volume meshes alone: labelmesh_bench --volumes.
   if (argc == 2 && std::string(argv[1]) == "--volumes") return bench_volumes(liver_path);
   std::vector<std::string> files;
-  for (int i = 1; i < argc; ++i) files.emplace_back(argv[i]);
+  const bool conforming = argc > 1 && std::string(argv[1]) == "--conforming";
+  for (int i = conforming ? 2 : 1; i < argc; ++i) files.emplace_back(argv[i]);
+  // Conforming meshes of every label, ours beside Mesh_3: labelmesh_bench --conforming [FILE...].
+  if (conforming) {
+    if (files.empty()) files = conforming_examples();
+    return bench_conforming(files);
+  }
   if (files.empty()) {
     files = {liver_path, std::string(LABELMESH_SHARED_DATA) + "/vb-seg.mha"};
   }

@@ -1,0 +1,145 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+#include "core/conforming/conforming_mesher.h"
+
+#include <algorithm>
+#include <chrono>
+#include <map>
+
+#include "core/util/text.h"
+#include "core/util/vec3.h"
+#include "core/volume/voxel_access.h"
+
+namespace labelmesh::conforming {
+namespace {
+
+// Voxels per selected label (every non-zero label when `labels` is empty).
+std::vector<std::pair<int32_t, uint64_t>> voxel_counts(const volume::LabelVolume& volume,
+                                                       const std::vector<int32_t>& labels) {
+  std::map<int32_t, uint64_t> counts;
+  volume::visit_voxels(volume.voxels, [&](const auto* voxels, size_t count) {
+    for (size_t i = 0; i < count; ++i) {
+      const auto label = static_cast<int32_t>(voxels[i]);
+      if (label != kOutside) ++counts[label];
+    }
+  });
+  std::vector<std::pair<int32_t, uint64_t>> selected;
+  for (const auto& [label, count] : counts) {
+    if (labels.empty() || std::find(labels.begin(), labels.end(), label) != labels.end())
+      selected.push_back({label, count});
+  }
+  return selected;
+}
+
+// Puts the points of crossing triangles back on the staircase until nothing
+// crosses; after the last round, every point.
+absl::Status remove_crossings(InterfaceSurface& surface, int max_rounds, const RunContext& context,
+                              ConformingFigures& figures) {
+  for (int round = 0;; ++round) {
+    if (auto status = context.check_stop(); !status.ok()) return status;
+    auto crossing = crossing_points(surface);
+    if (!crossing.ok()) return crossing.status();
+    if (crossing->empty()) return absl::OkStatus();
+    if (round == max_rounds) {
+      std::vector<uint32_t> all(surface.points.size());
+      for (uint32_t p = 0; p < all.size(); ++p) all[p] = p;
+      restore_staircase(surface, all);
+      figures.staircase_only = true;
+      return absl::OkStatus();
+    }
+    ++figures.crossing_repairs;
+    figures.restored_points += crossing->size();
+    restore_staircase(surface, *crossing);
+  }
+}
+
+}  // namespace
+
+double LabelVolumeFigures::volume_change() const {
+  return voxel_volume_mm3 > 0 ? (mesh_volume_mm3 - voxel_volume_mm3) / voxel_volume_mm3 : 0;
+}
+
+std::vector<LabelVolumeFigures> label_volume_figures(
+    const volume_mesh::TetMesh& mesh, const std::vector<std::pair<int32_t, uint64_t>>& voxels,
+    double voxel_volume_mm3) {
+  std::vector<LabelVolumeFigures> figures;
+  std::map<int32_t, size_t> at;
+  for (const auto& [label, count] : voxels) {
+    at[label] = figures.size();
+    figures.push_back({label, count, static_cast<double>(count) * voxel_volume_mm3, 0, 0});
+  }
+  for (size_t t = 0; t < mesh.tetrahedra.size(); ++t) {
+    const auto it = at.find(mesh.labels[t]);
+    if (it == at.end()) continue;
+    figures[it->second].mesh_volume_mm3 += volume_mesh::signed_volume(mesh, t);
+    ++figures[it->second].tetrahedra;
+  }
+  return figures;
+}
+
+absl::StatusOr<volume_mesh::TetMesh> mesh_conforming(const volume::LabelVolume& volume,
+                                                     const std::vector<int32_t>& labels,
+                                                     const ConformingParams& params,
+                                                     const RunContext& context,
+                                                     ConformingFigures& figures,
+                                                     volume_mesh::ImproveFigures& improve) {
+  const auto start = std::chrono::steady_clock::now();
+  figures = ConformingFigures{};
+  if (auto status = volume_mesh::check_tetgen_params(params.tetgen); !status.ok()) return status;
+  const auto voxels = voxel_counts(volume, labels);
+  if (voxels.empty()) {
+    return absl::InvalidArgumentError(
+        "conforming mesh: no voxel holds any of the selected labels; nothing to mesh");
+  }
+  context.report("interfaces", 0);
+  InterfaceSurface surface =
+      label_interfaces(volume, labels, params.interfaces, figures.interfaces);
+  if (auto status = remove_crossings(surface, params.max_crossing_repairs, context, figures);
+      !status.ok()) {
+    return status;
+  }
+  auto mesh =
+      tetrahedralize_interfaces(surface, params.tetgen, context, figures.tetgen, figures.regions);
+  if (!mesh.ok()) return mesh.status();
+  std::vector<double> reach(surface.points.size());
+  const auto& spacing = volume.geometry.spacing;
+  const double least_reach =
+      params.slide_reach_voxels * std::min({spacing[0], spacing[1], spacing[2]});
+  for (size_t p = 0; p < reach.size(); ++p) {
+    reach[p] = std::max(least_reach,
+                        geometry::norm(geometry::sub(surface.points[p], surface.staircase[p])));
+  }
+  context.report("tet_improve", 0);
+  SlideFigures slid;
+  if (auto status = slide_interface_points(*mesh, surface.points.size(), surface.staircase, reach,
+                                           params.slide, context, slid);
+      !status.ok()) {
+    return status;
+  }
+  figures.slide = slid;
+  if (params.improve.target_quality > 0) {
+    if (auto status = volume_mesh::improve_tet_mesh(*mesh, params.improve, context, improve);
+        !status.ok()) {
+      return status;
+    }
+  }
+  // The improvement pass keeps the points it does not drop in order, and it
+  // never drops interface points, which it does not touch.
+  if (auto status = slide_interface_points(*mesh, surface.points.size(), surface.staircase, reach,
+                                           params.slide, context, slid);
+      !status.ok()) {
+    return status;
+  }
+  figures.slide.points_moved += slid.points_moved;
+  figures.slide.tetrahedra_below_after = slid.tetrahedra_below_after;
+  figures.slide.seconds += slid.seconds;
+  figures.conformity = check_conforming_mesh(*mesh);
+  figures.labels = label_volume_figures(*mesh, voxels, volume.geometry.voxel_volume());
+  figures.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (!figures.conformity.ok()) {
+    return absl::FailedPreconditionError(
+        cat("conforming mesh: failed its conformity check: ", figures.conformity.failures()));
+  }
+  return mesh;
+}
+
+}  // namespace labelmesh::conforming

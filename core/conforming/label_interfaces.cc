@@ -1,0 +1,369 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+#include "core/conforming/label_interfaces.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <unordered_map>
+#include <utility>
+
+#include "core/util/vec3.h"
+#include "core/volume/voxel_access.h"
+
+namespace labelmesh::conforming {
+namespace {
+
+using geometry::Vec3;
+
+constexpr uint32_t kNoPoint = UINT32_MAX;
+
+// The volume's labels with a ring of outside voxels around them, so every
+// surface closes.
+struct PaddedLabels {
+  std::array<int64_t, 3> dims{0, 0, 0};
+  std::vector<int32_t> labels;
+
+  int32_t at(int64_t x, int64_t y, int64_t z) const {
+    return labels[static_cast<size_t>((z * dims[1] + y) * dims[0] + x)];
+  }
+};
+
+PaddedLabels padded_labels(const volume::LabelVolume& volume, std::vector<int32_t> selected) {
+  std::sort(selected.begin(), selected.end());
+  const auto& dims = volume.geometry.dims;
+  PaddedLabels padded;
+  padded.dims = {dims[0] + 2, dims[1] + 2, dims[2] + 2};
+  padded.labels.assign(static_cast<size_t>(padded.dims[0] * padded.dims[1] * padded.dims[2]),
+                       kOutside);
+  volume::visit_voxels(volume.voxels, [&](const auto* voxels, size_t count) {
+    if (count != static_cast<size_t>(dims[0] * dims[1] * dims[2])) return;
+    size_t i = 0;
+    for (int64_t z = 0; z < dims[2]; ++z) {
+      for (int64_t y = 0; y < dims[1]; ++y) {
+        size_t out = static_cast<size_t>(((z + 1) * padded.dims[1] + y + 1) * padded.dims[0] + 1);
+        for (int64_t x = 0; x < dims[0]; ++x, ++i, ++out) {
+          const auto label = static_cast<int32_t>(voxels[i]);
+          if (label == kOutside) continue;
+          if (selected.empty() || std::binary_search(selected.begin(), selected.end(), label))
+            padded.labels[out] = label;
+        }
+      }
+    }
+  });
+  return padded;
+}
+
+// The cubes between voxel centres: cube (a, b, c) has the padded voxels
+// (a..a+1, b..b+1, c..c+1) as corners.
+struct Cubes {
+  std::array<int64_t, 3> dims{0, 0, 0};
+  std::vector<uint32_t> point;  // per cube: its point, or kNoPoint
+
+  size_t index(int64_t a, int64_t b, int64_t c) const {
+    return static_cast<size_t>((c * dims[1] + b) * dims[0] + a);
+  }
+};
+
+struct Net {
+  // Positions in scaled voxel space: index times spacing, mm along each axis.
+  std::vector<Vec3> centre;
+  std::vector<uint8_t> label_count;  // distinct labels among the cube's corners
+  std::vector<std::array<uint32_t, 4>> quads;
+  std::vector<std::array<int32_t, 2>> quad_sides;
+  std::vector<uint8_t> quad_axis;  // the axis between the quad's two voxels
+};
+
+uint8_t distinct_labels(const PaddedLabels& labels, int64_t a, int64_t b, int64_t c) {
+  std::array<int32_t, 8> seen{};
+  uint8_t count = 0;
+  for (int corner = 0; corner < 8; ++corner) {
+    const int32_t label = labels.at(a + (corner & 1), b + ((corner >> 1) & 1), c + (corner >> 2));
+    if (std::find(seen.begin(), seen.begin() + count, label) == seen.begin() + count)
+      seen[count++] = label;
+  }
+  return count;
+}
+
+Net build_net(const PaddedLabels& labels, const std::array<double, 3>& spacing, Cubes& cubes) {
+  Net net;
+  cubes.dims = {labels.dims[0] - 1, labels.dims[1] - 1, labels.dims[2] - 1};
+  cubes.point.assign(static_cast<size_t>(cubes.dims[0] * cubes.dims[1] * cubes.dims[2]), kNoPoint);
+  for (int64_t c = 0; c < cubes.dims[2]; ++c) {
+    for (int64_t b = 0; b < cubes.dims[1]; ++b) {
+      for (int64_t a = 0; a < cubes.dims[0]; ++a) {
+        const uint8_t count = distinct_labels(labels, a, b, c);
+        if (count < 2) continue;
+        cubes.point[cubes.index(a, b, c)] = static_cast<uint32_t>(net.centre.size());
+        // Padded voxel a is voxel a - 1; the cube's centre is half a voxel on.
+        net.centre.push_back(
+            {(a - 0.5) * spacing[0], (b - 0.5) * spacing[1], (c - 0.5) * spacing[2]});
+        net.label_count.push_back(count);
+      }
+    }
+  }
+  // One quad per pair of face neighbours with different labels, wound so its
+  // normal points from the first voxel to the second: the four cubes around
+  // their common axis, counter-clockwise seen from the second voxel.
+  for (int axis = 0; axis < 3; ++axis) {
+    const int u = (axis + 1) % 3;
+    const int v = (axis + 2) % 3;
+    std::array<int64_t, 3> p{};
+    for (p[2] = 0; p[2] < labels.dims[2]; ++p[2]) {
+      for (p[1] = 0; p[1] < labels.dims[1]; ++p[1]) {
+        for (p[0] = 0; p[0] < labels.dims[0]; ++p[0]) {
+          if (p[axis] + 1 >= labels.dims[axis]) continue;
+          std::array<int64_t, 3> q = p;
+          ++q[axis];
+          const int32_t behind = labels.at(p[0], p[1], p[2]);
+          const int32_t front = labels.at(q[0], q[1], q[2]);
+          if (behind == front) continue;
+          constexpr std::array<std::array<int, 2>, 4> kOffsets{{{1, 1}, {0, 1}, {0, 0}, {1, 0}}};
+          std::array<uint32_t, 4> quad{};
+          for (int k = 0; k < 4; ++k) {
+            std::array<int64_t, 3> cube = p;
+            cube[u] -= kOffsets[k][0];
+            cube[v] -= kOffsets[k][1];
+            quad[k] = cubes.point[cubes.index(cube[0], cube[1], cube[2])];
+          }
+          net.quads.push_back(quad);
+          net.quad_sides.push_back({behind, front});
+          net.quad_axis.push_back(static_cast<uint8_t>(axis));
+        }
+      }
+    }
+  }
+  return net;
+}
+
+// Neighbours each point averages over: every neighbour on a patch between
+// two labels; on a junction curve, only its two neighbours on the curve.
+// Points where curves meet or end have none and stay fixed.
+struct Stencil {
+  std::vector<uint32_t> start;  // CSR offsets, one past the last point
+  std::vector<uint32_t> neighbours;
+};
+
+Stencil smoothing_stencil(const Net& net, InterfaceFigures& figures) {
+  std::vector<std::pair<uint32_t, uint32_t>> edges;
+  edges.reserve(8 * net.quads.size());
+  for (const auto& quad : net.quads) {
+    for (int k = 0; k < 4; ++k) {
+      edges.push_back({quad[k], quad[(k + 1) % 4]});
+      edges.push_back({quad[(k + 1) % 4], quad[k]});
+    }
+  }
+  std::sort(edges.begin(), edges.end());
+  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+
+  const size_t n = net.centre.size();
+  Stencil stencil;
+  stencil.start.assign(n + 1, 0);
+  size_t e = 0;
+  for (uint32_t p = 0; p < n; ++p) {
+    stencil.start[p] = static_cast<uint32_t>(stencil.neighbours.size());
+    const size_t first = stencil.neighbours.size();
+    const bool junction = net.label_count[p] > 2;
+    for (; e < edges.size() && edges[e].first == p; ++e) {
+      if (!junction || net.label_count[edges[e].second] > 2)
+        stencil.neighbours.push_back(edges[e].second);
+    }
+    if (junction) {
+      ++figures.junction_points;
+      if (stencil.neighbours.size() - first != 2) {
+        stencil.neighbours.resize(first);
+        ++figures.fixed_points;
+      }
+    }
+  }
+  stencil.start[n] = static_cast<uint32_t>(stencil.neighbours.size());
+  return stencil;
+}
+
+void smooth(const Stencil& stencil, const std::vector<Vec3>& centre, const Vec3& half_box,
+            const InterfaceParams& params, std::vector<Vec3>& points) {
+  std::vector<Vec3> next(points.size());
+  const auto step = [&](double factor) {
+    for (size_t p = 0; p < points.size(); ++p) {
+      const uint32_t first = stencil.start[p];
+      const uint32_t last = stencil.start[p + 1];
+      if (first == last) {
+        next[p] = points[p];
+        continue;
+      }
+      Vec3 mean{0, 0, 0};
+      for (uint32_t i = first; i < last; ++i)
+        mean = geometry::add(mean, points[stencil.neighbours[i]]);
+      mean = geometry::scale(mean, 1.0 / (last - first));
+      for (int k = 0; k < 3; ++k) {
+        const double moved = points[p][k] + factor * (mean[k] - points[p][k]);
+        next[p][k] = std::clamp(moved, centre[p][k] - half_box[k], centre[p][k] + half_box[k]);
+      }
+    }
+    points.swap(next);
+  };
+  for (int round = 0; round < params.smoothing_rounds; ++round) {
+    step(params.shrink_step);
+    step(params.inflate_step);
+  }
+}
+
+double smallest_angle_cosine_max(const Vec3& a, const Vec3& b, const Vec3& c) {
+  // The largest cosine among the triangle's angles: the smallest angle's.
+  const auto cosine = [](const Vec3& at, const Vec3& p, const Vec3& q) {
+    const Vec3 u = geometry::sub(p, at);
+    const Vec3 w = geometry::sub(q, at);
+    const double lengths = geometry::norm(u) * geometry::norm(w);
+    return lengths > 0 ? geometry::dot(u, w) / lengths : 1.0;
+  };
+  return std::max({cosine(a, b, c), cosine(b, c, a), cosine(c, a, b)});
+}
+
+// On a grid with thicker slices along some axis, a quad is as long as the
+// slice along that axis and as short as the pixel along the others: its
+// triangles would be needles, and so would the tetrahedra on them. Each quad
+// is cut into k_u x k_v smaller ones, k_a being the spacing along axis a over
+// the smallest spacing (rounded), with points on shared edges made once.
+// `points` and `centre` grow by the new points, bilinear between the
+// quad's corners.
+void subdivide_quads(const std::array<double, 3>& spacing, Net& net, std::vector<Vec3>& points,
+                     std::vector<Vec3>& centre) {
+  const double least = std::min({spacing[0], spacing[1], spacing[2]});
+  std::array<int, 3> parts{};
+  for (int a = 0; a < 3; ++a)
+    parts[a] = std::max(1, static_cast<int>(std::lround(spacing[a] / least)));
+  if (parts == std::array<int, 3>{1, 1, 1}) return;
+
+  const auto lerp = [](const Vec3& a, const Vec3& b, double t) {
+    return geometry::add(a, geometry::scale(geometry::sub(b, a), t));
+  };
+  const auto add_point = [&](const Vec3& position, const Vec3& on_staircase) {
+    points.push_back(position);
+    centre.push_back(on_staircase);
+    return static_cast<uint32_t>(points.size() - 1);
+  };
+  // The k - 1 points inside edge (a, b), from a to b, made on first use.
+  std::unordered_map<uint64_t, uint32_t> edge_points;
+  const auto edge = [&](uint32_t a, uint32_t b, int k, int i) -> uint32_t {
+    if (i == 0) return a;
+    if (i == k) return b;
+    const bool forward = a < b;
+    const uint64_t key = forward ? (uint64_t{a} << 32) | b : (uint64_t{b} << 32) | a;
+    auto [it, made] = edge_points.try_emplace(key, 0);
+    if (made) {
+      const uint32_t lo = forward ? a : b, hi = forward ? b : a;
+      it->second = static_cast<uint32_t>(points.size());
+      for (int j = 1; j < k; ++j) {
+        const double t = double(j) / k;
+        add_point(lerp(points[lo], points[hi], t), lerp(centre[lo], centre[hi], t));
+      }
+    }
+    return it->second + static_cast<uint32_t>(forward ? i - 1 : k - i - 1);
+  };
+
+  std::vector<std::array<uint32_t, 4>> quads;
+  std::vector<std::array<int32_t, 2>> sides;
+  for (size_t q = 0; q < net.quads.size(); ++q) {
+    const auto& c = net.quads[q];
+    const int ku = parts[(net.quad_axis[q] + 1) % 3];
+    const int kv = parts[(net.quad_axis[q] + 2) % 3];
+    // grid[j][i]: i along u (corner 0 to 1), j along v (corner 0 to 3).
+    std::vector<std::vector<uint32_t>> grid(kv + 1, std::vector<uint32_t>(ku + 1));
+    for (int i = 0; i <= ku; ++i) {
+      grid[0][i] = edge(c[0], c[1], ku, i);
+      grid[kv][i] = edge(c[3], c[2], ku, i);
+    }
+    for (int j = 1; j < kv; ++j) {
+      grid[j][0] = edge(c[0], c[3], kv, j);
+      grid[j][ku] = edge(c[1], c[2], kv, j);
+      for (int i = 1; i < ku; ++i) {
+        const double u = double(i) / ku;
+        grid[j][i] = add_point(lerp(points[grid[j][0]], points[grid[j][ku]], u),
+                               lerp(centre[grid[j][0]], centre[grid[j][ku]], u));
+      }
+    }
+    for (int j = 0; j < kv; ++j) {
+      for (int i = 0; i < ku; ++i) {
+        quads.push_back({grid[j][i], grid[j][i + 1], grid[j + 1][i + 1], grid[j + 1][i]});
+        sides.push_back(net.quad_sides[q]);
+      }
+    }
+  }
+  net.quads = std::move(quads);
+  net.quad_sides = std::move(sides);
+  net.quad_axis.clear();
+}
+
+}  // namespace
+
+InterfaceSurface label_interfaces(const volume::LabelVolume& volume,
+                                  const std::vector<int32_t>& labels, const InterfaceParams& params,
+                                  InterfaceFigures& figures) {
+  const auto start = std::chrono::steady_clock::now();
+  figures = InterfaceFigures{};
+  const auto& geometry = volume.geometry;
+  const PaddedLabels padded = padded_labels(volume, labels);
+  Cubes cubes;
+  Net net = build_net(padded, geometry.spacing, cubes);
+  cubes.point.clear();
+  cubes.point.shrink_to_fit();
+
+  const Stencil stencil = smoothing_stencil(net, figures);
+  const double half = 0.5 * params.cube_fraction;
+  const Vec3 half_box{half * geometry.spacing[0], half * geometry.spacing[1],
+                      half * geometry.spacing[2]};
+  std::vector<Vec3> points = net.centre;
+  smooth(stencil, net.centre, half_box, params, points);
+  subdivide_quads(geometry.spacing, net, points, net.centre);
+
+  InterfaceSurface surface;
+  const auto to_patient = [&](const Vec3& scaled) {
+    return geometry.to_physical({scaled[0] / geometry.spacing[0], scaled[1] / geometry.spacing[1],
+                                 scaled[2] / geometry.spacing[2]});
+  };
+  surface.points.reserve(points.size());
+  surface.staircase.reserve(points.size());
+  for (size_t p = 0; p < points.size(); ++p) {
+    surface.points.push_back(to_patient(points[p]));
+    surface.staircase.push_back(to_patient(net.centre[p]));
+    figures.max_offset_mm =
+        std::max(figures.max_offset_mm,
+                 geometry::norm(geometry::sub(surface.points.back(), surface.staircase.back())));
+  }
+
+  // A direction matrix with negative determinant mirrors space: windings
+  // reverse so that normals still point from sides[0] to sides[1].
+  const auto& d = geometry.direction;
+  const double det = d[0] * (d[4] * d[8] - d[5] * d[7]) - d[1] * (d[3] * d[8] - d[5] * d[6]) +
+                     d[2] * (d[3] * d[7] - d[4] * d[6]);
+  const bool mirrored = det < 0;
+  surface.triangles.reserve(2 * net.quads.size());
+  surface.sides.reserve(2 * net.quads.size());
+  for (size_t q = 0; q < net.quads.size(); ++q) {
+    const auto& quad = net.quads[q];
+    const auto& x = surface.points;
+    const double split_02 = std::max(smallest_angle_cosine_max(x[quad[0]], x[quad[1]], x[quad[2]]),
+                                     smallest_angle_cosine_max(x[quad[0]], x[quad[2]], x[quad[3]]));
+    const double split_13 = std::max(smallest_angle_cosine_max(x[quad[0]], x[quad[1]], x[quad[3]]),
+                                     smallest_angle_cosine_max(x[quad[1]], x[quad[2]], x[quad[3]]));
+    std::array<std::array<uint32_t, 3>, 2> pair =
+        split_02 <= split_13 ? std::array<std::array<uint32_t, 3>, 2>{{{quad[0], quad[1], quad[2]},
+                                                                       {quad[0], quad[2], quad[3]}}}
+                             : std::array<std::array<uint32_t, 3>, 2>{
+                                   {{quad[0], quad[1], quad[3]}, {quad[1], quad[2], quad[3]}}};
+    for (auto& triangle : pair) {
+      if (mirrored) std::swap(triangle[1], triangle[2]);
+      surface.triangles.push_back(triangle);
+      surface.sides.push_back(net.quad_sides[q]);
+    }
+  }
+  figures.points = surface.points.size();
+  figures.triangles = surface.triangles.size();
+  figures.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return surface;
+}
+
+void restore_staircase(InterfaceSurface& surface, const std::vector<uint32_t>& points) {
+  for (uint32_t p : points) surface.points[p] = surface.staircase[p];
+}
+
+}  // namespace labelmesh::conforming

@@ -1,0 +1,61 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// The interfaces between the labels of a volume as one smooth triangle
+// surface in which touching labels share their triangles: a multi-label
+// surface net. One point sits in each voxel cube (eight neighbouring voxel
+// centres) whose corners hold more than one label; each pair of
+// face-neighbouring voxels with different labels gives the quad joining the
+// points of the four cubes around the segment between them. With every point
+// at its cube's centre that is exactly the voxels' staircase; the points are
+// then smoothed, each held inside its cube, so the surface stays within one
+// voxel of the labels' voxel boundary and cannot tear apart.
+// Reference: S. Frisken, "SurfaceNets for Multi-Label Segmentations with
+// Preservation of Sharp Boundaries", J. Computer Graphics Techniques 11(1), 2022.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "core/conforming/interface_surface.h"
+#include "core/volume/label_volume.h"
+
+namespace labelmesh::conforming {
+
+struct InterfaceParams {
+  // Taubin rounds (a shrinking step and an inflating one each): smooth the
+  // staircase without shrinking convex organs the way plain averaging does.
+  int smoothing_rounds = 12;
+  double shrink_step = 0.5;
+  double inflate_step = -0.53;
+  // How far a point may leave its cube's centre along each axis, as a
+  // fraction of half the voxel: below 1, so points of neighbouring cubes
+  // never meet.
+  double cube_fraction = 0.9;
+};
+
+struct InterfaceFigures {
+  size_t points = 0;
+  size_t triangles = 0;
+  // Points where three or more labels meet, smoothed along their junction
+  // curve only, and the fixed ones where curves meet.
+  size_t junction_points = 0;
+  size_t fixed_points = 0;
+  // The farthest any point lies from its staircase position, mm: the surface
+  // is within this distance of the voxel boundary (both share triangles).
+  double max_offset_mm = 0;
+  double seconds = 0;
+};
+
+// Builds the interface surface of `labels` in `volume` (all non-zero labels
+// when empty). Labels outside the list count as the outside. Triangles are
+// split from their quads along the diagonal that gives the larger smallest
+// angle.
+InterfaceSurface label_interfaces(const volume::LabelVolume& volume,
+                                  const std::vector<int32_t>& labels, const InterfaceParams& params,
+                                  InterfaceFigures& figures);
+
+// Moves `points` (indices into surface.points) back to their staircase
+// positions: what the mesher does where smoothing made two patches cross.
+void restore_staircase(InterfaceSurface& surface, const std::vector<uint32_t>& points);
+
+}  // namespace labelmesh::conforming

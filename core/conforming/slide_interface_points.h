@@ -1,0 +1,45 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// Lifting the tetrahedra the improvement pass cannot reach: those whose
+// corners all lie on interfaces, which it never moves. Each interface point
+// of such a tetrahedron slides in its interface's tangent plane to where the
+// worst tetrahedron around it is best (a pattern search), so every interface
+// stays where it was to first order and no face changes sides.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <vector>
+
+#include "core/util/run_context.h"
+#include "core/volume_mesh/tet_mesh.h"
+
+namespace labelmesh::conforming {
+
+struct SlideParams {
+  // Tetrahedra below either bound are worked on.
+  double target_quality = 0.3;
+  double target_dihedral_deg = 15;
+  int max_sweeps = 4;
+};
+
+struct SlideFigures {
+  size_t points_moved = 0;
+  size_t tetrahedra_below_before = 0;
+  size_t tetrahedra_below_after = 0;
+  double seconds = 0;
+};
+
+// Slides points [0, interface_points) of `mesh` (the interface surface's
+// points, as tetrahedralize_interfaces keeps them) that lie on one interface
+// only; points where interfaces meet stay fixed. A point never moves farther
+// than `reach[p]` mm from `anchor[p]` (the voxels' staircase, so the
+// interfaces stay as close to the voxel boundary as they were), no
+// tetrahedron inverts, no interface face turns by more than 30 degrees, and
+// a move is kept only when it raises the worst tetrahedron around the point.
+// Errors: CANCELLED.
+absl::Status slide_interface_points(volume_mesh::TetMesh& mesh, size_t interface_points,
+                                    const std::vector<std::array<double, 3>>& anchor,
+                                    const std::vector<double>& reach, const SlideParams& params,
+                                    const RunContext& context, SlideFigures& figures);
+
+}  // namespace labelmesh::conforming

@@ -1,0 +1,99 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+#include "core/volume_mesh/tetgen_call.h"
+
+#include <charconv>
+#include <cmath>
+#include <exception>
+#include <new>
+
+#include "core/util/text.h"
+
+namespace labelmesh::volume_mesh {
+namespace {
+
+// A number as TetGen's switch parser reads it: plain decimal, no exponent.
+std::string switch_number(double value) {
+  char buffer[64];
+  const auto result =
+      std::to_chars(buffer, buffer + sizeof buffer, value, std::chars_format::fixed);
+  return std::string(buffer, result.ptr);
+}
+
+absl::Status tetgen_error(int code, std::string_view what) {
+  switch (code) {
+    case 1:
+      return absl::ResourceExhaustedError(cat("tetgen: ran out of memory meshing ", what));
+    case 2:
+      return absl::InternalError(cat("tetgen: internal error while meshing ", what));
+    case 3:
+      return absl::FailedPreconditionError(cat("tetgen: ", what, " intersects itself"));
+    case 4:
+      return absl::FailedPreconditionError(
+          cat("tetgen: ", what, " has a feature below TetGen's tolerance (1e-8 of its size)"));
+    case 5:
+      return absl::FailedPreconditionError(
+          cat("tetgen: ", what, " has two facets that nearly coincide"));
+    case 10:
+      return absl::FailedPreconditionError(cat("tetgen: rejected ", what, " as invalid input"));
+    default:
+      return absl::InternalError(cat("tetgen: failed with code ", code, " meshing ", what));
+  }
+}
+
+}  // namespace
+
+absl::Status run_tetgen(const std::string& switches, tetgenio& in, tetgenio& out,
+                        std::string_view what) {
+  try {
+    tetgenbehavior behavior;
+    std::string buffer = switches;
+    if (!behavior.parse_commandline(buffer.data())) {
+      return absl::InternalError(cat("tetgen: rejected the switches '", switches, "'"));
+    }
+    ::tetrahedralize(&behavior, &in, &out);
+  } catch (int code) {
+    return tetgen_error(code, what);
+  } catch (const std::bad_alloc&) {
+    return tetgen_error(1, what);
+  } catch (const std::exception& e) {
+    return absl::InternalError(cat("tetgen: ", e.what(), " while meshing ", what));
+  } catch (...) {
+    return absl::InternalError(cat("tetgen: unknown failure meshing ", what));
+  }
+  return absl::OkStatus();
+}
+
+absl::Status check_tetgen_params(const TetgenParams& params) {
+  const double ratio = params.radius_edge_ratio;
+  if (!std::isfinite(ratio) || ratio < 1.0 || ratio > 100.0) {
+    return absl::InvalidArgumentError(
+        cat("tet-radius-edge: is ", ratio,
+            "; it must be in [1, 100] (TetGen may not terminate below 1)"));
+  }
+  const double angle = params.min_dihedral_deg;
+  if (!std::isfinite(angle) || angle < 0.0 || angle > 30.0) {
+    return absl::InvalidArgumentError(
+        cat("tet-min-dihedral: is ", angle, " degrees; it must be in [0, 30] (0: no bound)"));
+  }
+  const double max_angle = params.max_dihedral_deg;
+  if (!std::isfinite(max_angle) || max_angle < 90.0 || max_angle > 179.0) {
+    return absl::InvalidArgumentError(
+        cat("tet-max-dihedral: is ", max_angle, " degrees; it must be in [90, 179]"));
+  }
+  const double volume = params.max_volume_mm3;
+  if (!std::isfinite(volume) || (volume != 0.0 && (volume < 1e-6 || volume > 1e12))) {
+    return absl::InvalidArgumentError(
+        cat("tet-max-volume: is ", volume, " mm³; it must be 0 (no bound) or in [1e-6, 1e12]"));
+  }
+  return absl::OkStatus();
+}
+
+std::string tetgen_quality_switches(const TetgenParams& params) {
+  std::string switches = cat("pq", switch_number(params.radius_edge_ratio), "/",
+                             switch_number(params.min_dihedral_deg));
+  if (params.max_volume_mm3 > 0) switches += cat("a", switch_number(params.max_volume_mm3));
+  if (params.keep_boundary) switches += "Y";
+  return switches + cat("o/", switch_number(params.max_dihedral_deg));
+}
+
+}  // namespace labelmesh::volume_mesh
