@@ -126,8 +126,10 @@ void add_pipeline_flags(CLI::App& command, PipelineFlags& flags) {
                   "Volume mesh: none; tet (TetGen on each label's output surface); mixed "
                   "(hexahedra inside each label and out to its surface, with pyramids and "
                   "tetrahedra where hexahedra cannot be valid); or hex (hexahedra only; labels "
-                  "where they cannot be valid are left out and reported)")
-      ->check(CLI::IsMember({"none", "tet", "mixed", "hex"}))
+                  "where they cannot be valid are left out and reported); or conforming (one "
+                  "tetrahedral mesh of all labels, touching labels sharing their interfaces; "
+                  "the label surfaces come from it)")
+      ->check(CLI::IsMember({"none", "tet", "mixed", "hex", "conforming"}))
       ->capture_default_str();
   command
       .add_option("--hex-size", flags.hex_size_mm,
@@ -253,10 +255,11 @@ absl::StatusOr<v1::MeshOptions> to_mesh_options(const PipelineFlags& flags) {
   proto.set_point_reduction(flags.point_reduction == "hierarchy" ? v1::POINT_REDUCTION_HIERARCHY
                             : flags.point_reduction == "none"    ? v1::POINT_REDUCTION_NONE
                                                                  : v1::POINT_REDUCTION_GRID);
-  if (flags.volume == "tet" || flags.volume == "mixed" || flags.volume == "hex") {
-    proto.set_volume(flags.volume == "mixed" ? v1::VOLUME_METHOD_MIXED
-                     : flags.volume == "hex" ? v1::VOLUME_METHOD_HEX
-                                             : v1::VOLUME_METHOD_TETGEN);
+  if (flags.volume != "none") {
+    proto.set_volume(flags.volume == "mixed"        ? v1::VOLUME_METHOD_MIXED
+                     : flags.volume == "hex"        ? v1::VOLUME_METHOD_HEX
+                     : flags.volume == "conforming" ? v1::VOLUME_METHOD_CONFORMING
+                                                    : v1::VOLUME_METHOD_TETGEN);
     proto.set_hex_size_mm(flags.hex_size_mm);
     proto.set_hex_interior_size_mm(flags.hex_interior_size_mm);
     proto.set_tet_radius_edge(flags.tetgen.radius_edge_ratio);

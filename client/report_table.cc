@@ -51,7 +51,9 @@ std::string report_table(const v1::Report& report) {
                  s.stage().c_str(), s.nodes(), s.min_angle_deg(), s.max_angle_deg(), s.volume_mm3(),
                  hausdorff.c_str(), warnings[s.label()].c_str());
   }
-  if (report.has_volume() && report.volume().mesher() != "tetgen") {
+  const bool tetrahedra_only = report.has_volume() && (report.volume().mesher() == "tetgen" ||
+                                                       report.volume().mesher() == "conforming");
+  if (report.has_volume() && !tetrahedra_only) {
     const auto& v = report.volume();
     table +=
         row("volume (%s, %.2f mm): %llu nodes, %llu hexahedra, %llu pyramids, %llu tetrahedra; "
@@ -70,6 +72,15 @@ std::string report_table(const v1::Report& report) {
             v.tetra_quality_min(), v.tetra_quality_mean(), v.min_dihedral_deg(),
             v.max_dihedral_deg(), (unsigned long long)c.invalid(), (unsigned long long)c.very_bad(),
             (unsigned long long)c.questionable(), (unsigned long long)c.good());
+  }
+  if (report.has_volume() && report.volume().has_conforming_figures()) {
+    const auto& f = report.volume().conforming_figures();
+    table += row(
+        "conforming: %llu interfaces (%llu shared faces, %llu outer); interfaces within %.2f mm "
+        "of the voxel boundary; volume gap %.1e; label volume change median %.2f %%, p90 %.2f %%\n",
+        (unsigned long long)f.interfaces(), (unsigned long long)f.interface_faces(),
+        (unsigned long long)f.outer_faces(), f.interface_offset_max_mm(), f.volume_gap(),
+        100 * f.volume_change_median(), 100 * f.volume_change_p90());
   }
   return table;
 }

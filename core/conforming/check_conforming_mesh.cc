@@ -9,84 +9,8 @@
 #include "core/util/vec3.h"
 
 namespace labelmesh::conforming {
-namespace {
 
 using volume_mesh::TetMesh;
-
-struct FaceEntry {
-  std::array<uint32_t, 3> key;  // sorted point indices
-  uint32_t tet;
-  uint8_t across;
-};
-
-// Every tetrahedron's four faces, grouped by their points.
-std::vector<FaceEntry> sorted_faces(const TetMesh& mesh) {
-  std::vector<FaceEntry> entries;
-  entries.reserve(4 * mesh.tetrahedra.size());
-  for (size_t t = 0; t < mesh.tetrahedra.size(); ++t) {
-    const auto& tet = mesh.tetrahedra[t];
-    for (uint8_t across = 0; across < 4; ++across) {
-      const auto& local = volume_mesh::outward_face(across);
-      std::array<uint32_t, 3> key{tet[local[0]], tet[local[1]], tet[local[2]]};
-      std::sort(key.begin(), key.end());
-      entries.push_back({key, static_cast<uint32_t>(t), across});
-    }
-  }
-  std::sort(entries.begin(), entries.end(), [](const FaceEntry& a, const FaceEntry& b) {
-    return std::tie(a.key, a.tet, a.across) < std::tie(b.key, b.tet, b.across);
-  });
-  return entries;
-}
-
-InterfaceFace face_of(const TetMesh& mesh, const FaceEntry& entry, int32_t across_label) {
-  const auto& local = volume_mesh::outward_face(entry.across);
-  const auto& tet = mesh.tetrahedra[entry.tet];
-  return {{tet[local[0]], tet[local[1]], tet[local[2]]},
-          {mesh.labels[entry.tet], across_label},
-          entry.tet,
-          entry.across};
-}
-
-// Calls `group(first, count)` for each run of entries with the same points.
-template <typename F>
-void for_each_face(const std::vector<FaceEntry>& entries, F&& group) {
-  for (size_t i = 0; i < entries.size();) {
-    size_t j = i + 1;
-    while (j < entries.size() && entries[j].key == entries[i].key) ++j;
-    group(i, j - i);
-    i = j;
-  }
-}
-
-}  // namespace
-
-std::vector<InterfaceFace> interface_faces(const TetMesh& mesh) {
-  const auto entries = sorted_faces(mesh);
-  std::vector<InterfaceFace> faces;
-  for_each_face(entries, [&](size_t first, size_t count) {
-    if (count == 1) {
-      faces.push_back(face_of(mesh, entries[first], 0));
-    } else if (count == 2) {
-      const FaceEntry* a = &entries[first];
-      const FaceEntry* b = &entries[first + 1];
-      if (mesh.labels[a->tet] == mesh.labels[b->tet]) return;
-      if (mesh.labels[b->tet] < mesh.labels[a->tet]) std::swap(a, b);
-      faces.push_back(face_of(mesh, *a, mesh.labels[b->tet]));
-    }
-  });
-  std::sort(faces.begin(), faces.end(), [](const InterfaceFace& a, const InterfaceFace& b) {
-    return std::tie(a.labels, a.tet, a.across) < std::tie(b.labels, b.tet, b.across);
-  });
-  return faces;
-}
-
-std::vector<std::array<int32_t, 2>> interface_pairs(const std::vector<InterfaceFace>& faces) {
-  std::vector<std::array<int32_t, 2>> pairs;
-  for (const auto& face : faces) {
-    if (pairs.empty() || pairs.back() != face.labels) pairs.push_back(face.labels);
-  }
-  return pairs;
-}
 
 double ConformityCheck::volume_gap_fraction() const {
   return union_volume_mm3 > 0 ? std::abs(label_volume_sum_mm3 - union_volume_mm3) / union_volume_mm3
@@ -139,15 +63,14 @@ ConformityCheck check_conforming_mesh(const TetMesh& mesh) {
   for (size_t i = 1; i < sorted_points.size(); ++i)
     check.duplicate_points += sorted_points[i] == sorted_points[i - 1];
 
-  const auto entries = sorted_faces(mesh);
   std::vector<std::array<int32_t, 2>> pairs;
   std::vector<std::pair<uint32_t, uint32_t>> outer_edges;
-  for_each_face(entries, [&](size_t first, size_t count) {
+  volume_mesh::for_each_face(mesh, [&](const volume_mesh::FaceUse* uses, size_t count) {
     if (count > 2) {
       ++check.overshared_faces;
     } else if (count == 2) {
-      const int32_t a = mesh.labels[entries[first].tet];
-      const int32_t b = mesh.labels[entries[first + 1].tet];
+      const int32_t a = mesh.labels[uses[0].tet];
+      const int32_t b = mesh.labels[uses[1].tet];
       if (a == b) {
         ++check.interior_faces;
       } else {
@@ -156,9 +79,8 @@ ConformityCheck check_conforming_mesh(const TetMesh& mesh) {
       }
     } else {
       ++check.outer_faces;
-      const InterfaceFace face = face_of(mesh, entries[first], 0);
-      pairs.push_back(face.labels);
-      const auto& p = face.points;
+      pairs.push_back({mesh.labels[uses[0].tet], 0});
+      const auto p = volume_mesh::face_points(mesh, uses[0]);
       // Relative to the first point, to keep the sum's rounding small.
       const auto& o = mesh.points.front();
       check.union_volume_mm3 +=

@@ -1,6 +1,5 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-// The faces where labels meet in a conforming tetrahedral mesh of several
-// labels, and the check that the mesh is one: faces shared by at most two
+// The check that a tetrahedral mesh of several labels is conforming: faces shared by at most two
 // tetrahedra, no repeated points, every label's region closed, and no overlap
 // or gap between the labels.
 #pragma once
@@ -14,24 +13,6 @@
 #include "core/volume_mesh/tet_mesh.h"
 
 namespace labelmesh::conforming {
-
-// A face between two labels, or between a label and the outside (label 0),
-// listed once.
-struct InterfaceFace {
-  // Wound so the right-hand normal points out of `tet`, into labels[1].
-  std::array<uint32_t, 3> points;
-  // {label of `tet`, label across}. Between two labels the smaller comes
-  // first; on the outer boundary the second is 0.
-  std::array<int32_t, 2> labels;
-  uint32_t tet;
-  uint8_t across;  // local index of the tetrahedron's node opposite the face
-};
-
-// Every interface face, sorted by label pair, then tetrahedron and face.
-std::vector<InterfaceFace> interface_faces(const volume_mesh::TetMesh& mesh);
-
-// The distinct label pairs of `faces`, in order: interface i is pairs[i].
-std::vector<std::array<int32_t, 2>> interface_pairs(const std::vector<InterfaceFace>& faces);
 
 struct ConformityCheck {
   size_t tetrahedra = 0;

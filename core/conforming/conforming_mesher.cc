@@ -100,6 +100,7 @@ absl::StatusOr<volume_mesh::TetMesh> mesh_conforming(const volume::LabelVolume& 
   auto mesh =
       tetrahedralize_interfaces(surface, params.tetgen, context, figures.tetgen, figures.regions);
   if (!mesh.ok()) return mesh.status();
+  figures.tetgen_quality = volume_mesh::summarise_quality(*mesh);
   std::vector<double> reach(surface.points.size());
   const auto& spacing = volume.geometry.spacing;
   const double least_reach =

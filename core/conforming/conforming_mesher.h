@@ -54,6 +54,8 @@ struct ConformingFigures {
   size_t restored_points = 0;
   bool staircase_only = false;
   volume_mesh::TetgenFigures tetgen;
+  // TetGen's mesh before the slides and the improvement pass.
+  quality::QualitySummary tetgen_quality;
   LabelledRegions regions;
   // Both slides together: points moved, tetrahedra below the slide's targets
   // before the first and after the last.

@@ -59,7 +59,7 @@ bool below_target(const TetMesh& mesh, uint32_t t, const SlideParams& params) {
          quality::tetra_dihedral_range_deg(tet).first < params.target_dihedral_deg;
 }
 
-Vec3 face_normal(const TetMesh& mesh, const InterfaceFace& face) {
+Vec3 face_normal(const TetMesh& mesh, const volume_mesh::InterfaceFace& face) {
   const Vec3& a = mesh.points[face.points[0]];
   return geometry::cross(geometry::sub(mesh.points[face.points[1]], a),
                          geometry::sub(mesh.points[face.points[2]], a));
@@ -74,7 +74,7 @@ class Slider {
  public:
   Slider(TetMesh& mesh, size_t interface_points, const std::vector<Vec3>& anchor,
          const std::vector<double>& reach)
-      : mesh_(mesh), anchor_(anchor), reach_(reach), faces_(interface_faces(mesh)) {
+      : mesh_(mesh), anchor_(anchor), reach_(reach), faces_(volume_mesh::interface_faces(mesh)) {
     std::vector<std::pair<uint32_t, uint32_t>> pairs;
     for (size_t t = 0; t < mesh.tetrahedra.size(); ++t) {
       for (uint32_t p : mesh.tetrahedra[t]) {
@@ -194,7 +194,7 @@ class Slider {
   TetMesh& mesh_;
   const std::vector<Vec3>& anchor_;
   const std::vector<double>& reach_;
-  std::vector<InterfaceFace> faces_;
+  std::vector<volume_mesh::InterfaceFace> faces_;
   std::vector<Vec3> face_normal_;
   Lists star_;
   Lists around_;

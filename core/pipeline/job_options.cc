@@ -265,6 +265,9 @@ absl::Status read_volume_options(const v1::MeshOptions& options, MeshParams& par
     case v1::VOLUME_METHOD_HEX:
       params.volume = VolumeMethod::kHex;
       break;
+    case v1::VOLUME_METHOD_CONFORMING:
+      params.volume = VolumeMethod::kConforming;
+      break;
     default:
       return absl::InvalidArgumentError("volume: unknown volume method");
   }
@@ -363,9 +366,10 @@ v1::MeshOptions make_options(const MeshParams& params) {
   for (auto format : params.formats)
     options.add_formats(std::string(surface::surface_format_name(format)));
   if (params.volume != VolumeMethod::kNone) {
-    options.set_volume(params.volume == VolumeMethod::kMixed ? v1::VOLUME_METHOD_MIXED
-                       : params.volume == VolumeMethod::kHex ? v1::VOLUME_METHOD_HEX
-                                                             : v1::VOLUME_METHOD_TETGEN);
+    options.set_volume(params.volume == VolumeMethod::kMixed        ? v1::VOLUME_METHOD_MIXED
+                       : params.volume == VolumeMethod::kHex        ? v1::VOLUME_METHOD_HEX
+                       : params.volume == VolumeMethod::kConforming ? v1::VOLUME_METHOD_CONFORMING
+                                                                    : v1::VOLUME_METHOD_TETGEN);
     options.set_hex_size_mm(params.hex_size_mm);
     options.set_hex_interior_size_mm(params.hex_interior_size_mm);
     for (auto format : params.volume_formats)

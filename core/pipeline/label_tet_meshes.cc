@@ -9,24 +9,6 @@
 namespace labelmesh {
 namespace {
 
-quality::Tet corners(const volume_mesh::TetMesh& mesh, size_t t) {
-  const auto& tet = mesh.tetrahedra[t];
-  return {mesh.points[tet[0]], mesh.points[tet[1]], mesh.points[tet[2]], mesh.points[tet[3]]};
-}
-
-void measure(VolumeResult& result) {
-  result.quality.clear();
-  result.summary = {};
-  result.quality.reserve(result.mesh.tetrahedra.size());
-  for (size_t t = 0; t < result.mesh.tetrahedra.size(); ++t) {
-    const quality::Tet tet = corners(result.mesh, t);
-    const double q = quality::tetra_quality(tet);
-    result.quality.push_back(q);
-    result.summary.add(q);
-    result.summary.add_dihedral_range(quality::tetra_dihedral_range_deg(tet));
-  }
-}
-
 absl::StatusOr<VolumeResult> measure_and_join(const std::vector<LabelBoundary>& boundaries,
                                               const volume_mesh::TetgenParams& params,
                                               const RunContext& context) {
@@ -51,6 +33,10 @@ absl::StatusOr<VolumeResult> measure_and_join(const std::vector<LabelBoundary>& 
 }
 
 }  // namespace
+
+void measure(VolumeResult& result) {
+  result.summary = volume_mesh::summarise_quality(result.mesh, &result.quality);
+}
 
 absl::StatusOr<VolumeResult> tetrahedralize_labels(const std::vector<LabelBoundary>& boundaries,
                                                    const volume_mesh::TetgenParams& params,

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
+#include "core/conforming/conforming_mesher.h"
 #include "core/quality/element_quality.h"
 #include "core/surface/triangle_mesh.h"
 #include "core/util/run_context.h"
@@ -33,9 +34,14 @@ struct VolumeResult {
   double seconds = 0;
   // Set when the improvement pass ran.
   std::optional<VolumeImprovement> improvement;
+  // Conforming meshes only.
+  std::optional<conforming::ConformingFigures> conforming;
   // Files written for it, relative to the output directory.
   std::vector<std::string> files;
 };
+
+// Fills `quality` and `summary` from the mesh.
+void measure(VolumeResult& result);
 
 // One label's closed, outward surface to fill with tetrahedra.
 struct LabelBoundary {

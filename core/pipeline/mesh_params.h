@@ -100,6 +100,9 @@ enum class VolumeMethod {
   // Hexahedra only, where they can be valid; other labels are left out and
   // the report says why.
   kHex,
+  // One tetrahedral mesh of every label with shared interfaces
+  // (conforming/conforming_mesher.h); the label surfaces come from it.
+  kConforming,
 };
 
 // The guard on what is delivered: each label's output surface is compared

@@ -11,6 +11,7 @@
 #include <mutex>
 #include <thread>
 
+#include "core/pipeline/label_conforming_mesh.h"
 #include "core/pipeline/label_queue.h"
 #include "core/pipeline/label_surfaces.h"
 #include "core/pipeline/volume_layers.h"
@@ -350,6 +351,24 @@ absl::StatusOr<MeshResult> run_stages(const std::string& path, const MeshParams&
   auto labels = choose_labels(path, result.input.statistics, params.labels);
   if (!labels.ok()) return labels.status();
   auto layer_of = layer_of_labels(layers, *labels);
+  // The label volume as read, for the scene formats that write it.
+  const auto keep_label_image = [&] {
+    if (std::any_of(params.scene_formats.begin(), params.scene_formats.end(),
+                    [](SceneFormat f) { return f != SceneFormat::kVtm; })) {
+      result.label_image = std::make_shared<const volume::LabelVolume>(std::move(*volume));
+    }
+  };
+  if (params.volume == VolumeMethod::kConforming) {
+    if (layers.size() > 1) {
+      return absl::FailedPreconditionError(
+          cat(path, ": its segments overlap (", layers.size(),
+              " layers); one conforming mesh gives each point one label, so mesh overlapping "
+              "segments with --volume tet"));
+    }
+    if (auto s = add_conforming_mesh(*volume, *labels, params, context, result); !s.ok()) return s;
+    keep_label_image();
+    return result;
+  }
 
   absl::StatusOr<std::vector<surface::LabelSurface>> surfaces;
   {
@@ -419,10 +438,7 @@ absl::StatusOr<MeshResult> run_stages(const std::string& path, const MeshParams&
   if (params.volume == VolumeMethod::kMixed || params.volume == VolumeMethod::kHex) {
     if (auto s = add_mixed_mesh(params, volume->geometry, context, result); !s.ok()) return s;
   }
-  if (std::any_of(params.scene_formats.begin(), params.scene_formats.end(),
-                  [](SceneFormat f) { return f != SceneFormat::kVtm; })) {
-    result.label_image = std::make_shared<const volume::LabelVolume>(std::move(*volume));
-  }
+  keep_label_image();
   return result;
 }
 

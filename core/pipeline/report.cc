@@ -3,6 +3,7 @@
 
 #include <google/protobuf/util/json_util.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "core/pipeline/build_info.h"
@@ -82,6 +83,64 @@ v1::VolumeMeshSummary make_mixed_summary(const MixedVolumeResult& mixed) {
   return entry;
 }
 
+// The median and 90th percentile of |volume change| over labels of at least
+// kSmallLabelVoxels voxels.
+std::pair<double, double> volume_change_percentiles(
+    const std::vector<conforming::LabelVolumeFigures>& labels) {
+  std::vector<double> changes;
+  for (const auto& label : labels) {
+    if (label.voxels >= kSmallLabelVoxels) changes.push_back(std::abs(label.volume_change()));
+  }
+  if (changes.empty()) return {0, 0};
+  std::sort(changes.begin(), changes.end());
+  const auto at = [&](double q) {
+    return changes[static_cast<size_t>(std::lround(q * double(changes.size() - 1)))];
+  };
+  return {at(0.5), at(0.9)};
+}
+
+void add_conforming_figures(const conforming::ConformingFigures& figures,
+                            v1::VolumeMeshSummary& entry) {
+  const auto& check = figures.conformity;
+  auto* conformity = entry.mutable_conformity_check();
+  conformity->set_interior_faces(check.interior_faces + check.interface_faces);
+  conformity->set_boundary_faces(check.outer_faces);
+  conformity->set_nonconforming_faces(check.overshared_faces);
+  conformity->set_duplicate_points(check.duplicate_points);
+  conformity->set_open_boundary_edges(check.open_boundary_edges);
+  entry.set_enclosed_volume_mm3(check.label_volume_sum_mm3);
+  entry.set_inverted(check.inverted_tetrahedra);
+  auto* out = entry.mutable_conforming_figures();
+  out->set_interfaces(check.interfaces);
+  out->set_interface_faces(check.interface_faces);
+  out->set_outer_faces(check.outer_faces);
+  out->set_interface_offset_max_mm(figures.interfaces.max_offset_mm);
+  out->set_volume_gap(check.volume_gap_fraction());
+  out->set_inverted_tetrahedra(check.inverted_tetrahedra);
+  out->set_overshared_faces(check.overshared_faces);
+  out->set_duplicate_points(check.duplicate_points);
+  out->set_open_boundary_edges(check.open_boundary_edges);
+  out->set_crossing_repairs(figures.crossing_repairs);
+  out->set_restored_points(figures.restored_points);
+  out->set_staircase_only(figures.staircase_only);
+  out->set_interface_points_slid(figures.slide.points_moved);
+  out->set_below_slide_targets_before(figures.slide.tetrahedra_below_before);
+  out->set_below_slide_targets_after(figures.slide.tetrahedra_below_after);
+  out->set_outside_regions(figures.regions.outside_regions);
+  for (const auto& label : figures.labels) {
+    auto* l = out->add_labels();
+    l->set_label(label.label);
+    l->set_voxels(label.voxels);
+    l->set_voxel_volume_mm3(label.voxel_volume_mm3);
+    l->set_mesh_volume_mm3(label.mesh_volume_mm3);
+    l->set_tetrahedra(label.tetrahedra);
+    l->set_volume_change(label.volume_change());
+  }
+  const auto [median, p90] = volume_change_percentiles(figures.labels);
+  out->set_volume_change_median(median);
+  out->set_volume_change_p90(p90);
+}
+
 v1::VolumeMeshSummary make_volume_summary(const VolumeResult& volume) {
   v1::VolumeMeshSummary entry;
   entry.set_mesher(volume.mesher);
@@ -100,8 +159,9 @@ v1::VolumeMeshSummary make_volume_summary(const VolumeResult& volume) {
   categories->set_very_bad(q.very_bad);
   categories->set_questionable(q.questionable);
   categories->set_good(q.good);
-  entry.set_conforming(false);
+  entry.set_conforming(volume.conforming.has_value());
   entry.set_seconds(volume.seconds);
+  if (volume.conforming) add_conforming_figures(*volume.conforming, entry);
   if (volume.improvement) {
     const auto& before = volume.improvement->tetgen_summary;
     const auto& figures = volume.improvement->figures;

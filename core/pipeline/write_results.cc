@@ -123,14 +123,18 @@ absl::Status write_all(MeshResult& result, const MeshParams& params, const std::
   if (result.volume) {
     StageTimer timer(result.stages, "write_volume");
     result.volume->files.clear();
+    auto volume_info = info;
+    volume_info.interfaces = result.volume->conforming.has_value();
     for (auto format : params.volume_formats) {
       const std::string name = cat("volume.", volume_mesh::volume_format_name(format));
       const auto path = (std::filesystem::path(out_dir) / name).string();
       if (auto s = volume_mesh::write_volume_mesh(result.volume->mesh, result.volume->quality, path,
-                                                  format, info);
+                                                  format, volume_info);
           !s.ok())
         return s;
       result.volume->files.push_back(name);
+      if (volume_info.interfaces && format == volume_mesh::VolumeFormat::kVtu)
+        result.volume->files.push_back(volume_mesh::interfaces_vtu_path(name));
       // TetGen's pair: the .ele beside the .node.
       if (format == volume_mesh::VolumeFormat::kTetgen)
         result.volume->files.push_back("volume.ele");

@@ -70,10 +70,13 @@ absl::Status write_vtu_grid(vtkUnstructuredGrid* grid, const std::string& path) 
 }
 
 void write_msh_head(TextFile& file, const std::vector<int32_t>& labels,
-                    const std::vector<std::array<double, 3>>& points, const VolumeFileInfo& info) {
+                    const std::vector<std::array<double, 3>>& points, const VolumeFileInfo& info,
+                    const std::vector<std::string>& surface_names) {
   const auto groups = distinct_labels(labels);
   file << "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n";
-  file << "$PhysicalNames\n" << groups.size() << '\n';
+  file << "$PhysicalNames\n" << groups.size() + surface_names.size() << '\n';
+  for (size_t i = 0; i < surface_names.size(); ++i)
+    file << "2 " << i + 1 << " \"" << surface_names[i] << "\"\n";
   for (int32_t label : groups)
     file << "3 " << label << " \"" << label_group_name(label, info) << "\"\n";
   file << "$EndPhysicalNames\n";

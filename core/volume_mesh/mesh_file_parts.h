@@ -42,10 +42,12 @@ void add_label_fields(const std::vector<int32_t>& labels, const VolumeFileInfo& 
 absl::Status write_vtu_grid(vtkUnstructuredGrid* grid, const std::string& path);
 
 // The start of a Gmsh MSH 2.2 ASCII file up to its elements: the format, a
-// 3D physical group per label (tag = label, named by label_group_name) and
-// the nodes (numbered from 1, in info.frame). Labels must be positive.
+// 3D physical group per label (tag = label, named by label_group_name), a
+// 2D physical group per surface name (tag = its position + 1) and the nodes
+// (numbered from 1, in info.frame). Labels must be positive.
 void write_msh_head(TextFile& file, const std::vector<int32_t>& labels,
-                    const std::vector<std::array<double, 3>>& points, const VolumeFileInfo& info);
+                    const std::vector<std::array<double, 3>>& points, const VolumeFileInfo& info,
+                    const std::vector<std::string>& surface_names = {});
 
 // The start of a Medit .mesh file up to its elements: version, dimension,
 // comments naming the frame and each label's ref, and the vertices (ref 0,

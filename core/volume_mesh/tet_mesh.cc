@@ -90,4 +90,86 @@ absl::Status check_tet_mesh(const TetMesh& mesh) {
   return absl::OkStatus();
 }
 
+void for_each_face(const TetMesh& mesh, const std::function<void(const FaceUse*, size_t)>& visit) {
+  struct Entry {
+    std::array<uint32_t, 3> key;  // sorted point indices
+    FaceUse use;
+  };
+  std::vector<Entry> entries;
+  entries.reserve(4 * mesh.tetrahedra.size());
+  for (size_t t = 0; t < mesh.tetrahedra.size(); ++t) {
+    for (uint8_t across = 0; across < 4; ++across) {
+      const FaceUse use{static_cast<uint32_t>(t), across};
+      std::array<uint32_t, 3> key = face_points(mesh, use);
+      std::sort(key.begin(), key.end());
+      entries.push_back({key, use});
+    }
+  }
+  std::sort(entries.begin(), entries.end(), [](const Entry& a, const Entry& b) {
+    return std::tie(a.key, a.use.tet, a.use.across) < std::tie(b.key, b.use.tet, b.use.across);
+  });
+  std::vector<FaceUse> uses;
+  for (size_t i = 0; i < entries.size();) {
+    uses.clear();
+    size_t j = i;
+    for (; j < entries.size() && entries[j].key == entries[i].key; ++j)
+      uses.push_back(entries[j].use);
+    visit(uses.data(), uses.size());
+    i = j;
+  }
+}
+
+std::array<uint32_t, 3> face_points(const TetMesh& mesh, const FaceUse& use) {
+  const auto& local = outward_face(use.across);
+  const auto& tet = mesh.tetrahedra[use.tet];
+  return {tet[local[0]], tet[local[1]], tet[local[2]]};
+}
+
+quality::QualitySummary summarise_quality(const TetMesh& mesh,
+                                          std::vector<double>* per_tetrahedron) {
+  quality::QualitySummary summary;
+  if (per_tetrahedron != nullptr) {
+    per_tetrahedron->clear();
+    per_tetrahedron->reserve(mesh.tetrahedra.size());
+  }
+  for (const auto& v : mesh.tetrahedra) {
+    const quality::Tet tet{mesh.points[v[0]], mesh.points[v[1]], mesh.points[v[2]],
+                           mesh.points[v[3]]};
+    const double q = quality::tetra_quality(tet);
+    if (per_tetrahedron != nullptr) per_tetrahedron->push_back(q);
+    summary.add(q);
+    summary.add_dihedral_range(quality::tetra_dihedral_range_deg(tet));
+  }
+  return summary;
+}
+
+std::vector<InterfaceFace> interface_faces(const TetMesh& mesh) {
+  std::vector<InterfaceFace> faces;
+  for_each_face(mesh, [&](const FaceUse* uses, size_t count) {
+    if (count == 1) {
+      faces.push_back(
+          {face_points(mesh, uses[0]), {mesh.labels[uses[0].tet], 0}, uses[0].tet, uses[0].across});
+    } else if (count == 2) {
+      const FaceUse* a = &uses[0];
+      const FaceUse* b = &uses[1];
+      if (mesh.labels[a->tet] == mesh.labels[b->tet]) return;
+      if (mesh.labels[b->tet] < mesh.labels[a->tet]) std::swap(a, b);
+      faces.push_back(
+          {face_points(mesh, *a), {mesh.labels[a->tet], mesh.labels[b->tet]}, a->tet, a->across});
+    }
+  });
+  std::sort(faces.begin(), faces.end(), [](const InterfaceFace& a, const InterfaceFace& b) {
+    return std::tie(a.labels, a.tet, a.across) < std::tie(b.labels, b.tet, b.across);
+  });
+  return faces;
+}
+
+std::vector<std::array<int32_t, 2>> interface_pairs(const std::vector<InterfaceFace>& faces) {
+  std::vector<std::array<int32_t, 2>> pairs;
+  for (const auto& face : faces) {
+    if (pairs.empty() || pairs.back() != face.labels) pairs.push_back(face.labels);
+  }
+  return pairs;
+}
+
 }  // namespace labelmesh::volume_mesh

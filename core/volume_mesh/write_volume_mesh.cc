@@ -6,6 +6,7 @@
 #include <charconv>
 #include <cstdint>
 #include <fstream>
+#include <optional>
 #include <set>
 #include <string>
 #include <type_traits>
@@ -37,13 +38,69 @@ std::string name_of(int32_t label, const VolumeFileInfo& info) {
   return found == info.label_names.end() ? std::string() : found->second;
 }
 
-absl::Status write_vtu(const TetMesh& mesh, const std::vector<double>& quality,
-                       const VolumeFileInfo& info, const std::string& path) {
+// A conforming mesh's interface faces, each with its interface's index.
+struct Interfaces {
+  std::vector<InterfaceFace> faces;
+  std::vector<std::array<int32_t, 2>> pairs;
+  std::vector<size_t> index;  // per face: its pair's index in `pairs`
+
+  explicit Interfaces(const TetMesh& mesh)
+      : faces(interface_faces(mesh)), pairs(interface_pairs(faces)) {
+    index.reserve(faces.size());
+    for (size_t f = 0, i = 0; f < faces.size(); ++f) {
+      while (pairs[i] != faces[f].labels) ++i;
+      index.push_back(i);
+    }
+  }
+};
+
+vtkNew<vtkPoints> vtk_points(const TetMesh& mesh, const VolumeFileInfo& info) {
   vtkNew<vtkPoints> points;
   points->SetDataTypeToDouble();
   points->SetNumberOfPoints(static_cast<vtkIdType>(mesh.points.size()));
   for (size_t i = 0; i < mesh.points.size(); ++i)
     points->SetPoint(static_cast<vtkIdType>(i), in_frame(mesh.points[i], info.frame).data());
+  return points;
+}
+
+vtkNew<vtkIntArray> int_array(const char* name, size_t size) {
+  vtkNew<vtkIntArray> array;
+  array->SetName(name);
+  array->SetNumberOfValues(static_cast<vtkIdType>(size));
+  return array;
+}
+
+absl::Status write_interfaces_vtu(const TetMesh& mesh, const VolumeFileInfo& info,
+                                  const std::string& path) {
+  const Interfaces interfaces(mesh);
+  vtkNew<vtkCellArray> cells;
+  auto id = int_array("interface", interfaces.faces.size());
+  auto inside = int_array("label_inside", interfaces.faces.size());
+  auto outside = int_array("label_outside", interfaces.faces.size());
+  for (size_t f = 0; f < interfaces.faces.size(); ++f) {
+    const auto& face = interfaces.faces[f];
+    const vtkIdType ids[3] = {face.points[0], face.points[1], face.points[2]};
+    cells->InsertNextCell(3, ids);
+    id->SetValue(static_cast<vtkIdType>(f), static_cast<int>(interfaces.index[f] + 1));
+    inside->SetValue(static_cast<vtkIdType>(f), face.labels[0]);
+    outside->SetValue(static_cast<vtkIdType>(f), face.labels[1]);
+  }
+  vtkNew<vtkUnstructuredGrid> grid;
+  grid->SetPoints(vtk_points(mesh, info));
+  grid->SetCells(VTK_TRIANGLE, cells);
+  grid->GetCellData()->AddArray(id);
+  grid->GetCellData()->AddArray(inside);
+  grid->GetCellData()->AddArray(outside);
+  add_label_fields(mesh.labels, info, grid->GetFieldData());
+  return write_vtu_grid(grid, path);
+}
+
+absl::Status write_vtu(const TetMesh& mesh, const std::vector<double>& quality,
+                       const VolumeFileInfo& info, const std::string& path) {
+  if (info.interfaces) {
+    if (auto status = write_interfaces_vtu(mesh, info, interfaces_vtu_path(path)); !status.ok())
+      return status;
+  }
   vtkNew<vtkCellArray> cells;
   cells->AllocateExact(static_cast<vtkIdType>(mesh.tetrahedra.size()),
                        static_cast<vtkIdType>(4 * mesh.tetrahedra.size()));
@@ -52,11 +109,9 @@ absl::Status write_vtu(const TetMesh& mesh, const std::vector<double>& quality,
     cells->InsertNextCell(4, ids);
   }
   vtkNew<vtkUnstructuredGrid> grid;
-  grid->SetPoints(points);
+  grid->SetPoints(vtk_points(mesh, info));
   grid->SetCells(VTK_TETRA, cells);
-  vtkNew<vtkIntArray> labels;
-  labels->SetName("label");
-  labels->SetNumberOfValues(static_cast<vtkIdType>(mesh.labels.size()));
+  auto labels = int_array("label", mesh.labels.size());
   for (size_t i = 0; i < mesh.labels.size(); ++i)
     labels->SetValue(static_cast<vtkIdType>(i), mesh.labels[i]);
   grid->GetCellData()->AddArray(labels);
@@ -76,9 +131,17 @@ absl::Status write_vtu(const TetMesh& mesh, const std::vector<double>& quality,
 absl::Status write_msh(const TetMesh& mesh, const std::vector<double>& quality,
                        const VolumeFileInfo& info, const std::string& path) {
   if (auto status = check_positive_labels(mesh.labels, path, "MSH"); !status.ok()) return status;
+  std::optional<Interfaces> interfaces;
+  std::vector<std::string> surface_names;
+  if (info.interfaces) {
+    interfaces.emplace(mesh);
+    for (const auto& pair : interfaces->pairs)
+      surface_names.push_back(interface_group_name(pair, info));
+  }
   TextFile file(path, "the volume mesh");
-  write_msh_head(file, mesh.labels, mesh.points, info);
-  file << "$Elements\n" << mesh.tetrahedra.size() << '\n';
+  write_msh_head(file, mesh.labels, mesh.points, info, surface_names);
+  const size_t triangles = interfaces ? interfaces->faces.size() : 0;
+  file << "$Elements\n" << mesh.tetrahedra.size() + triangles << '\n';
   for (size_t i = 0; i < mesh.tetrahedra.size(); ++i) {
     const auto& t = mesh.tetrahedra[i];
     const int32_t label = mesh.labels[i];
@@ -87,8 +150,17 @@ absl::Status write_msh(const TetMesh& mesh, const std::vector<double>& quality,
     for (uint32_t v : t) file << ' ' << v + 1;
     file << '\n';
   }
+  // Triangles after the tetrahedra, so element data keeps numbering tetrahedra from 1.
+  for (size_t f = 0; f < triangles; ++f) {
+    const size_t group = interfaces->index[f] + 1;
+    file << mesh.tetrahedra.size() + f + 1 << " 2 2 " << group << ' ' << group;
+    for (uint32_t v : interfaces->faces[f].points) file << ' ' << v + 1;
+    file << '\n';
+  }
   file << "$EndElements\n";
-  if (!quality.empty()) {
+  // Element data must cover every element for meshio, and Q means nothing for the interface
+  // triangles: with interfaces, quality is in the VTU only.
+  if (!quality.empty() && !interfaces) {
     // One string tag (the name), one real tag (the time), three integer tags (time step,
     // components, entries).
     file << "$ElementData\n1\n\"quality\"\n1\n0\n3\n0\n1\n" << quality.size() << '\n';
@@ -100,13 +172,25 @@ absl::Status write_msh(const TetMesh& mesh, const std::vector<double>& quality,
 
 // Medit .mesh (INRIA, "The Medit mesh file format"), read by Mmg, Medit, meshio and TetGen.
 absl::Status write_medit(const TetMesh& mesh, const VolumeFileInfo& info, const std::string& path) {
-  const auto faces = label_boundary_faces(mesh);
   TextFile file(path, "the volume mesh");
   write_medit_head(file, mesh.labels, mesh.points, info);
-  file << "\nTriangles\n" << faces.size() << '\n';
-  for (const auto& face : faces) {
-    for (uint32_t v : face.points) file << v + 1 << ' ';
-    file << face.label << '\n';
+  if (info.interfaces) {
+    const Interfaces interfaces(mesh);
+    for (size_t i = 0; i < interfaces.pairs.size(); ++i)
+      file << "# triangle ref " << i + 1 << ": " << interface_group_name(interfaces.pairs[i], info)
+           << '\n';
+    file << "\nTriangles\n" << interfaces.faces.size() << '\n';
+    for (size_t f = 0; f < interfaces.faces.size(); ++f) {
+      for (uint32_t v : interfaces.faces[f].points) file << v + 1 << ' ';
+      file << interfaces.index[f] + 1 << '\n';
+    }
+  } else {
+    const auto faces = label_boundary_faces(mesh);
+    file << "\nTriangles\n" << faces.size() << '\n';
+    for (const auto& face : faces) {
+      for (uint32_t v : face.points) file << v + 1 << ' ';
+      file << face.label << '\n';
+    }
   }
   file << "\nTetrahedra\n" << mesh.tetrahedra.size() << '\n';
   for (size_t i = 0; i < mesh.tetrahedra.size(); ++i) {
@@ -156,6 +240,17 @@ absl::Status write_abaqus(const TetMesh& mesh, const VolumeFileInfo& info,
       file << faces[i].tet + 1 << ", S" << kFaceByOmittedNode[faces[i].across] << '\n';
     begin = end;
   }
+  if (info.interfaces) {
+    const Interfaces interfaces(mesh);
+    for (size_t f = 0; f < interfaces.faces.size(); ++f) {
+      const auto& face = interfaces.faces[f];
+      if (f == 0 || interfaces.index[f] != interfaces.index[f - 1]) {
+        file << "*SURFACE, TYPE=ELEMENT, NAME="
+             << upper_case(interface_group_name(face.labels, info)) << '\n';
+      }
+      file << face.tet + 1 << ", S" << kFaceByOmittedNode[face.across] << '\n';
+    }
+  }
   return file.finish();
 }
 
@@ -198,6 +293,20 @@ std::string label_group_name(int32_t label, const VolumeFileInfo& info) {
   std::replace(slug.begin(), slug.end(), '-', '_');
   if (!slug.empty()) group += cat("_", slug);
   return group;
+}
+
+std::string interface_group_name(const std::array<int32_t, 2>& labels, const VolumeFileInfo& info) {
+  return cat(label_group_name(labels[0], info), "__",
+             labels[1] == 0 ? std::string("outside") : label_group_name(labels[1], info));
+}
+
+std::string interfaces_vtu_path(const std::string& vtu_path) {
+  constexpr std::string_view kSuffix = ".vtu";
+  const bool has_suffix =
+      vtu_path.size() >= kSuffix.size() &&
+      std::string_view(vtu_path).substr(vtu_path.size() - kSuffix.size()) == kSuffix;
+  return (has_suffix ? vtu_path.substr(0, vtu_path.size() - kSuffix.size()) : vtu_path) +
+         "_interfaces.vtu";
 }
 
 absl::Status write_volume_mesh(const TetMesh& mesh, const std::vector<double>& cell_quality,

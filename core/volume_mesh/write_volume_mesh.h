@@ -22,7 +22,18 @@ struct VolumeFileInfo {
   std::map<int32_t, std::string> label_names;
   // Points are written in this frame; the files that have comments or field data say which.
   CoordinateFrame frame = CoordinateFrame::kLps;
+  // A conforming mesh's interfaces (interface_faces): each face between two
+  // labels, or between a label and the outside, written once and grouped by
+  // label pair, as described for each format below.
+  bool interfaces = false;
 };
+
+// The name of an interface's group: "<label group>__<label group>", or
+// "<label group>__outside" on the outer boundary.
+std::string interface_group_name(const std::array<int32_t, 2>& labels, const VolumeFileInfo& info);
+
+// Where the VTU writer puts the interfaces: "x_interfaces.vtu" beside "x.vtu".
+std::string interfaces_vtu_path(const std::string& vtu_path);
 
 // "label_<N>" or "label_<N>_<slug of the name>": a group name every format accepts.
 std::string label_group_name(int32_t label, const VolumeFileInfo& info);
@@ -51,6 +62,17 @@ std::string label_group_name(int32_t label, const VolumeFileInfo& info);
 //   Labels must be positive.
 // - kTetgen: `path` must end in ".node"; writes it and the .ele beside it, 1-based, with the
 //   label as each tetrahedron's region attribute.
+//
+// With info.interfaces, interface i (1-based, in label-pair order) is also written:
+// - kVtu: a second file (interfaces_vtu_path) of the same points and the interface triangles,
+//   cell arrays "interface" (i), "label_inside" and "label_outside" (the face's normal points
+//   from the first into the second; 0 is the outside).
+// - kMsh: triangles (type 2) after the tetrahedra, in 2D physical group i named by
+//   interface_group_name; no quality block (element data would have to cover the triangles).
+// - kMedit: the triangles are the interface faces, once each, with ref = i (comments name them),
+//   instead of each label's boundary.
+// - kAbaqus: also *SURFACE, TYPE=ELEMENT, NAME=<interface group in upper case> per interface,
+//   the faces taken from the first label's elements.
 //
 // Errors: INVALID_ARGUMENT naming the file when the mesh is malformed (see check_tet_mesh), the
 // quality count is wrong, a label is not positive where it must be, or a TetGen path does not
