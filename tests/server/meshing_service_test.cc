@@ -210,6 +210,37 @@ TEST_F(MeshingServiceTest, HexahedraOnlyJobsListTheLabelsLeftOut) {
   EXPECT_EQ(served.files_size(), 0);
 }
 
+TEST_F(MeshingServiceTest, ConformingJobsShareInterfacesAsInTheCli) {
+  ServiceHarness service(config_);
+  const fs::path input = write_phantom(dir_, volume::PhantomShape::kNestedSpheres);
+  v1::MeshOptions options;
+  options.set_volume(v1::VOLUME_METHOD_CONFORMING);
+  options.add_formats("vtu");
+  options.add_formats("msh");
+  const v1::Job job = finished_job(service, input, options);
+  ASSERT_EQ(job.state(), v1::JOB_STATE_SUCCEEDED) << job.error().message();
+  const v1::VolumeMeshSummary& served = job.report().volume();
+  EXPECT_EQ(served.mesher(), "conforming");
+  EXPECT_TRUE(served.conforming());
+  // Ball, two shells: (1,2), (2,3) and (3, outside).
+  EXPECT_EQ(served.conforming_figures().interfaces(), 3u);
+  EXPECT_GT(served.conforming_figures().interface_faces(), 0u);
+  EXPECT_EQ(served.conforming_figures().labels_size(), 3);
+  EXPECT_EQ(served.inverted(), 0u);
+  EXPECT_EQ(job.report().surfaces_size(), 3);
+
+  // The same job in this process gives the same mesh.
+  auto params = params_from_options(options);
+  ASSERT_TRUE(params.ok());
+  auto local = run_pipeline(input.string(), *params, {});
+  ASSERT_TRUE(local.ok()) << local.status();
+  const v1::VolumeMeshSummary mine = make_report(*local, *params).volume();
+  EXPECT_EQ(served.tetrahedra(), mine.tetrahedra());
+  EXPECT_EQ(served.nodes(), mine.nodes());
+  EXPECT_EQ(served.tetra_quality_min(), mine.tetra_quality_min());
+  EXPECT_EQ(served.files_size(), 3);  // volume.vtu, volume_interfaces.vtu, volume.msh
+}
+
 TEST_F(MeshingServiceTest, FullQueueRefusesWithResourceExhausted) {
   config_.workers = 0;  // Nothing starts: the queue only fills.
   config_.queue_capacity = 2;

@@ -95,8 +95,8 @@ def check_gmsh(work, report):
           "physical name label_255_liver")
 
 
-def check_calculix(work, nodes, fixed):
-    run = subprocess.run(["ccx", "-i", "liver"], cwd=work, capture_output=True, text=True,
+def check_calculix(work, nodes, fixed, job="liver"):
+    run = subprocess.run(["ccx", "-i", job], cwd=work, capture_output=True, text=True,
                          timeout=1200)
     text = run.stdout + run.stderr
     (work / "ccx.log").write_text(text)
@@ -108,7 +108,7 @@ def check_calculix(work, nodes, fixed):
         fail("ccx did not finish: " + text[-2000:])
     displacements = {}
     in_table = False
-    for line in (work / "liver.dat").read_text().splitlines():
+    for line in (work / f"{job}.dat").read_text().splitlines():
         if "displacements" in line:
             in_table = True
             continue
@@ -127,6 +127,7 @@ def check_calculix(work, nodes, fixed):
         fail(f"the largest displacement {u} does not point down")
     print(f"ccx: {len(fixed)} fixed nodes, largest displacement {math.dist((0, 0, 0), u):.3g} mm "
           f"at node {largest} (z {nodes[largest][2]:.1f} mm), no error or Jacobian warning")
+    return displacements
 
 
 def main():
