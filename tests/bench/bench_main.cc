@@ -447,95 +447,121 @@ std::vector<double> volume_errors_percent(
   return errors;
 }
 
-// One conforming mesh of every label of `path`, in this (child) process.
-int bench_conforming_file(const std::string& path) {
+// One conforming mesh of every label of `path`, in this (child) process: its
+// figures, then CGAL Mesh_3 on the same labels, run in turn `pairs` times.
+int bench_conforming_file(const std::string& path, int pairs) {
   using namespace labelmesh;
   auto volume = volume::read_label_volume(path, {}, {});
   if (!volume.ok()) {
     std::fprintf(stderr, "%s\n", std::string(volume.status().message()).c_str());
     return 1;
   }
-  conforming::ConformingParams params;
-  if (getenv("LM_KEEP")) params.tetgen.keep_boundary = atoi(getenv("LM_KEEP"));
-  if (getenv("LM_ROUNDS")) params.interfaces.smoothing_rounds = atoi(getenv("LM_ROUNDS"));
-  if (getenv("LM_ANGLE")) params.tetgen.min_dihedral_deg = atof(getenv("LM_ANGLE"));
-  conforming::ConformingFigures figures;
-  volume_mesh::ImproveFigures improve;
-  const auto start = Clock::now();
-  auto mesh = conforming::mesh_conforming(*volume, {}, params, RunContext{}, figures, improve);
-  const double seconds = seconds_since(start);
-  if (!mesh.ok()) {
-    std::fprintf(stderr, "%s: %s\n", path.c_str(), std::string(mesh.status().message()).c_str());
-    return 1;
-  }
-  quality::QualitySummary summary;
-  for (size_t t = 0; t < mesh->tetrahedra.size(); ++t) {
-    const auto& v = mesh->tetrahedra[t];
-    const quality::Tet tet{mesh->points[v[0]], mesh->points[v[1]], mesh->points[v[2]],
-                           mesh->points[v[3]]};
-    summary.add(quality::tetra_quality(tet));
-    summary.add_dihedral_range(quality::tetra_dihedral_range_deg(tet));
-  }
-  {
-    size_t bad = 0, bad_all_surface = 0, bad_three = 0;
-    const size_t ns = figures.interfaces.points;
+  const auto& spacing = volume->geometry.spacing;
+  const double voxel = std::cbrt(spacing[0] * spacing[1] * spacing[2]);
+  bench::Mesh3Sizing sizing{voxel, 0.5 * voxel, voxel};
+  std::vector<double> ours_seconds, mesh3_seconds;
+  for (int pair = 0; pair < pairs; ++pair) {
+    conforming::ConformingFigures figures;
+    volume_mesh::ImproveFigures improve;
+    const auto start = Clock::now();
+    auto mesh = conforming::mesh_conforming(*volume, {}, {}, RunContext{}, figures, improve);
+    ours_seconds.push_back(seconds_since(start));
+    if (!mesh.ok()) {
+      std::fprintf(stderr, "%s: %s\n", path.c_str(), std::string(mesh.status().message()).c_str());
+      return 1;
+    }
+    auto mesh3 = bench::mesh_labels_with_mesh3(*volume, sizing);
+    if (!mesh3.ok()) {
+      std::fprintf(stderr, "%s: %s\n", path.c_str(), std::string(mesh3.status().message()).c_str());
+      return 1;
+    }
+    mesh3_seconds.push_back(mesh3->seconds);
+    if (pair > 0) continue;
+
+    const auto summary = volume_mesh::summarise_quality(*mesh);
+    size_t below = 0;
     for (size_t t = 0; t < mesh->tetrahedra.size(); ++t) {
       const auto& v = mesh->tetrahedra[t];
       const quality::Tet tet{mesh->points[v[0]], mesh->points[v[1]], mesh->points[v[2]],
                              mesh->points[v[3]]};
-      const auto range = quality::tetra_dihedral_range_deg(tet);
-      if (quality::tetra_quality(tet) >= 0.2 && range.first >= 10) continue;
-      ++bad;
-      int on = 0;
-      for (auto p : v) on += p < ns;
-      bad_all_surface += on == 4;
-      bad_three += on == 3;
+      below +=
+          quality::tetra_quality(tet) < 0.2 || quality::tetra_dihedral_range_deg(tet).first < 10;
     }
-    std::printf("  bad (Q<0.2 or dihedral<10): %zu, all four on the surface %zu, three %zu\n", bad,
-                bad_all_surface, bad_three);
+    auto errors = volume_errors_percent(figures.labels);
+    const double median = percentile(errors, 0.5), p90 = percentile(errors, 0.9);
+    const auto& i = figures.interfaces;
+    const auto& c = figures.conformity;
+    std::printf("%s: conforming mesh of %zu labels\n", path.c_str(), figures.labels.size());
+    std::printf(
+        "  interfaces   %8.3f s  %zu points (%zu on junctions, %zu fixed), %zu triangles, "
+        "within %.2f mm of the voxel boundary\n",
+        i.seconds, i.points, i.junction_points, i.fixed_points, i.triangles, i.max_offset_mm);
+    std::printf("  crossings    repairs %d, points restored %zu, staircase only %d\n",
+                figures.crossing_repairs, figures.restored_points, int(figures.staircase_only));
+    std::printf("  tetgen       %8.3f s  %zu tetrahedra, %zu regions (%zu outside)\n",
+                figures.tetgen.seconds, figures.tetgen.tetrahedra, figures.regions.regions,
+                figures.regions.outside_regions);
+    std::printf("  slides       %8.3f s  %zu points moved; below Q 0.3 or 15 deg %zu -> %zu\n",
+                figures.slide.seconds, figures.slide.points_moved,
+                figures.slide.tetrahedra_below_before, figures.slide.tetrahedra_below_after);
+    std::printf("  improvement  %8.3f s  Q min %.3f -> %.3f\n", improve.seconds,
+                improve.quality_min_before, improve.quality_min_after);
+    std::printf(
+        "  ours         %zu tetrahedra, %zu nodes, Q min %.3f mean %.3f, dihedral "
+        "%.1f-%.1f, below Q 0.2 or 10 deg %zu\n",
+        mesh->tetrahedra.size(), mesh->points.size(), summary.min, summary.mean,
+        summary.min_dihedral_deg, summary.max_dihedral_deg, below);
+    std::printf(
+        "  conformity   %s; %zu interfaces, %zu shared faces, %zu outer faces, volume "
+        "gap %.1e\n",
+        c.ok() ? "ok" : c.failures().c_str(), c.interfaces, c.interface_faces, c.outer_faces,
+        c.volume_gap_fraction());
+    std::printf(
+        "  ours volume error, %zu labels >= 1000 voxels: median %.2f %%, p90 %.2f %%, "
+        "max %.2f %%\n",
+        errors.size(), median, p90, errors.empty() ? 0.0 : errors.back());
+    std::vector<conforming::LabelVolumeFigures> theirs;
+    for (const auto& figure : figures.labels) {
+      auto copy = figure;
+      copy.mesh_volume_mm3 = 0;
+      copy.tetrahedra = 0;
+      for (const auto& label : mesh3->labels) {
+        if (label.label == figure.label) {
+          copy.mesh_volume_mm3 = label.volume_mm3;
+          copy.tetrahedra = label.tetrahedra;
+        }
+      }
+      theirs.push_back(copy);
+    }
+    auto mesh3_errors = volume_errors_percent(theirs);
+    const double mesh3_median = percentile(mesh3_errors, 0.5);
+    const double mesh3_p90 = percentile(mesh3_errors, 0.9);
+    size_t mesh3_missing = 0;
+    for (const auto& label : theirs) mesh3_missing += label.tetrahedra == 0;
+    const auto& m = mesh3->quality;
+    std::printf(
+        "  Mesh_3       %zu tetrahedra, %zu nodes, Q min %.3f mean %.3f, dihedral "
+        "%.1f-%.1f; labels without cells %zu (facet size %.2f, distance %.2f, cell "
+        "size %.2f mm)\n",
+        mesh3->tetrahedra, mesh3->nodes, m.min, m.mean, m.min_dihedral_deg, m.max_dihedral_deg,
+        mesh3_missing, sizing.facet_size_mm, sizing.facet_distance_mm, sizing.cell_size_mm);
+    std::printf("  Mesh_3 volume error: median %.2f %%, p90 %.2f %%, max %.2f %%\n", mesh3_median,
+                mesh3_p90, mesh3_errors.empty() ? 0.0 : mesh3_errors.back());
   }
-  auto errors = volume_errors_percent(figures.labels);
-  const double median = percentile(errors, 0.5), p90 = percentile(errors, 0.9);
-  const auto& i = figures.interfaces;
-  const auto& c = figures.conformity;
-  std::printf("%s: conforming mesh of %zu labels\n", path.c_str(), figures.labels.size());
-  std::printf(
-      "  interfaces   %8.3f s  %zu points (%zu on junctions, %zu fixed), %zu triangles, "
-      "max offset %.2f mm\n",
-      i.seconds, i.points, i.junction_points, i.fixed_points, i.triangles, i.max_offset_mm);
-  std::printf("  crossings    repairs %d, points restored %zu, staircase only %d\n",
-              figures.crossing_repairs, figures.restored_points, int(figures.staircase_only));
-  std::printf(
-      "  tetgen       %8.3f s  %zu tetrahedra, %zu Steiner points, %zu regions (%zu outside)\n",
-      figures.tetgen.seconds, figures.tetgen.tetrahedra, figures.tetgen.steiner_points,
-      figures.regions.regions, figures.regions.outside_regions);
-  std::printf("  improvement  %8.3f s  Q min %.3f -> %.3f\n", improve.seconds,
-              improve.quality_min_before, improve.quality_min_after);
-  std::printf("  slides       %8.3f s  %zu points moved; below targets %zu -> %zu\n",
-              figures.slide.seconds, figures.slide.points_moved,
-              figures.slide.tetrahedra_below_before, figures.slide.tetrahedra_below_after);
-  std::printf(
-      "  mesh         %zu tetrahedra, %zu points, Q min %.3f mean %.3f, dihedral %.1f-%.1f\n",
-      mesh->tetrahedra.size(), mesh->points.size(), summary.min, summary.mean,
-      summary.min_dihedral_deg, summary.max_dihedral_deg);
-  std::printf(
-      "  conformity   %s; %zu interfaces, %zu interface faces, %zu outer faces, "
-      "volume gap %.2e\n",
-      c.ok() ? "ok" : c.failures().c_str(), c.interfaces, c.interface_faces, c.outer_faces,
-      c.volume_gap_fraction());
-  const size_t counted = errors.size();
-  std::printf(
-      "  volume error labels >= 1000 voxels (%zu): median %.2f %%, p90 %.2f %%, max %.2f %%\n",
-      counted, percentile(errors, 0.5), percentile(errors, 0.9),
-      errors.empty() ? 0.0 : errors.back());
-  std::printf("  total        %8.3f s, peak RSS %.1f MiB\n", seconds, peak_rss_mib());
+  for (int pair = 0; pair < pairs; ++pair) {
+    std::printf("  run %d        ours %.3f s, Mesh_3 %.3f s, ratio %.2f\n", pair + 1,
+                ours_seconds[pair], mesh3_seconds[pair], ours_seconds[pair] / mesh3_seconds[pair]);
+  }
+  std::printf("  peak RSS     %.1f MiB (both)\n", peak_rss_mib());
   return 0;
 }
 
 int bench_conforming(const std::vector<std::string>& files) {
   int failures = 0;
   for (const auto& file : files) {
-    if (!in_child([&] { return bench_conforming_file(file); })) ++failures;
+    // The first volume (the 61 labels) in turn twice, the others once.
+    const int pairs = &file == &files.front() ? 2 : 1;
+    if (!in_child([&] { return bench_conforming_file(file, pairs); })) ++failures;
   }
   return failures == 0 ? 0 : 1;
 }

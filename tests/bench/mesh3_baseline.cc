@@ -145,9 +145,8 @@ absl::StatusOr<Mesh3Figures> mesh_label_with_mesh3(const volume::LabelVolume& vo
 
 absl::StatusOr<Mesh3LabelsFigures> mesh_labels_with_mesh3(const volume::LabelVolume& volume,
                                                           const Mesh3Sizing& sizing) {
-  const auto& d = volume.geometry.direction;
-  if (d != std::array<double, 9>{1, 0, 0, 0, 1, 0, 0, 0, 1})
-    return absl::UnimplementedError("mesh3 baseline: only axis-aligned volumes");
+  // Meshed along the image's own axes: volumes and angles do not depend on
+  // how the axes are turned in patient space.
   if (!volume.more_layers.empty())
     return absl::UnimplementedError("mesh3 baseline: overlapping label layers");
   if (volume.voxels == nullptr ||

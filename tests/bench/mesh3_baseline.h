@@ -50,7 +50,8 @@ struct Mesh3Sizing {
 // interfaces shared. Every connected component of every label is seeded
 // (initialize_triangulation_from_labeled_image), then refined with facet angle 30 degrees,
 // radius-edge 3 and `sizing`, then perturbed and exuded. Randomness is seeded fixed so runs
-// repeat. Axis-aligned volumes with labels in [0, 65535] only, and no overlapping layers.
+// repeat. Meshed along the image's axes (the direction is ignored: volumes and angles do not
+// depend on it). Labels in [0, 65535] only, and no overlapping layers.
 absl::StatusOr<Mesh3LabelsFigures> mesh_labels_with_mesh3(const volume::LabelVolume& volume,
                                                           const Mesh3Sizing& sizing);
 
