@@ -3,7 +3,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <tuple>
 
 #include "core/util/text.h"
 #include "core/util/vec3.h"

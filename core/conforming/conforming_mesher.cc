@@ -3,11 +3,12 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <map>
 
 #include "core/util/text.h"
 #include "core/util/vec3.h"
-#include "core/volume/voxel_access.h"
+#include "core/volume/label_statistics.h"
 
 namespace labelmesh::conforming {
 namespace {
@@ -15,17 +16,10 @@ namespace {
 // Voxels per selected label (every non-zero label when `labels` is empty).
 std::vector<std::pair<int32_t, uint64_t>> voxel_counts(const volume::LabelVolume& volume,
                                                        const std::vector<int32_t>& labels) {
-  std::map<int32_t, uint64_t> counts;
-  volume::visit_voxels(volume.voxels, [&](const auto* voxels, size_t count) {
-    for (size_t i = 0; i < count; ++i) {
-      const auto label = static_cast<int32_t>(voxels[i]);
-      if (label != kOutside) ++counts[label];
-    }
-  });
   std::vector<std::pair<int32_t, uint64_t>> selected;
-  for (const auto& [label, count] : counts) {
-    if (labels.empty() || std::find(labels.begin(), labels.end(), label) != labels.end())
-      selected.push_back({label, count});
+  for (const auto& label : volume::compute_label_statistics(volume).labels) {
+    if (labels.empty() || std::find(labels.begin(), labels.end(), label.label) != labels.end())
+      selected.push_back({label.label, label.voxels});
   }
   return selected;
 }
@@ -56,6 +50,20 @@ absl::Status remove_crossings(InterfaceSurface& surface, int max_rounds, const R
 
 double LabelVolumeFigures::volume_change() const {
   return voxel_volume_mm3 > 0 ? (mesh_volume_mm3 - voxel_volume_mm3) / voxel_volume_mm3 : 0;
+}
+
+VolumeChangeSpread volume_change_spread(const std::vector<LabelVolumeFigures>& labels,
+                                        uint64_t min_voxels) {
+  std::vector<double> changes;
+  for (const auto& label : labels) {
+    if (label.voxels >= min_voxels) changes.push_back(std::abs(label.volume_change()));
+  }
+  if (changes.empty()) return {};
+  std::sort(changes.begin(), changes.end());
+  const auto at = [&](double q) {
+    return changes[static_cast<size_t>(std::lround(q * double(changes.size() - 1)))];
+  };
+  return {at(0.5), at(0.9), changes.back(), changes.size()};
 }
 
 std::vector<LabelVolumeFigures> label_volume_figures(

@@ -81,6 +81,18 @@ absl::StatusOr<volume_mesh::TetMesh> mesh_conforming(const volume::LabelVolume& 
                                                      ConformingFigures& figures,
                                                      volume_mesh::ImproveFigures& improve);
 
+// How far labels' volumes are from their voxels': over labels of at least
+// `min_voxels` voxels, the median, 90th percentile and largest |volume
+// change|, and how many labels that is (all zero when none).
+struct VolumeChangeSpread {
+  double median = 0;
+  double p90 = 0;
+  double max = 0;
+  size_t labels = 0;
+};
+VolumeChangeSpread volume_change_spread(const std::vector<LabelVolumeFigures>& labels,
+                                        uint64_t min_voxels);
+
 // The figures of each label of `mesh` against its voxel counts.
 std::vector<LabelVolumeFigures> label_volume_figures(
     const volume_mesh::TetMesh& mesh, const std::vector<std::pair<int32_t, uint64_t>>& voxels,

@@ -18,7 +18,9 @@ namespace labelmesh::conforming {
 namespace {
 
 using geometry::Vec3;
+using volume_mesh::fill_triangle_plc;
 using volume_mesh::run_tetgen;
+using volume_mesh::tetgen_point;
 
 constexpr std::string_view kStage = "tetgen";
 constexpr std::string_view kWhat = "the labels' interface surface";
@@ -43,34 +45,6 @@ absl::Status check_surface(const InterfaceSurface& surface) {
       return absl::InvalidArgumentError(cat(kWhat, ": triangle ", t, " repeats a corner"));
   }
   return absl::OkStatus();
-}
-
-// Each triangle is one facet whose marker is its index + 1.
-void fill_plc(const InterfaceSurface& surface, tetgenio& in) {
-  in.firstnumber = 0;
-  in.numberofpoints = static_cast<int>(surface.points.size());
-  in.pointlist = new REAL[3 * surface.points.size()];
-  for (size_t i = 0; i < surface.points.size(); ++i) {
-    for (int k = 0; k < 3; ++k) in.pointlist[3 * i + k] = surface.points[i][k];
-  }
-  in.facetlist = new tetgenio::facet[surface.triangles.size()]();
-  in.numberoffacets = static_cast<int>(surface.triangles.size());
-  in.facetmarkerlist = new int[surface.triangles.size()];
-  for (size_t i = 0; i < surface.triangles.size(); ++i) {
-    tetgenio::facet& facet = in.facetlist[i];
-    facet.polygonlist = new tetgenio::polygon[1]();
-    facet.numberofpolygons = 1;
-    tetgenio::polygon& polygon = facet.polygonlist[0];
-    polygon.vertexlist = new int[3];
-    polygon.numberofvertices = 3;
-    for (int k = 0; k < 3; ++k) polygon.vertexlist[k] = static_cast<int>(surface.triangles[i][k]);
-    in.facetmarkerlist[i] = static_cast<int>(i) + 1;
-  }
-}
-
-Vec3 out_point(const tetgenio& out, int index) {
-  const REAL* p = out.pointlist + 3 * static_cast<size_t>(index);
-  return {p[0], p[1], p[2]};
 }
 
 const int* out_tet(const tetgenio& out, size_t t) { return out.tetrahedronlist + 4 * t; }
@@ -124,7 +98,7 @@ absl::StatusOr<std::vector<int32_t>> region_labels(const InterfaceSurface& surfa
       const Vec3& p0 = surface.points[tri[0]];
       const Vec3 normal = geometry::cross(geometry::sub(surface.points[tri[1]], p0),
                                           geometry::sub(surface.points[tri[2]], p0));
-      const double side = geometry::dot(normal, geometry::sub(out_point(out, v[across]), p0));
+      const double side = geometry::dot(normal, geometry::sub(tetgen_point(out, v[across]), p0));
       if (side == 0) continue;
       const auto& sides = surface.sides[it->second];
       ++votes[sets.find(static_cast<uint32_t>(t))][side < 0 ? sides[0] : sides[1]];
@@ -190,7 +164,7 @@ absl::StatusOr<volume_mesh::TetMesh> labelled_mesh(const InterfaceSurface& surfa
   for (size_t p = 0; p < out_points; ++p) {
     if (new_index[p] == kUnused) continue;
     new_index[p] = static_cast<uint32_t>(mesh.points.size());
-    mesh.points.push_back(out_point(out, static_cast<int>(p)));
+    mesh.points.push_back(tetgen_point(out, static_cast<int>(p)));
   }
   for (size_t t = 0; t < tet_count; ++t) {
     if ((*labels)[t] == kOutside) continue;
@@ -210,7 +184,7 @@ absl::StatusOr<volume_mesh::TetMesh> labelled_mesh(const InterfaceSurface& surfa
 absl::StatusOr<std::vector<uint32_t>> crossing_points(const InterfaceSurface& surface) {
   if (auto status = check_surface(surface); !status.ok()) return status;
   tetgenio in;
-  fill_plc(surface, in);
+  fill_triangle_plc(surface.points, surface.triangles, in);
   tetgenio check;
   if (auto status = run_tetgen("pdzQ", in, check, kWhat); !status.ok()) return status;
   std::vector<uint32_t> points;
@@ -237,7 +211,7 @@ absl::StatusOr<volume_mesh::TetMesh> tetrahedralize_interfaces(
   absl::StatusOr<volume_mesh::TetMesh> result;
   try {
     tetgenio in;
-    fill_plc(surface, in);
+    fill_triangle_plc(surface.points, surface.triangles, in);
     tetgenio out;
     // -n: neighbours, to find the regions; the faces TetGen lists are the constrained ones, marked.
     const std::string switches = volume_mesh::tetgen_quality_switches(params) + "nzQ";

@@ -83,22 +83,6 @@ v1::VolumeMeshSummary make_mixed_summary(const MixedVolumeResult& mixed) {
   return entry;
 }
 
-// The median and 90th percentile of |volume change| over labels of at least
-// kSmallLabelVoxels voxels.
-std::pair<double, double> volume_change_percentiles(
-    const std::vector<conforming::LabelVolumeFigures>& labels) {
-  std::vector<double> changes;
-  for (const auto& label : labels) {
-    if (label.voxels >= kSmallLabelVoxels) changes.push_back(std::abs(label.volume_change()));
-  }
-  if (changes.empty()) return {0, 0};
-  std::sort(changes.begin(), changes.end());
-  const auto at = [&](double q) {
-    return changes[static_cast<size_t>(std::lround(q * double(changes.size() - 1)))];
-  };
-  return {at(0.5), at(0.9)};
-}
-
 void add_conforming_figures(const conforming::ConformingFigures& figures,
                             v1::VolumeMeshSummary& entry) {
   const auto& check = figures.conformity;
@@ -116,10 +100,6 @@ void add_conforming_figures(const conforming::ConformingFigures& figures,
   out->set_outer_faces(check.outer_faces);
   out->set_interface_offset_max_mm(figures.interfaces.max_offset_mm);
   out->set_volume_gap(check.volume_gap_fraction());
-  out->set_inverted_tetrahedra(check.inverted_tetrahedra);
-  out->set_overshared_faces(check.overshared_faces);
-  out->set_duplicate_points(check.duplicate_points);
-  out->set_open_boundary_edges(check.open_boundary_edges);
   out->set_crossing_repairs(figures.crossing_repairs);
   out->set_restored_points(figures.restored_points);
   out->set_staircase_only(figures.staircase_only);
@@ -136,9 +116,9 @@ void add_conforming_figures(const conforming::ConformingFigures& figures,
     l->set_tetrahedra(label.tetrahedra);
     l->set_volume_change(label.volume_change());
   }
-  const auto [median, p90] = volume_change_percentiles(figures.labels);
-  out->set_volume_change_median(median);
-  out->set_volume_change_p90(p90);
+  const auto spread = conforming::volume_change_spread(figures.labels, kSmallLabelVoxels);
+  out->set_volume_change_median(spread.median);
+  out->set_volume_change_p90(spread.p90);
 }
 
 v1::VolumeMeshSummary make_volume_summary(const VolumeResult& volume) {

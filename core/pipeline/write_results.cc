@@ -124,7 +124,11 @@ absl::Status write_all(MeshResult& result, const MeshParams& params, const std::
     StageTimer timer(result.stages, "write_volume");
     result.volume->files.clear();
     auto volume_info = info;
-    volume_info.interfaces = result.volume->conforming.has_value();
+    std::vector<volume_mesh::InterfaceFace> interfaces;
+    if (result.volume->conforming) {
+      interfaces = volume_mesh::interface_faces(result.volume->mesh);
+      volume_info.interfaces = &interfaces;
+    }
     for (auto format : params.volume_formats) {
       const std::string name = cat("volume.", volume_mesh::volume_format_name(format));
       const auto path = (std::filesystem::path(out_dir) / name).string();
@@ -133,7 +137,7 @@ absl::Status write_all(MeshResult& result, const MeshParams& params, const std::
           !s.ok())
         return s;
       result.volume->files.push_back(name);
-      if (volume_info.interfaces && format == volume_mesh::VolumeFormat::kVtu)
+      if (volume_info.interfaces != nullptr && format == volume_mesh::VolumeFormat::kVtu)
         result.volume->files.push_back(volume_mesh::interfaces_vtu_path(name));
       // TetGen's pair: the .ele beside the .node.
       if (format == volume_mesh::VolumeFormat::kTetgen)

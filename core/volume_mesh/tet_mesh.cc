@@ -34,40 +34,16 @@ const std::array<uint8_t, 3>& outward_face(uint8_t across) {
 }
 
 std::vector<BoundaryFace> label_boundary_faces(const TetMesh& mesh) {
-  struct Entry {
-    int32_t label;
-    std::array<uint32_t, 3> key;  // sorted point indices
-    uint32_t tet;
-    uint8_t across;
-  };
-  std::vector<Entry> entries;
-  entries.reserve(4 * mesh.tetrahedra.size());
-  for (size_t t = 0; t < mesh.tetrahedra.size(); ++t) {
-    for (uint8_t across = 0; across < 4; ++across) {
-      const auto& local = outward_face(across);
-      std::array<uint32_t, 3> key{mesh.tetrahedra[t][local[0]], mesh.tetrahedra[t][local[1]],
-                                  mesh.tetrahedra[t][local[2]]};
-      std::sort(key.begin(), key.end());
-      entries.push_back({mesh.labels[t], key, static_cast<uint32_t>(t), across});
-    }
-  }
-  std::sort(entries.begin(), entries.end(), [](const Entry& a, const Entry& b) {
-    return std::tie(a.label, a.key, a.tet, a.across) < std::tie(b.label, b.key, b.tet, b.across);
-  });
   std::vector<BoundaryFace> faces;
-  for (size_t i = 0; i < entries.size();) {
-    size_t j = i + 1;
-    while (j < entries.size() && entries[j].label == entries[i].label &&
-           entries[j].key == entries[i].key)
-      ++j;
-    if (j - i == 1) {
-      const Entry& e = entries[i];
-      const auto& local = outward_face(e.across);
-      const auto& tet = mesh.tetrahedra[e.tet];
-      faces.push_back({e.tet, e.label, e.across, {tet[local[0]], tet[local[1]], tet[local[2]]}});
+  for_each_face(mesh, [&](const FaceUse* uses, size_t count) {
+    for (size_t i = 0; i < count; ++i) {
+      const int32_t label = mesh.labels[uses[i].tet];
+      size_t same_label = 0;
+      for (size_t j = 0; j < count; ++j) same_label += mesh.labels[uses[j].tet] == label;
+      if (same_label == 1)
+        faces.push_back({uses[i].tet, label, uses[i].across, face_points(mesh, uses[i])});
     }
-    i = j;
-  }
+  });
   std::sort(faces.begin(), faces.end(), [](const BoundaryFace& a, const BoundaryFace& b) {
     return std::tie(a.label, a.tet, a.across) < std::tie(b.label, b.tet, b.across);
   });

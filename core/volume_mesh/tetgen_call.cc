@@ -88,6 +88,35 @@ absl::Status check_tetgen_params(const TetgenParams& params) {
   return absl::OkStatus();
 }
 
+void fill_triangle_plc(const std::vector<std::array<double, 3>>& points,
+                       const std::vector<std::array<uint32_t, 3>>& triangles, tetgenio& in) {
+  in.firstnumber = 0;
+  in.numberofpoints = static_cast<int>(points.size());
+  in.pointlist = new REAL[3 * points.size()];
+  for (size_t i = 0; i < points.size(); ++i) {
+    for (int k = 0; k < 3; ++k) in.pointlist[3 * i + k] = points[i][k];
+  }
+  // Value-initialised, so that tetgenio's destructor finds null lists if an allocation fails.
+  in.facetlist = new tetgenio::facet[triangles.size()]();
+  in.numberoffacets = static_cast<int>(triangles.size());
+  in.facetmarkerlist = new int[triangles.size()];
+  for (size_t i = 0; i < triangles.size(); ++i) {
+    tetgenio::facet& facet = in.facetlist[i];
+    facet.polygonlist = new tetgenio::polygon[1]();
+    facet.numberofpolygons = 1;
+    tetgenio::polygon& polygon = facet.polygonlist[0];
+    polygon.vertexlist = new int[3];
+    polygon.numberofvertices = 3;
+    for (int k = 0; k < 3; ++k) polygon.vertexlist[k] = static_cast<int>(triangles[i][k]);
+    in.facetmarkerlist[i] = static_cast<int>(i) + 1;
+  }
+}
+
+std::array<double, 3> tetgen_point(const tetgenio& out, int index) {
+  const REAL* p = out.pointlist + 3 * static_cast<size_t>(index);
+  return {p[0], p[1], p[2]};
+}
+
 std::string tetgen_quality_switches(const TetgenParams& params) {
   std::string switches = cat("pq", switch_number(params.radius_edge_ratio), "/",
                              switch_number(params.min_dihedral_deg));

@@ -91,35 +91,6 @@ size_t component_count(const Boundary& boundary) {
   return count;
 }
 
-// Each triangle is one facet whose marker is its index + 1, so output faces name their triangle.
-void fill_plc(const Boundary& boundary, tetgenio& in) {
-  in.firstnumber = 0;
-  in.numberofpoints = static_cast<int>(boundary.points.size());
-  in.pointlist = new REAL[3 * boundary.points.size()];
-  for (size_t i = 0; i < boundary.points.size(); ++i) {
-    for (int k = 0; k < 3; ++k) in.pointlist[3 * i + k] = boundary.points[i][k];
-  }
-  // Value-initialised, so that tetgenio's destructor finds null lists if an allocation fails.
-  in.facetlist = new tetgenio::facet[boundary.triangles.size()]();
-  in.numberoffacets = static_cast<int>(boundary.triangles.size());
-  in.facetmarkerlist = new int[boundary.triangles.size()];
-  for (size_t i = 0; i < boundary.triangles.size(); ++i) {
-    tetgenio::facet& facet = in.facetlist[i];
-    facet.polygonlist = new tetgenio::polygon[1]();
-    facet.numberofpolygons = 1;
-    tetgenio::polygon& polygon = facet.polygonlist[0];
-    polygon.vertexlist = new int[3];
-    polygon.numberofvertices = 3;
-    for (int k = 0; k < 3; ++k) polygon.vertexlist[k] = static_cast<int>(boundary.triangles[i][k]);
-    in.facetmarkerlist[i] = static_cast<int>(i) + 1;
-  }
-}
-
-Vec3 out_point(const tetgenio& out, int index) {
-  const REAL* p = out.pointlist + 3 * static_cast<size_t>(index);
-  return {p[0], p[1], p[2]};
-}
-
 std::array<int, 4> out_tet(const tetgenio& out, size_t t) {
   const int* v = out.tetrahedronlist + 4 * t;
   return {v[0], v[1], v[2], v[3]};
@@ -127,9 +98,9 @@ std::array<int, 4> out_tet(const tetgenio& out, size_t t) {
 
 double out_volume6(const tetgenio& out, const std::array<int, 4>& v) {
   using geometry::cross, geometry::dot, geometry::sub;
-  const Vec3 p0 = out_point(out, v[0]);
-  return dot(sub(out_point(out, v[1]), p0),
-             cross(sub(out_point(out, v[2]), p0), sub(out_point(out, v[3]), p0)));
+  const Vec3 p0 = tetgen_point(out, v[0]);
+  return dot(sub(tetgen_point(out, v[1]), p0),
+             cross(sub(tetgen_point(out, v[2]), p0), sub(tetgen_point(out, v[3]), p0)));
 }
 
 // Points inside the cavities of a nested boundary. TetGen keeps every region the boundary
@@ -198,7 +169,7 @@ absl::StatusOr<std::vector<Vec3>> cavity_points(const Boundary& boundary, const 
     for (auto it = std::lower_bound(faces.begin(), faces.end(), probe, by_key);
          it != faces.end() && it->key == key; ++it) {
       const int opposite = out_tet(cdt, it->tet)[it->across];
-      const double side = geometry::dot(normal, geometry::sub(out_point(cdt, opposite), a));
+      const double side = geometry::dot(normal, geometry::sub(tetgen_point(cdt, opposite), a));
       if (side != 0) votes[regions.find(it->tet)] += side < 0 ? 1 : -1;
     }
   }
@@ -215,7 +186,7 @@ absl::StatusOr<std::vector<Vec3>> cavity_points(const Boundary& boundary, const 
     if (volume6 <= largest[root]) continue;
     largest[root] = volume6;
     Vec3 centroid{0, 0, 0};
-    for (int k = 0; k < 4; ++k) centroid = geometry::add(centroid, out_point(cdt, v[k]));
+    for (int k = 0; k < 4; ++k) centroid = geometry::add(centroid, tetgen_point(cdt, v[k]));
     holes_by_root[root] = geometry::scale(centroid, 0.25);
   }
   if (!any_material) {
@@ -248,7 +219,7 @@ absl::StatusOr<TetMesh> run(const surface::TriangleMesh& mesh, int32_t label,
   context.report(kStage, 0);
 
   tetgenio in;
-  fill_plc(*boundary, in);
+  fill_triangle_plc(boundary->points, boundary->triangles, in);
 
   // -d reports intersecting facets instead of failing, which TetGen 1.5.0 cannot do safely.
   {
@@ -309,7 +280,7 @@ absl::StatusOr<TetMesh> run(const surface::TriangleMesh& mesh, int32_t label,
   for (size_t v = 0; v < out_points; ++v) {
     if (new_index[v] == kUnused) continue;
     new_index[v] = static_cast<uint32_t>(result.points.size());
-    result.points.push_back(out_point(out, static_cast<int>(v)));
+    result.points.push_back(tetgen_point(out, static_cast<int>(v)));
   }
   // TetGen 1.5 already writes tetrahedra in VTK's orientation (checked on its output: every
   // dot(p1 - p0, (p2 - p0) x (p3 - p0)) is positive), so corners are copied in order. The check

@@ -40,12 +40,12 @@ std::string name_of(int32_t label, const VolumeFileInfo& info) {
 
 // A conforming mesh's interface faces, each with its interface's index.
 struct Interfaces {
-  std::vector<InterfaceFace> faces;
+  const std::vector<InterfaceFace>& faces;
   std::vector<std::array<int32_t, 2>> pairs;
   std::vector<size_t> index;  // per face: its pair's index in `pairs`
 
-  explicit Interfaces(const TetMesh& mesh)
-      : faces(interface_faces(mesh)), pairs(interface_pairs(faces)) {
+  explicit Interfaces(const std::vector<InterfaceFace>& all)
+      : faces(all), pairs(interface_pairs(all)) {
     index.reserve(faces.size());
     for (size_t f = 0, i = 0; f < faces.size(); ++f) {
       while (pairs[i] != faces[f].labels) ++i;
@@ -72,7 +72,7 @@ vtkNew<vtkIntArray> int_array(const char* name, size_t size) {
 
 absl::Status write_interfaces_vtu(const TetMesh& mesh, const VolumeFileInfo& info,
                                   const std::string& path) {
-  const Interfaces interfaces(mesh);
+  const Interfaces interfaces(*info.interfaces);
   vtkNew<vtkCellArray> cells;
   auto id = int_array("interface", interfaces.faces.size());
   auto inside = int_array("label_inside", interfaces.faces.size());
@@ -97,7 +97,7 @@ absl::Status write_interfaces_vtu(const TetMesh& mesh, const VolumeFileInfo& inf
 
 absl::Status write_vtu(const TetMesh& mesh, const std::vector<double>& quality,
                        const VolumeFileInfo& info, const std::string& path) {
-  if (info.interfaces) {
+  if (info.interfaces != nullptr) {
     if (auto status = write_interfaces_vtu(mesh, info, interfaces_vtu_path(path)); !status.ok())
       return status;
   }
@@ -133,8 +133,8 @@ absl::Status write_msh(const TetMesh& mesh, const std::vector<double>& quality,
   if (auto status = check_positive_labels(mesh.labels, path, "MSH"); !status.ok()) return status;
   std::optional<Interfaces> interfaces;
   std::vector<std::string> surface_names;
-  if (info.interfaces) {
-    interfaces.emplace(mesh);
+  if (info.interfaces != nullptr) {
+    interfaces.emplace(*info.interfaces);
     for (const auto& pair : interfaces->pairs)
       surface_names.push_back(interface_group_name(pair, info));
   }
@@ -174,8 +174,8 @@ absl::Status write_msh(const TetMesh& mesh, const std::vector<double>& quality,
 absl::Status write_medit(const TetMesh& mesh, const VolumeFileInfo& info, const std::string& path) {
   TextFile file(path, "the volume mesh");
   write_medit_head(file, mesh.labels, mesh.points, info);
-  if (info.interfaces) {
-    const Interfaces interfaces(mesh);
+  if (info.interfaces != nullptr) {
+    const Interfaces interfaces(*info.interfaces);
     for (size_t i = 0; i < interfaces.pairs.size(); ++i)
       file << "# triangle ref " << i + 1 << ": " << interface_group_name(interfaces.pairs[i], info)
            << '\n';
@@ -240,8 +240,8 @@ absl::Status write_abaqus(const TetMesh& mesh, const VolumeFileInfo& info,
       file << faces[i].tet + 1 << ", S" << kFaceByOmittedNode[faces[i].across] << '\n';
     begin = end;
   }
-  if (info.interfaces) {
-    const Interfaces interfaces(mesh);
+  if (info.interfaces != nullptr) {
+    const Interfaces interfaces(*info.interfaces);
     for (size_t f = 0; f < interfaces.faces.size(); ++f) {
       const auto& face = interfaces.faces[f];
       if (f == 0 || interfaces.index[f] != interfaces.index[f - 1]) {

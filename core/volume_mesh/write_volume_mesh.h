@@ -22,10 +22,10 @@ struct VolumeFileInfo {
   std::map<int32_t, std::string> label_names;
   // Points are written in this frame; the files that have comments or field data say which.
   CoordinateFrame frame = CoordinateFrame::kLps;
-  // A conforming mesh's interfaces (interface_faces): each face between two
-  // labels, or between a label and the outside, written once and grouped by
-  // label pair, as described for each format below.
-  bool interfaces = false;
+  // A conforming mesh's interfaces, interface_faces(mesh) when set: each face
+  // between two labels, or between a label and the outside, written once and
+  // grouped by label pair, as described for each format below.
+  const std::vector<InterfaceFace>* interfaces = nullptr;
 };
 
 // The name of an interface's group: "<label group>__<label group>", or
@@ -63,7 +63,7 @@ std::string label_group_name(int32_t label, const VolumeFileInfo& info);
 // - kTetgen: `path` must end in ".node"; writes it and the .ele beside it, 1-based, with the
 //   label as each tetrahedron's region attribute.
 //
-// With info.interfaces, interface i (1-based, in label-pair order) is also written:
+// With info.interfaces set, interface i (1-based, in label-pair order) is also written:
 // - kVtu: a second file (interfaces_vtu_path) of the same points and the interface triangles,
 //   cell arrays "interface" (i), "label_inside" and "label_outside" (the face's normal points
 //   from the first into the second; 0 is the outside).

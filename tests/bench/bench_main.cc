@@ -430,23 +430,6 @@ std::vector<std::string> conforming_examples() {
           data + "/msd_prostate_mask_00.nii", data + "/liver.inr.gz"};
 }
 
-// Percentile q (0-1) of `values` (sorted in place); 0 when empty.
-double percentile(std::vector<double>& values, double q) {
-  if (values.empty()) return 0;
-  std::sort(values.begin(), values.end());
-  return values[static_cast<size_t>(q * double(values.size() - 1) + 0.5)];
-}
-
-// |volume change| of labels of at least 1,000 voxels, percent.
-std::vector<double> volume_errors_percent(
-    const std::vector<labelmesh::conforming::LabelVolumeFigures>& labels) {
-  std::vector<double> errors;
-  for (const auto& l : labels) {
-    if (l.voxels >= 1000) errors.push_back(100 * std::abs(l.volume_change()));
-  }
-  return errors;
-}
-
 // One conforming mesh of every label of `path`, in this (child) process: its
 // figures, then CGAL Mesh_3 on the same labels, run in turn `pairs` times.
 int bench_conforming_file(const std::string& path, int pairs) {
@@ -487,8 +470,7 @@ int bench_conforming_file(const std::string& path, int pairs) {
       below +=
           quality::tetra_quality(tet) < 0.2 || quality::tetra_dihedral_range_deg(tet).first < 10;
     }
-    auto errors = volume_errors_percent(figures.labels);
-    const double median = percentile(errors, 0.5), p90 = percentile(errors, 0.9);
+    const auto ours_spread = conforming::volume_change_spread(figures.labels, 1000);
     const auto& i = figures.interfaces;
     const auto& c = figures.conformity;
     std::printf("%s: conforming mesh of %zu labels\n", path.c_str(), figures.labels.size());
@@ -519,7 +501,7 @@ int bench_conforming_file(const std::string& path, int pairs) {
     std::printf(
         "  ours volume error, %zu labels >= 1000 voxels: median %.2f %%, p90 %.2f %%, "
         "max %.2f %%\n",
-        errors.size(), median, p90, errors.empty() ? 0.0 : errors.back());
+        ours_spread.labels, 100 * ours_spread.median, 100 * ours_spread.p90, 100 * ours_spread.max);
     std::vector<conforming::LabelVolumeFigures> theirs;
     for (const auto& figure : figures.labels) {
       auto copy = figure;
@@ -533,9 +515,7 @@ int bench_conforming_file(const std::string& path, int pairs) {
       }
       theirs.push_back(copy);
     }
-    auto mesh3_errors = volume_errors_percent(theirs);
-    const double mesh3_median = percentile(mesh3_errors, 0.5);
-    const double mesh3_p90 = percentile(mesh3_errors, 0.9);
+    const auto mesh3_spread = conforming::volume_change_spread(theirs, 1000);
     size_t mesh3_missing = 0;
     for (const auto& label : theirs) mesh3_missing += label.tetrahedra == 0;
     const auto& m = mesh3->quality;
@@ -545,8 +525,8 @@ int bench_conforming_file(const std::string& path, int pairs) {
         "size %.2f mm)\n",
         mesh3->tetrahedra, mesh3->nodes, m.min, m.mean, m.min_dihedral_deg, m.max_dihedral_deg,
         mesh3_missing, sizing.facet_size_mm, sizing.facet_distance_mm, sizing.cell_size_mm);
-    std::printf("  Mesh_3 volume error: median %.2f %%, p90 %.2f %%, max %.2f %%\n", mesh3_median,
-                mesh3_p90, mesh3_errors.empty() ? 0.0 : mesh3_errors.back());
+    std::printf("  Mesh_3 volume error: median %.2f %%, p90 %.2f %%, max %.2f %%\n",
+                100 * mesh3_spread.median, 100 * mesh3_spread.p90, 100 * mesh3_spread.max);
   }
   for (int pair = 0; pair < pairs; ++pair) {
     std::printf("  run %d        ours %.3f s, Mesh_3 %.3f s, ratio %.2f\n", pair + 1,

@@ -7,12 +7,10 @@
 #include <map>
 #include <set>
 
-#include <vtkDataArray.h>
-#include <vtkPointData.h>
-
 #include "core/conforming/check_conforming_mesh.h"
 #include "core/conforming/label_interfaces.h"
 #include "core/util/vec3.h"
+#include "core/volume/label_statistics.h"
 #include "core/volume/phantom.h"
 
 namespace labelmesh::conforming {
@@ -23,11 +21,8 @@ using volume::PhantomShape;
 
 std::map<int32_t, uint64_t> voxel_counts(const volume::LabelVolume& volume) {
   std::map<int32_t, uint64_t> counts;
-  vtkDataArray* scalars = volume.voxels->GetPointData()->GetScalars();
-  for (vtkIdType i = 0; i < scalars->GetNumberOfTuples(); ++i) {
-    const auto label = static_cast<int32_t>(scalars->GetTuple1(i));
-    if (label != 0) ++counts[label];
-  }
+  for (const auto& label : volume::compute_label_statistics(volume).labels)
+    counts[label.label] = label.voxels;
   return counts;
 }
 
