@@ -81,6 +81,10 @@ std::string report_table(const v1::Report& report) {
         (unsigned long long)f.interfaces(), (unsigned long long)f.interface_faces(),
         (unsigned long long)f.outer_faces(), f.interface_offset_max_mm(), f.volume_gap(),
         100 * f.volume_change_median(), 100 * f.volume_change_p90());
+    if (f.thick_slice_axis() >= 0 && f.thick_slice_parts() > 1) {
+      table += row("conforming: thick slices along voxel axis %d cut into %u each\n",
+                   f.thick_slice_axis(), f.thick_slice_parts());
+    }
   }
   return table;
 }

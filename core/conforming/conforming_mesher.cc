@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <map>
+#include <optional>
 
 #include "core/util/text.h"
 #include "core/util/vec3.h"
@@ -99,8 +100,21 @@ absl::StatusOr<volume_mesh::TetMesh> mesh_conforming(const volume::LabelVolume& 
         "conforming mesh: no voxel holds any of the selected labels; nothing to mesh");
   }
   context.report("interfaces", 0);
+  // Thick slices are cut into thinner ones first; the voxels counted above
+  // stay the measure of each label's volume.
+  figures.thick_slices = find_thick_slices(volume.geometry, params.thick_slices);
+  std::optional<volume::LabelVolume> thinner;
+  if (figures.thick_slices.axis >= 0) {
+    const auto cut_start = std::chrono::steady_clock::now();
+    thinner = interpolate_thick_slices(volume, labels, figures.thick_slices);
+    figures.thick_slice_seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - cut_start).count();
+  }
+  const volume::LabelVolume& meshed = thinner ? *thinner : volume;
   InterfaceSurface surface =
-      label_interfaces(volume, labels, params.interfaces, figures.interfaces);
+      label_interfaces(meshed, labels, params.interfaces, figures.interfaces);
+  const std::array<double, 3> spacing = meshed.geometry.spacing;
+  thinner.reset();
   if (auto status = remove_crossings(surface, params.max_crossing_repairs, context, figures);
       !status.ok()) {
     return status;
@@ -110,7 +124,6 @@ absl::StatusOr<volume_mesh::TetMesh> mesh_conforming(const volume::LabelVolume& 
   if (!mesh.ok()) return mesh.status();
   figures.tetgen_quality = volume_mesh::summarise_quality(*mesh);
   std::vector<double> reach(surface.points.size());
-  const auto& spacing = volume.geometry.spacing;
   const double least_reach =
       params.slide_reach_voxels * std::min({spacing[0], spacing[1], spacing[2]});
   for (size_t p = 0; p < reach.size(); ++p) {
@@ -132,15 +145,23 @@ absl::StatusOr<volume_mesh::TetMesh> mesh_conforming(const volume::LabelVolume& 
     }
   }
   // The improvement pass keeps the points it does not drop in order, and it
-  // never drops interface points, which it does not touch.
+  // never drops interface points, which it does not touch. The last slide
+  // may also step off the interfaces, within the same reach.
+  SlideParams last_slide = params.slide;
+  last_slide.off_fraction = params.last_slide_off_fraction;
   if (auto status = slide_interface_points(*mesh, surface.points.size(), surface.staircase, reach,
-                                           params.slide, context, slid);
+                                           last_slide, context, slid);
       !status.ok()) {
     return status;
   }
   figures.slide.points_moved += slid.points_moved;
   figures.slide.tetrahedra_below_after = slid.tetrahedra_below_after;
   figures.slide.seconds += slid.seconds;
+  for (size_t p = 0; p < surface.points.size(); ++p) {
+    figures.interfaces.max_offset_mm =
+        std::max(figures.interfaces.max_offset_mm,
+                 geometry::norm(geometry::sub(mesh->points[p], surface.staircase[p])));
+  }
   figures.conformity = check_conforming_mesh(*mesh);
   figures.labels = label_volume_figures(*mesh, voxels, volume.geometry.voxel_volume());
   figures.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

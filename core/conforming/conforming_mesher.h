@@ -13,6 +13,7 @@
 #include "core/conforming/label_interfaces.h"
 #include "core/conforming/slide_interface_points.h"
 #include "core/conforming/tetrahedralize_interfaces.h"
+#include "core/conforming/thick_slices.h"
 #include "core/util/run_context.h"
 #include "core/volume/label_volume.h"
 #include "core/volume_mesh/improve_tet_mesh.h"
@@ -22,6 +23,7 @@
 namespace labelmesh::conforming {
 
 struct ConformingParams {
+  ThickSliceParams thick_slices;
   InterfaceParams interfaces;
   volume_mesh::TetgenParams tetgen;
   volume_mesh::ImproveParams improve;
@@ -30,6 +32,8 @@ struct ConformingParams {
   // smallest spacing.
   SlideParams slide;
   double slide_reach_voxels = 0.45;
+  // The last slide's steps off the interfaces (SlideParams::off_fraction).
+  double last_slide_off_fraction = 0.5;
   // Rounds of putting the points of crossing triangles back on the
   // staircase (which never crosses itself) before all of them go back.
   int max_crossing_repairs = 4;
@@ -47,6 +51,10 @@ struct LabelVolumeFigures {
 };
 
 struct ConformingFigures {
+  // The thick axis cut before the interfaces were made, if any; the
+  // interfaces' figures are then on the thinner grid.
+  ThickSlices thick_slices;
+  double thick_slice_seconds = 0;
   InterfaceFigures interfaces;
   // Repair rounds run and the points put back on the staircase; whether
   // every point had to go back.

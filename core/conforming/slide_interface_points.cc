@@ -145,11 +145,28 @@ class Slider {
     return ok;
   }
 
-  // Pattern search in the tangent plane; true when the point moved.
-  bool slide(uint32_t p) {
-    if (kind_[p] == Kind::kFixed) return false;
+  // Pattern search in the tangent plane (or along the junction curve) and,
+  // with `off_fraction` > 0, off it by that fraction of the step; true when
+  // the point moved.
+  bool slide(uint32_t p, double off_fraction) {
+    std::vector<Vec3> directions;
     const auto& [t1, t2] = direction_[p];
-    const int directions = kind_[p] == Kind::kPlane ? 8 : 2;
+    if (kind_[p] == Kind::kPlane) {
+      for (int k = 0; k < 8; ++k) {
+        const double angle = k * 2 * std::numbers::pi / 8;
+        directions.push_back(geometry::add(geometry::scale(t1, std::cos(angle)),
+                                           geometry::scale(t2, std::sin(angle))));
+      }
+    } else if (kind_[p] == Kind::kCurve) {
+      directions = {t1, geometry::scale(t1, -1)};
+    }
+    if (off_fraction > 0) {
+      for (const Vec3& off : off_directions(p)) {
+        directions.push_back(geometry::scale(off, off_fraction));
+        directions.push_back(geometry::scale(off, -off_fraction));
+      }
+    }
+    if (directions.empty()) return false;
     double length = 0;
     int edges = 0;
     star_.for_each(p, [&](uint32_t t) {
@@ -169,11 +186,8 @@ class Slider {
       for (int round = 0; round < 6; ++round) {
         const Vec3 from = position;
         Vec3 chosen = from;
-        for (int k = 0; k < directions; ++k) {
-          const double angle = k * 2 * std::numbers::pi / directions;
-          const Vec3 offset = geometry::add(geometry::scale(t1, std::cos(angle) * step * length),
-                                            geometry::scale(t2, std::sin(angle) * step * length));
-          const Vec3 candidate = geometry::add(from, offset);
+        for (const Vec3& direction : directions) {
+          const Vec3 candidate = geometry::add(from, geometry::scale(direction, step * length));
           if (geometry::norm(geometry::sub(candidate, anchor_[p])) > reach_[p]) continue;
           position = candidate;
           const double w = worst(p);
@@ -191,6 +205,19 @@ class Slider {
   }
 
  private:
+  // Unit directions across the point's own directions: the normal on one
+  // interface, two across a junction curve, three axes where curves meet.
+  std::vector<Vec3> off_directions(uint32_t p) const {
+    const auto& [t1, t2] = direction_[p];
+    if (kind_[p] == Kind::kPlane) return {geometry::cross(t1, t2)};
+    if (kind_[p] == Kind::kCurve) {
+      const Vec3 helper = std::abs(t1[0]) < 0.9 ? Vec3{1, 0, 0} : Vec3{0, 1, 0};
+      const Vec3 u = unit(geometry::cross(t1, helper));
+      return {u, geometry::cross(t1, u)};
+    }
+    return {Vec3{1, 0, 0}, Vec3{0, 1, 0}, Vec3{0, 0, 1}};
+  }
+
   TetMesh& mesh_;
   const std::vector<Vec3>& anchor_;
   const std::vector<double>& reach_;
@@ -238,7 +265,7 @@ absl::Status slide_interface_points(TetMesh& mesh, size_t interface_points,
     std::vector<uint32_t> changed = below;
     size_t moved = 0;
     for (uint32_t p : points) {
-      if (!slider.slide(p)) continue;
+      if (!slider.slide(p, params.off_fraction)) continue;
       ++moved;
       slider.star().for_each(p, [&](uint32_t t) { changed.push_back(t); });
     }

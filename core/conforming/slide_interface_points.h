@@ -20,6 +20,11 @@ struct SlideParams {
   double target_quality = 0.3;
   double target_dihedral_deg = 15;
   int max_sweeps = 4;
+  // Steps off the interface, as a fraction of the steps along it: 0 keeps
+  // every interface where it was to first order; above 0 lets a point leave
+  // it too (still within its reach), which lifts slivers whose corners lie
+  // on one flat patch.
+  double off_fraction = 0;
 };
 
 struct SlideFigures {
@@ -30,12 +35,14 @@ struct SlideFigures {
 };
 
 // Slides points [0, interface_points) of `mesh` (the interface surface's
-// points, as tetrahedralize_interfaces keeps them) that lie on one interface
-// only; points where interfaces meet stay fixed. A point never moves farther
-// than `reach[p]` mm from `anchor[p]` (the voxels' staircase, so the
-// interfaces stay as close to the voxel boundary as they were), no
-// tetrahedron inverts, no interface face turns by more than 30 degrees, and
-// a move is kept only when it raises the worst tetrahedron around the point.
+// points, as tetrahedralize_interfaces keeps them): in their interface's
+// tangent plane, along their junction curve where three labels meet, and,
+// with params.off_fraction > 0, off those too (then also the points where
+// curves meet, which otherwise stay). A point never moves farther than
+// `reach[p]` mm from `anchor[p]` (the voxels' staircase, so the interfaces
+// stay as close to the voxel boundary as they were), no tetrahedron
+// inverts, no interface face turns by more than 30 degrees, and a move is
+// kept only when it raises the worst tetrahedron around the point.
 // Errors: CANCELLED.
 absl::Status slide_interface_points(volume_mesh::TetMesh& mesh, size_t interface_points,
                                     const std::vector<std::array<double, 3>>& anchor,

@@ -107,6 +107,8 @@ void add_conforming_figures(const conforming::ConformingFigures& figures,
   out->set_below_slide_targets_before(figures.slide.tetrahedra_below_before);
   out->set_below_slide_targets_after(figures.slide.tetrahedra_below_after);
   out->set_outside_regions(figures.regions.outside_regions);
+  out->set_thick_slice_axis(figures.thick_slices.axis);
+  out->set_thick_slice_parts(static_cast<uint32_t>(figures.thick_slices.parts));
   for (const auto& label : figures.labels) {
     auto* l = out->add_labels();
     l->set_label(label.label);

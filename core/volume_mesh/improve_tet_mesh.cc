@@ -372,8 +372,8 @@ bool insert_in_cavity(WorkMesh& w, uint32_t t, std::vector<uint32_t> cavity,
   std::sort(cavity.begin(), cavity.end());
   cavity.erase(std::unique(cavity.begin(), cavity.end()), cavity.end());
   auto in_cavity = [&](uint32_t x) { return std::binary_search(cavity.begin(), cavity.end(), x); };
-  // The cavity's boundary, each face wound so its normal points inwards; the
-  // surface faces among them give the direction into the material.
+  // The cavity's boundary, each face wound so its normal points inwards; t's
+  // faces on its label's boundary give the direction into the label.
   std::vector<std::array<uint32_t, 3>> faces;
   Vec3 inward = {0, 0, 0};
   for (uint32_t c : cavity) {
@@ -383,7 +383,8 @@ bool insert_in_cavity(WorkMesh& w, uint32_t t, std::vector<uint32_t> cavity,
       const auto other = w.across(c, face[0], face[1], face[2]);
       if (other && in_cavity(*other)) continue;
       faces.push_back(face);
-      if (!other && c == t) {
+      // Outer faces and interfaces with other labels alike bound t's label.
+      if ((!other || w.label(*other) != label) && c == t) {
         inward = geometry::add(inward,
                                geometry::cross(geometry::sub(w.point(face[1]), w.point(face[0])),
                                                geometry::sub(w.point(face[2]), w.point(face[0]))));

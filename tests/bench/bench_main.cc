@@ -478,6 +478,11 @@ int bench_conforming_file(const std::string& path, int pairs) {
         "  interfaces   %8.3f s  %zu points (%zu on junctions, %zu fixed), %zu triangles, "
         "within %.2f mm of the voxel boundary\n",
         i.seconds, i.points, i.junction_points, i.fixed_points, i.triangles, i.max_offset_mm);
+    if (figures.thick_slices.axis >= 0) {
+      std::printf("  thick slices %8.3f s  axis %d cut into %d each (shape-based interpolation)\n",
+                  figures.thick_slice_seconds, figures.thick_slices.axis,
+                  figures.thick_slices.parts);
+    }
     std::printf("  crossings    repairs %d, points restored %zu, staircase only %d\n",
                 figures.crossing_repairs, figures.restored_points, int(figures.staircase_only));
     std::printf("  tetgen       %8.3f s  %zu tetrahedra, %zu regions (%zu outside)\n",

@@ -162,8 +162,8 @@ TEST(ConformingMesher, NestedLabelsShareTheirInterfaces) {
     EXPECT_LT(std::abs(label.volume_change()), 0.03) << "label " << label.label;
   }
   const auto quality = volume_mesh::summarise_quality(mesh);
-  EXPECT_GT(quality.min, 0.1);
-  EXPECT_GT(quality.min_dihedral_deg, 5.0);
+  EXPECT_GE(quality.min, 0.2);
+  EXPECT_GE(quality.min_dihedral_deg, 10.0);
   EXPECT_EQ(quality.invalid, 0);
 }
 

@@ -1,0 +1,51 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// Thick slices (one voxel axis much coarser than the others, as in most 2D
+// MR and many CT series) cut into thinner ones by shape-based interpolation:
+// each label's signed distance within every slice, interpolated linearly
+// between slice centres, the largest one winning. A surface net on the
+// thinner grid can then slope between slices instead of stepping a whole
+// slice at once, which folds it.
+// Reference: S. P. Raya and J. K. Udupa, "Shape-based interpolation of
+// multidimensional objects", IEEE Trans. Medical Imaging 9(1), 1990.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+#include "core/volume/label_volume.h"
+
+namespace labelmesh::conforming {
+
+struct ThickSliceParams {
+  // An axis whose spacing is at least this many times the largest other one
+  // counts as thick.
+  double min_ratio = 3;
+  // The thinner slices are about this many times the largest other spacing:
+  // the interface surface cuts its quads near square anyway, and more
+  // slices only add voxels to interpolate.
+  double thin_ratio = 2;
+  // At most this many thin slices per thick one.
+  int max_parts = 8;
+};
+
+struct ThickSlices {
+  int axis = -1;  // -1: no axis is thick
+  int parts = 1;  // thin slices per thick slice
+};
+
+// Which axis is thick, and into how many parts it is cut: its spacing over
+// thin_ratio times the largest other one, rounded, from 2 to max_parts.
+ThickSlices find_thick_slices(const volume::ImageGeometry& geometry,
+                              const ThickSliceParams& params);
+
+// The volume of `labels` (every non-zero label when empty; the others become
+// 0) on the thinner grid: the same extent and directions, `cut.parts` slices
+// for each slice along `cut.axis`, int32 voxels. Beyond the first and last
+// slice centres, each slice's own labels are kept.
+// Precondition: cut.axis is 0, 1 or 2 and cut.parts >= 2.
+volume::LabelVolume interpolate_thick_slices(const volume::LabelVolume& volume,
+                                             const std::vector<int32_t>& labels,
+                                             const ThickSlices& cut);
+
+}  // namespace labelmesh::conforming

@@ -1,0 +1,143 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+#include "core/conforming/thick_slices.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <map>
+
+#include "core/conforming/check_conforming_mesh.h"
+#include "core/conforming/conforming_mesher.h"
+#include "core/util/vec3.h"
+#include "core/volume/label_statistics.h"
+#include "core/volume/phantom_grid.h"
+#include "core/volume/voxel_access.h"
+
+namespace labelmesh::conforming {
+namespace {
+
+constexpr std::array<double, 9> kIdentity{1, 0, 0, 0, 1, 0, 0, 0, 1};
+const std::array<double, 3> kCentre{10, -20, 30};
+constexpr double kInner = 8, kOuter = 16;  // mm
+
+// Label 1 inside a ball of radius kInner, 2 in the shell out to kOuter.
+int32_t nested_label(const std::array<double, 3>& p) {
+  const double d = geometry::norm(geometry::sub(p, kCentre));
+  return d < kInner ? 1 : d < kOuter ? 2 : 0;
+}
+
+// The nested balls on 0.5 x 0.5 x 3 mm voxels (slices along z, or along
+// `thick_axis`).
+volume::LabelVolume thick_nested_balls(int thick_axis = 2) {
+  std::array<double, 3> spacing{0.5, 0.5, 0.5};
+  spacing[thick_axis] = 3;
+  std::array<int64_t, 3> dims{};
+  for (int a = 0; a < 3; ++a) dims[a] = static_cast<int64_t>(std::ceil(36 / spacing[a])) + 1;
+  return volume::rasterise(volume::centred_grid(dims, spacing, kIdentity, kCentre), nested_label);
+}
+
+std::vector<int32_t> labels_of(const volume::LabelVolume& volume) {
+  std::vector<int32_t> out;
+  volume::visit_voxels(
+      volume.voxels, [&](const auto* voxels, size_t count) { out.assign(voxels, voxels + count); });
+  return out;
+}
+
+std::map<int32_t, double> label_volumes(const volume::LabelVolume& volume) {
+  std::map<int32_t, double> volumes;
+  for (const auto& label : volume::compute_label_statistics(volume).labels)
+    volumes[label.label] = static_cast<double>(label.voxels) * volume.geometry.voxel_volume();
+  return volumes;
+}
+
+TEST(ThickSlices, FindsTheThickAxisAndHowFineToCutIt) {
+  volume::ImageGeometry g;
+  g.dims = {100, 100, 20};
+  g.spacing = {0.5, 0.5, 3};
+  EXPECT_EQ(find_thick_slices(g, {}).axis, 2);
+  EXPECT_EQ(find_thick_slices(g, {}).parts, 3);
+  g.spacing = {3, 0.6, 0.5};
+  EXPECT_EQ(find_thick_slices(g, {}).axis, 0);
+  EXPECT_EQ(find_thick_slices(g, {}).parts, 3);  // 3 / (2 x 0.6), rounded
+  g.spacing = {0.6, 0.6, 2};
+  EXPECT_EQ(find_thick_slices(g, {}).parts, 2);
+  g.spacing = {1, 1, 2.5};  // not thick enough to cut
+  EXPECT_EQ(find_thick_slices(g, {}).axis, -1);
+  g.spacing = {0.2, 0.2, 10};
+  EXPECT_EQ(find_thick_slices(g, {}).parts, 8);  // at most max_parts
+}
+
+TEST(ThickSlices, KeepEachSliceAndEachLabelsVolume) {
+  const auto thick = thick_nested_balls();
+  const ThickSlices cut = find_thick_slices(thick.geometry, {});
+  ASSERT_EQ(cut.axis, 2);
+  ASSERT_EQ(cut.parts, 3);
+  const auto fine = interpolate_thick_slices(thick, {}, cut);
+  EXPECT_EQ(fine.geometry.dims[2], thick.geometry.dims[2] * 3);
+  EXPECT_DOUBLE_EQ(fine.geometry.spacing[2], 1.0);
+  // Both grids start and end at the same plane.
+  const auto first_thick = thick.geometry.to_physical({0, 0, -0.5});
+  const auto first_fine = fine.geometry.to_physical({0, 0, -0.5});
+  EXPECT_NEAR(geometry::norm(geometry::sub(first_thick, first_fine)), 0, 1e-9);
+
+  const auto thick_volumes = label_volumes(thick);
+  const auto fine_volumes = label_volumes(fine);
+  ASSERT_EQ(fine_volumes.size(), 2u);
+  for (int32_t label : {1, 2}) {
+    EXPECT_NEAR(fine_volumes.at(label) / thick_volumes.at(label), 1.0, 0.005) << "label " << label;
+  }
+}
+
+TEST(ThickSlices, FollowTheShapeBetweenSlicesBetterThanTheSlicesDo) {
+  const auto thick = thick_nested_balls();
+  const ThickSlices cut = find_thick_slices(thick.geometry, {});
+  const auto fine = interpolate_thick_slices(thick, {}, cut);
+  const auto fine_labels = labels_of(fine);
+  const auto thick_labels = labels_of(thick);
+  const auto& d = fine.geometry.dims;
+  size_t interpolated_wrong = 0, sliced_wrong = 0;
+  size_t i = 0;
+  for (int64_t z = 0; z < d[2]; ++z) {
+    for (int64_t y = 0; y < d[1]; ++y) {
+      for (int64_t x = 0; x < d[0]; ++x, ++i) {
+        const int32_t truth =
+            nested_label(fine.geometry.to_physical({double(x), double(y), double(z)}));
+        interpolated_wrong += fine_labels[i] != truth;
+        const int64_t slice = z / cut.parts;  // the thick voxel this fine one lies in
+        sliced_wrong += thick_labels[static_cast<size_t>((slice * d[1] + y) * d[0] + x)] != truth;
+      }
+    }
+  }
+  EXPECT_GT(sliced_wrong, 3000u);
+  EXPECT_LT(interpolated_wrong, sliced_wrong / 2);
+}
+
+TEST(ThickSlices, AnyAxisCanBeThick) {
+  const auto thick = thick_nested_balls(0);
+  const ThickSlices cut = find_thick_slices(thick.geometry, {});
+  ASSERT_EQ(cut.axis, 0);
+  const auto fine = interpolate_thick_slices(thick, {}, cut);
+  const auto thick_volumes = label_volumes(thick);
+  const auto fine_volumes = label_volumes(fine);
+  for (int32_t label : {1, 2})
+    EXPECT_NEAR(fine_volumes.at(label) / thick_volumes.at(label), 1.0, 0.005);
+}
+
+TEST(ThickSlices, GiveAConformingMeshOfFiniteElementQuality) {
+  const auto thick = thick_nested_balls();
+  ConformingFigures figures;
+  volume_mesh::ImproveFigures improve;
+  auto mesh = mesh_conforming(thick, {}, ConformingParams{}, RunContext{}, figures, improve);
+  ASSERT_TRUE(mesh.ok()) << mesh.status();
+  EXPECT_EQ(figures.thick_slices.axis, 2);
+  EXPECT_TRUE(check_conforming_mesh(*mesh).ok());
+  const auto quality = volume_mesh::summarise_quality(*mesh);
+  EXPECT_GE(quality.min, 0.2);
+  EXPECT_GE(quality.min_dihedral_deg, 10.0);
+  ASSERT_EQ(figures.labels.size(), 2u);
+  for (const auto& label : figures.labels)
+    EXPECT_LT(std::abs(label.volume_change()), 0.02) << "label " << label.label;
+}
+
+}  // namespace
+}  // namespace labelmesh::conforming
