@@ -301,6 +301,11 @@ absl::Status write_mixed_mesh(const MixedMesh& mesh, const MixedQuality& quality
     case VolumeFormat::kTetgen:
       return absl::InvalidArgumentError(
           cat(path, ": TetGen's .node/.ele holds tetrahedra only, not a mixed-element mesh"));
+    case VolumeFormat::kXdmf:
+      return absl::InvalidArgumentError(
+          cat(path,
+              ": labelmesh writes XDMF for tetrahedral meshes only, not a mixed-element "
+              "mesh"));
   }
   return absl::InternalError("unhandled volume format");
 }

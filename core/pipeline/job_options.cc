@@ -445,7 +445,7 @@ absl::StatusOr<MeshParams> params_from_options(const v1::MeshOptions& options) {
         return absl::InvalidArgumentError(
             cat("formats: '", name,
                 "' is not one of stl, ply, obj, off, vtp (surfaces), vtm, vti, mha (scene), vtu, "
-                "msh, mesh, inp, node (volumes)"));
+                "msh, mesh, inp, node, xdmf (volumes)"));
       }
     }
     if (!volume_formats.empty()) {
@@ -456,11 +456,14 @@ absl::StatusOr<MeshParams> params_from_options(const v1::MeshOptions& options) {
       params.volume_formats = std::move(volume_formats);
     }
     if ((params.volume == VolumeMethod::kMixed || params.volume == VolumeMethod::kHex) &&
-        std::count(params.volume_formats.begin(), params.volume_formats.end(),
-                   volume_mesh::VolumeFormat::kTetgen) > 0) {
+        std::count_if(params.volume_formats.begin(), params.volume_formats.end(),
+                      [](volume_mesh::VolumeFormat format) {
+                        return format == volume_mesh::VolumeFormat::kTetgen ||
+                               format == volume_mesh::VolumeFormat::kXdmf;
+                      }) > 0) {
       return absl::InvalidArgumentError(
-          "formats: node (TetGen) holds tetrahedra only; a mixed mesh goes to vtu, msh, mesh or "
-          "inp");
+          "formats: node (TetGen) and xdmf hold tetrahedra only here; a mixed mesh goes to vtu, "
+          "msh, mesh or inp");
     }
     params.scene_formats = std::move(scene_formats);
   }

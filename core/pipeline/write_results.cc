@@ -139,6 +139,8 @@ absl::Status write_all(MeshResult& result, const MeshParams& params, const std::
       result.volume->files.push_back(name);
       if (volume_info.interfaces != nullptr && format == volume_mesh::VolumeFormat::kVtu)
         result.volume->files.push_back(volume_mesh::interfaces_vtu_path(name));
+      if (volume_info.interfaces != nullptr && format == volume_mesh::VolumeFormat::kXdmf)
+        result.volume->files.push_back(volume_mesh::facets_xdmf_path(name));
       // TetGen's pair: the .ele beside the .node.
       if (format == volume_mesh::VolumeFormat::kTetgen)
         result.volume->files.push_back("volume.ele");

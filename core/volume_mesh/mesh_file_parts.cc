@@ -121,4 +121,11 @@ void write_id_lines(TextFile& file, const std::vector<size_t>& ids) {
   }
 }
 
+std::string beside(const std::string& path, std::string_view suffix, std::string_view replacement) {
+  const bool has_suffix = path.size() >= suffix.size() &&
+                          std::string_view(path).substr(path.size() - suffix.size()) == suffix;
+  return (has_suffix ? path.substr(0, path.size() - suffix.size()) : path) +
+         std::string(replacement);
+}
+
 }  // namespace labelmesh::volume_mesh

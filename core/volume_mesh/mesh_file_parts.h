@@ -21,6 +21,30 @@ class vtkUnstructuredGrid;
 
 namespace labelmesh::volume_mesh {
 
+// A conforming mesh's interface faces, each with its interface's index
+// (0-based, in label-pair order).
+struct Interfaces {
+  const std::vector<InterfaceFace>& faces;
+  std::vector<std::array<int32_t, 2>> pairs;
+  std::vector<size_t> index;  // per face: its pair's index in `pairs`
+
+  explicit Interfaces(const std::vector<InterfaceFace>& all)
+      : faces(all), pairs(interface_pairs(all)) {
+    index.reserve(faces.size());
+    for (size_t f = 0, i = 0; f < faces.size(); ++f) {
+      while (pairs[i] != faces[f].labels) ++i;
+      index.push_back(i);
+    }
+  }
+};
+
+// `path` with `suffix` (when it ends so) replaced by `replacement`.
+std::string beside(const std::string& path, std::string_view suffix, std::string_view replacement);
+
+// XDMF 3 with inline XML data (see write_volume_mesh).
+absl::Status write_xdmf(const TetMesh& mesh, const std::vector<double>& quality,
+                        const VolumeFileInfo& info, const std::string& path);
+
 // The labels in `labels`, ascending, each once.
 std::vector<int32_t> distinct_labels(const std::vector<int32_t>& labels);
 

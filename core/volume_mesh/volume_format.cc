@@ -22,14 +22,16 @@ std::string_view volume_format_name(VolumeFormat format) {
       return "inp";
     case VolumeFormat::kTetgen:
       return "node";
+    case VolumeFormat::kXdmf:
+      return "xdmf";
   }
   return "unknown";
 }
 
 const std::vector<VolumeFormat>& all_volume_formats() {
-  static const std::vector<VolumeFormat> kAll{VolumeFormat::kVtu, VolumeFormat::kMsh,
-                                              VolumeFormat::kMedit, VolumeFormat::kAbaqus,
-                                              VolumeFormat::kTetgen};
+  static const std::vector<VolumeFormat> kAll{VolumeFormat::kVtu,    VolumeFormat::kMsh,
+                                              VolumeFormat::kMedit,  VolumeFormat::kAbaqus,
+                                              VolumeFormat::kTetgen, VolumeFormat::kXdmf};
   return kAll;
 }
 

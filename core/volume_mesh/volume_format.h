@@ -8,9 +8,9 @@
 
 namespace labelmesh::volume_mesh {
 
-enum class VolumeFormat { kVtu, kMsh, kMedit, kAbaqus, kTetgen };
+enum class VolumeFormat { kVtu, kMsh, kMedit, kAbaqus, kTetgen, kXdmf };
 
-// "vtu", "msh", "mesh", "inp" or "node"; nullopt otherwise.
+// "vtu", "msh", "mesh", "inp", "node" or "xdmf"; nullopt otherwise.
 std::optional<VolumeFormat> volume_format_from_name(std::string_view name);
 // The file extension without the dot; also the format's name.
 std::string_view volume_format_name(VolumeFormat format);

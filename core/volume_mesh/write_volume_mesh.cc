@@ -38,22 +38,6 @@ std::string name_of(int32_t label, const VolumeFileInfo& info) {
   return found == info.label_names.end() ? std::string() : found->second;
 }
 
-// A conforming mesh's interface faces, each with its interface's index.
-struct Interfaces {
-  const std::vector<InterfaceFace>& faces;
-  std::vector<std::array<int32_t, 2>> pairs;
-  std::vector<size_t> index;  // per face: its pair's index in `pairs`
-
-  explicit Interfaces(const std::vector<InterfaceFace>& all)
-      : faces(all), pairs(interface_pairs(all)) {
-    index.reserve(faces.size());
-    for (size_t f = 0, i = 0; f < faces.size(); ++f) {
-      while (pairs[i] != faces[f].labels) ++i;
-      index.push_back(i);
-    }
-  }
-};
-
 vtkNew<vtkPoints> vtk_points(const TetMesh& mesh, const VolumeFileInfo& info) {
   vtkNew<vtkPoints> points;
   points->SetDataTypeToDouble();
@@ -301,12 +285,11 @@ std::string interface_group_name(const std::array<int32_t, 2>& labels, const Vol
 }
 
 std::string interfaces_vtu_path(const std::string& vtu_path) {
-  constexpr std::string_view kSuffix = ".vtu";
-  const bool has_suffix =
-      vtu_path.size() >= kSuffix.size() &&
-      std::string_view(vtu_path).substr(vtu_path.size() - kSuffix.size()) == kSuffix;
-  return (has_suffix ? vtu_path.substr(0, vtu_path.size() - kSuffix.size()) : vtu_path) +
-         "_interfaces.vtu";
+  return beside(vtu_path, ".vtu", "_interfaces.vtu");
+}
+
+std::string facets_xdmf_path(const std::string& xdmf_path) {
+  return beside(xdmf_path, ".xdmf", "_facets.xdmf");
 }
 
 absl::Status write_volume_mesh(const TetMesh& mesh, const std::vector<double>& cell_quality,
@@ -330,6 +313,8 @@ absl::Status write_volume_mesh(const TetMesh& mesh, const std::vector<double>& c
       return write_abaqus(mesh, info, path);
     case VolumeFormat::kTetgen:
       return write_tetgen(mesh, info, path);
+    case VolumeFormat::kXdmf:
+      return write_xdmf(mesh, cell_quality, info, path);
   }
   return absl::InternalError("unhandled volume format");
 }

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 // Tetrahedral mesh files for viewers and finite-element solvers: VTK XML unstructured grid,
-// Gmsh MSH 2.2, Medit, Abaqus/CalculiX input, and TetGen's .node/.ele pair.
+// Gmsh MSH 2.2, Medit, Abaqus/CalculiX input, TetGen's .node/.ele pair and XDMF.
 #pragma once
 
 #include <map>
@@ -35,6 +35,9 @@ std::string interface_group_name(const std::array<int32_t, 2>& labels, const Vol
 // Where the VTU writer puts the interfaces: "x_interfaces.vtu" beside "x.vtu".
 std::string interfaces_vtu_path(const std::string& vtu_path);
 
+// Where the XDMF writer puts the interfaces: "x_facets.xdmf" beside "x.xdmf".
+std::string facets_xdmf_path(const std::string& xdmf_path);
+
 // "label_<N>" or "label_<N>_<slug of the name>": a group name every format accepts.
 std::string label_group_name(int32_t label, const VolumeFileInfo& info);
 
@@ -62,6 +65,10 @@ std::string label_group_name(int32_t label, const VolumeFileInfo& info);
 //   Labels must be positive.
 // - kTetgen: `path` must end in ".node"; writes it and the .ele beside it, 1-based, with the
 //   label as each tetrahedron's region attribute.
+// - kXdmf: XDMF 3, data inline as XML text (meshio, ParaView and dolfinx read it): one uniform
+//   grid "mesh" of tetrahedra (0-based), XYZ geometry, cell attributes "label" (int32, the
+//   cell tags) and "quality" (when given); comments name the frame, the units (mm) and each
+//   label's group.
 //
 // With info.interfaces set, interface i (1-based, in label-pair order) is also written:
 // - kVtu: a second file (interfaces_vtu_path) of the same points and the interface triangles,
@@ -73,6 +80,9 @@ std::string label_group_name(int32_t label, const VolumeFileInfo& info);
 //   instead of each label's boundary.
 // - kAbaqus: also *SURFACE, TYPE=ELEMENT, NAME=<interface group in upper case> per interface,
 //   the faces taken from the first label's elements.
+// - kXdmf: a second file (facets_xdmf_path), grid "facets" of the interface triangles on the
+//   same points, cell attributes "interface" (i; the facet tags), "label_inside" and
+//   "label_outside", and a comment naming each interface.
 //
 // Errors: INVALID_ARGUMENT naming the file when the mesh is malformed (see check_tet_mesh), the
 // quality count is wrong, a label is not positive where it must be, or a TetGen path does not

@@ -43,7 +43,7 @@ def check_meshio(work, report):
     tets = int(volume["tetrahedra"])
     interfaces = volume["conforming_figures"]
     faces = int(interfaces["interface_faces"]) + int(interfaces["outer_faces"])
-    for name in ("volume.vtu", "volume.msh", "volume.mesh"):
+    for name in ("volume.vtu", "volume.msh", "volume.mesh", "volume.xdmf"):
         mesh = meshio.read(work / name)
         counts = {}
         for block in mesh.cells:
@@ -59,12 +59,22 @@ def check_meshio(work, report):
                                                shared.cell_data["label_outside"][0])}
     if pairs != {(1, 2), (2, 3), (3, 0)}:
         fe.fail(f"volume_interfaces.vtu has label pairs {sorted(pairs)}, not (1,2) (2,3) (3,0)")
+    xdmf = meshio.read(work / "volume.xdmf")
+    cell_tags = sorted(set(xdmf.cell_data["label"][0].ravel().tolist()))
+    if cell_tags != [1, 2, 3]:
+        fe.fail(f"volume.xdmf cell tags {cell_tags}")
+    facets = meshio.read(work / "volume_facets.xdmf")
+    facet_count = sum(len(b.data) for b in facets.cells if b.type == "triangle")
+    tags = sorted(set(facets.cell_data["interface"][0].ravel().tolist()))
+    if facet_count != faces or tags != [1, 2, 3]:
+        fe.fail(f"volume_facets.xdmf: {facet_count} triangles tagged {tags}; the report has "
+                f"{faces} interface triangles in 3 interfaces")
     msh = meshio.read(work / "volume.msh")
     names = set(msh.field_data)
     for want in ("label_1__label_2", "label_2__label_3", "label_3__outside"):
         if want not in names:
             fe.fail(f"volume.msh has no physical surface {want}: {sorted(names)}")
-    print(f"meshio: {tets} tetrahedra and {faces} interface triangles in vtu, msh, mesh; "
+    print(f"meshio: {tets} tetrahedra and {faces} interface triangles in vtu, msh, mesh, xdmf; "
           f"interfaces {sorted(pairs)}")
 
 
@@ -115,7 +125,7 @@ def main():
         subprocess.run([args.labelmesh, "phantom", "nested-spheres", "--out", str(phantom)],
                        check=True, capture_output=True, timeout=120)
         run = subprocess.run([args.labelmesh, "mesh", str(phantom), "--volume", "conforming",
-                              "--formats", "vtu,msh,mesh,inp", "--out", str(work), "--json"],
+                              "--formats", "vtu,msh,mesh,inp,xdmf", "--out", str(work), "--json"],
                              capture_output=True, text=True, timeout=600)
         if run.returncode != 0:
             fe.fail(f"labelmesh mesh exited {run.returncode}: {run.stderr[-2000:]}")

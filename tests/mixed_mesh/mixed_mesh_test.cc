@@ -666,6 +666,11 @@ TEST(MixedMeshWrite, BadInputsAreErrorsNamingTheFile) {
   EXPECT_EQ(tetgen.code(), absl::StatusCode::kInvalidArgument);
   EXPECT_NE(std::string(tetgen.message()).find("tetrahedra only"), std::string::npos) << tetgen;
   EXPECT_FALSE(std::filesystem::exists(node));
+  const std::string xdmf = (dir / "x.xdmf").string();
+  const auto xdmf_status = write_mixed_mesh(mesh, quality, xdmf, VolumeFormat::kXdmf);
+  EXPECT_EQ(xdmf_status.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_NE(std::string(xdmf_status.message()).find("tetrahedral meshes only"), std::string::npos);
+  EXPECT_FALSE(std::filesystem::exists(xdmf));
 
   const std::string msh = (dir / "x.msh").string();
   MixedQuality short_quality = quality;

@@ -123,12 +123,16 @@ for kind in ("tetra", "triangle"):
     print(kind, sum(len(b.data) for b in m.cells if b.type == kind))
 volumes = [np.einsum("ij,ij->i", p[:, 1] - p[:, 0], np.cross(p[:, 2] - p[:, 0], p[:, 3] - p[:, 0])) / 6
            for p in (m.points[b.data] for b in m.cells if b.type == "tetra")]
-volumes = np.concatenate(volumes)
-print("min_volume", volumes.min())
-print("total_volume", volumes.sum())
+if volumes:
+    volumes = np.concatenate(volumes)
+    print("min_volume", volumes.min())
+    print("total_volume", volumes.sum())
 for key in ("gmsh:physical", "gmsh:geometrical", "medit:ref", "tetgen:ref"):
     for block, data in zip(m.cells, m.cell_data.get(key, [])):
         print(block.type + ":" + key, *sorted(set(int(x) for x in np.asarray(data).ravel())))
+for key in ("label", "interface", "label_inside", "label_outside"):
+    if key in m.cell_data:
+        print("values:" + key, *sorted(set(int(x) for d in m.cell_data[key] for x in np.asarray(d).ravel())))
 if "quality" in m.cell_data:
     print("quality_sum", sum(float(np.sum(d)) for d in m.cell_data["quality"]))
 for name, cells in sorted(m.cell_sets.items()):
@@ -168,13 +172,13 @@ void expect_meshio_counts(const std::map<std::string, std::string>& summary, con
 }
 
 TEST(WriteVolumeMesh, FormatNamesRoundTrip) {
-  ASSERT_EQ(all_volume_formats().size(), 5u);
+  ASSERT_EQ(all_volume_formats().size(), 6u);
   std::set<std::string_view> names;
   for (VolumeFormat format : all_volume_formats()) {
     names.insert(volume_format_name(format));
     EXPECT_EQ(volume_format_from_name(volume_format_name(format)), format);
   }
-  EXPECT_EQ(names, (std::set<std::string_view>{"vtu", "msh", "mesh", "inp", "node"}));
+  EXPECT_EQ(names, (std::set<std::string_view>{"vtu", "msh", "mesh", "inp", "node", "xdmf"}));
   EXPECT_FALSE(volume_format_from_name("vtk").has_value());
   EXPECT_FALSE(volume_format_from_name("").has_value());
 }
@@ -450,6 +454,11 @@ TEST(WriteVolumeMesh, NamesAndTheFrameReachEveryFormat) {
       case VolumeFormat::kTetgen:
         EXPECT_NE(text.find("SPACE=RAS"), std::string::npos);
         break;
+      case VolumeFormat::kXdmf:
+        EXPECT_NE(text.find("<!-- labelmesh: coordinates in mm, SPACE=RAS -->"), std::string::npos);
+        EXPECT_NE(text.find("<!-- label 2: label_2_right_kidney_rk -->"), std::string::npos);
+        EXPECT_EQ(summary.at("values:label"), "1 2");
+        break;
       case VolumeFormat::kVtu: {
         EXPECT_EQ(summary.at("field:label_1_liver"), "1");
         EXPECT_EQ(summary.at("field:label_2_right_kidney_rk"), "2");
@@ -458,6 +467,40 @@ TEST(WriteVolumeMesh, NamesAndTheFrameReachEveryFormat) {
       }
     }
   }
+}
+
+// XDMF for dolfinx: the labels as cell tags and quality beside them; the
+// interfaces in a second file as facet tags, on the same points.
+TEST(WriteVolumeMesh, XdmfCarriesCellTagsAndFacetTags) {
+  const TetMesh& mesh = two_labels();
+  const auto quality = qualities(mesh);
+  const auto faces = interface_faces(mesh);
+  const auto pairs = interface_pairs(faces);
+  ASSERT_EQ(pairs.size(), 2u);  // two cubes apart: each one's outer boundary
+  VolumeFileInfo info;
+  info.interfaces = &faces;
+  const auto dir = testing::scratch_dir("write-volume-xdmf");
+  const auto path = path_in(dir, VolumeFormat::kXdmf);
+  ASSERT_TRUE(write_volume_mesh(mesh, quality, path, VolumeFormat::kXdmf, info).ok());
+
+  const auto cells = meshio_summary(dir, path);
+  expect_meshio_counts(cells, mesh);
+  EXPECT_EQ(cells.at("values:label"), "1 2");
+  double quality_sum = 0;
+  for (double q : quality) quality_sum += q;
+  EXPECT_NEAR(std::stod(cells.at("quality_sum")), quality_sum, 1e-9 * quality_sum);
+
+  const auto facets_path = facets_xdmf_path(path);
+  EXPECT_EQ(facets_path, (dir / "two-labels_facets.xdmf").string());
+  const auto facets = meshio_summary(dir, facets_path);
+  EXPECT_EQ(facets.at("points"), std::to_string(mesh.points.size()));
+  EXPECT_EQ(facets.at("triangle"), std::to_string(faces.size()));
+  EXPECT_EQ(facets.at("values:interface"), "1 2");
+  EXPECT_EQ(facets.at("values:label_inside"), "1 2");
+  EXPECT_EQ(facets.at("values:label_outside"), "0");
+  const std::string text = read_text(facets_path);
+  EXPECT_NE(text.find("<!-- interface 2: label_2__outside -->"), std::string::npos)
+      << text.substr(0, 400);
 }
 
 TEST(WriteVolumeMesh, BadInputsAndPathsAreErrorsNamingTheFile) {
