@@ -5,7 +5,6 @@
 #include <chrono>
 #include <cmath>
 #include <map>
-#include <optional>
 
 #include "core/util/text.h"
 #include "core/util/vec3.h"
@@ -103,18 +102,19 @@ absl::StatusOr<volume_mesh::TetMesh> mesh_conforming(const volume::LabelVolume& 
   // Thick slices are cut into thinner ones first; the voxels counted above
   // stay the measure of each label's volume.
   figures.thick_slices = find_thick_slices(volume.geometry, params.thick_slices);
-  std::optional<volume::LabelVolume> thinner;
+  std::array<double, 3> spacing = volume.geometry.spacing;
+  InterfaceSurface surface;
   if (figures.thick_slices.axis >= 0) {
     const auto cut_start = std::chrono::steady_clock::now();
-    thinner = interpolate_thick_slices(volume, labels, figures.thick_slices);
+    auto thinner = interpolate_thick_slices(volume, labels, figures.thick_slices, context);
+    if (!thinner.ok()) return thinner.status();
     figures.thick_slice_seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - cut_start).count();
+    surface = label_interfaces(*thinner, labels, params.interfaces, figures.interfaces);
+    spacing = thinner->geometry.spacing;
+  } else {
+    surface = label_interfaces(volume, labels, params.interfaces, figures.interfaces);
   }
-  const volume::LabelVolume& meshed = thinner ? *thinner : volume;
-  InterfaceSurface surface =
-      label_interfaces(meshed, labels, params.interfaces, figures.interfaces);
-  const std::array<double, 3> spacing = meshed.geometry.spacing;
-  thinner.reset();
   if (auto status = remove_crossings(surface, params.max_crossing_repairs, context, figures);
       !status.ok()) {
     return status;
@@ -157,6 +157,7 @@ absl::StatusOr<volume_mesh::TetMesh> mesh_conforming(const volume::LabelVolume& 
   figures.slide.points_moved += slid.points_moved;
   figures.slide.tetrahedra_below_after = slid.tetrahedra_below_after;
   figures.slide.seconds += slid.seconds;
+  figures.interfaces.max_offset_mm = 0;
   for (size_t p = 0; p < surface.points.size(); ++p) {
     figures.interfaces.max_offset_mm =
         std::max(figures.interfaces.max_offset_mm,

@@ -10,6 +10,7 @@
 #include <limits>
 #include <memory>
 
+#include "core/util/text.h"
 #include "core/volume/voxel_access.h"
 
 namespace labelmesh::conforming {
@@ -264,16 +265,24 @@ ThickSlices find_thick_slices(const volume::ImageGeometry& geometry,
   const int axis = static_cast<int>(std::max_element(s.begin(), s.end()) - s.begin());
   const double others = std::max(s[(axis + 1) % 3], s[(axis + 2) % 3]);
   if (!(others > 0) || s[axis] < params.min_ratio * others || geometry.dims[axis] < 2) return {};
-  const int parts =
-      std::clamp(static_cast<int>(std::lround(s[axis] / (params.thin_ratio * others))), 2,
-                 std::max(2, params.max_parts));
-  return ThickSlices{axis, parts};
+  // No more thin voxels than a volume may hold.
+  const int64_t voxels = std::max<int64_t>(1, geometry.voxel_count());
+  const auto fitting =
+      static_cast<int>(std::min<int64_t>(params.max_parts, params.max_voxels / voxels));
+  const int parts = std::min(
+      fitting, std::max(2, static_cast<int>(std::lround(s[axis] / (params.thin_ratio * others)))));
+  return parts >= 2 ? ThickSlices{axis, parts} : ThickSlices{};
 }
 
-volume::LabelVolume interpolate_thick_slices(const volume::LabelVolume& volume,
-                                             const std::vector<int32_t>& labels,
-                                             const ThickSlices& cut) {
+absl::StatusOr<volume::LabelVolume> interpolate_thick_slices(const volume::LabelVolume& volume,
+                                                             const std::vector<int32_t>& labels,
+                                                             const ThickSlices& cut,
+                                                             const RunContext& context) {
   const auto& geometry = volume.geometry;
+  if (cut.axis < 0 || cut.axis > 2 || cut.parts < 2 || geometry.dims[cut.axis] < 2) {
+    return absl::InvalidArgumentError(
+        cat("thick slices: cannot cut axis ", cut.axis, " into ", cut.parts, " parts"));
+  }
   volume::LabelVolume fine;
   fine.format = volume.format;
   fine.file_voxel_type = volume.file_voxel_type;
@@ -290,29 +299,49 @@ volume::LabelVolume interpolate_thick_slices(const volume::LabelVolume& volume,
                              static_cast<int>(fine.geometry.dims[2]));
   fine.voxels->AllocateScalars(VTK_INT, 1);
   auto* out = static_cast<int32_t*>(fine.voxels->GetScalarPointer());
+  if (out == nullptr) {
+    return absl::ResourceExhaustedError(
+        cat("thick slices: no memory for ", fine.geometry.voxel_count(), " thinner voxels"));
+  }
 
   // Interpolation thins narrow shapes; each label's bias is raised by its
-  // missing volume spread over its boundary until every label has its
-  // voxels' volume to within a tenth of a percent, or rounds run out.
+  // missing volume spread over its boundary (by half a band for a label that
+  // vanished, which has none), at most half a band a round and a band in
+  // all, until every label has its voxels' volume to within a tenth of a
+  // percent or the rounds run out; the best round's biases are kept.
   const SliceInterpolator interpolator(volume, labels, cut);
   const auto& present = interpolator.present();
   std::vector<uint64_t> target = interpolator.source_counts();
   for (auto& count : target) count *= cut.parts;
   const double step =
       std::cbrt(fine.geometry.spacing[0] * fine.geometry.spacing[1] * fine.geometry.spacing[2]);
-  std::vector<double> bias(present.size(), 0);
+  const double band = geometry.spacing[cut.axis];
+  std::vector<double> bias(present.size(), 0), best_bias;
+  double best_error = std::numeric_limits<double>::infinity();
   std::vector<uint64_t> counts, boundary;
   for (int round = 0;; ++round) {
+    if (auto status = context.check_stop(); !status.ok()) return status;
     interpolator.fill(bias, out, counts, boundary);
-    bool close = true;
+    double error = 0;
+    for (size_t l = 0; l < present.size(); ++l) {
+      error = std::max(error, std::abs(double(target[l]) - double(counts[l])) /
+                                  std::max(1.0, double(target[l])));
+    }
+    const bool best = error < best_error;
+    if (best) {
+      best_error = error;
+      best_bias = bias;
+    }
+    if (error <= 1e-3 || round == kBiasRounds) {
+      if (!best) interpolator.fill(best_bias, out, counts, boundary);
+      break;
+    }
     for (size_t l = 0; l < present.size(); ++l) {
       const double missing = double(target[l]) - double(counts[l]);
-      close &= std::abs(missing) <= 1e-3 * double(target[l]);
-    }
-    if (close || round == kBiasRounds) break;
-    for (size_t l = 0; l < present.size(); ++l) {
-      if (boundary[l] == 0) continue;
-      bias[l] += (double(target[l]) - double(counts[l])) * step / double(boundary[l]);
+      const double change = boundary[l] > 0 ? missing * step / double(boundary[l])
+                            : missing > 0   ? band / 2
+                                            : 0;
+      bias[l] = std::clamp(bias[l] + std::clamp(change, -band / 2, band / 2), -band, band);
     }
   }
   return fine;

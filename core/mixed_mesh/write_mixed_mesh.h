@@ -42,10 +42,11 @@ namespace labelmesh::mixed_mesh {
 //   and NSET=<G>_BOUNDARY the points of its boundary, where <G> is the upper-case group name
 //   (LABEL_5_LIVER). Labels must be positive.
 // - kTetgen: not written: TetGen's .node/.ele pair holds tetrahedra only.
+// - kXdmf: not written: labelmesh writes XDMF for tetrahedral meshes only.
 //
 // Errors: INVALID_ARGUMENT naming the file when the mesh is malformed (see check_mixed_mesh),
 // a quality vector has the wrong size, a label is not positive where it must be, or the format
-// is kTetgen; INTERNAL naming the file when it cannot be written.
+// is kTetgen or kXdmf; INTERNAL naming the file when it cannot be written.
 absl::Status write_mixed_mesh(const MixedMesh& mesh, const MixedQuality& quality,
                               const std::string& path, volume_mesh::VolumeFormat format,
                               const volume_mesh::VolumeFileInfo& info = {});

@@ -43,6 +43,12 @@ std::vector<int32_t> labels_of(const volume::LabelVolume& volume) {
   return out;
 }
 
+volume::LabelVolume interpolated(const volume::LabelVolume& thick, const ThickSlices& cut) {
+  auto fine = interpolate_thick_slices(thick, {}, cut, RunContext{});
+  EXPECT_TRUE(fine.ok()) << fine.status();
+  return fine.ok() ? std::move(*fine) : volume::LabelVolume{};
+}
+
 std::map<int32_t, double> label_volumes(const volume::LabelVolume& volume) {
   std::map<int32_t, double> volumes;
   for (const auto& label : volume::compute_label_statistics(volume).labels)
@@ -56,15 +62,50 @@ TEST(ThickSlices, FindsTheThickAxisAndHowFineToCutIt) {
   g.spacing = {0.5, 0.5, 3};
   EXPECT_EQ(find_thick_slices(g, {}).axis, 2);
   EXPECT_EQ(find_thick_slices(g, {}).parts, 3);
-  g.spacing = {3, 0.6, 0.5};
+  g.spacing = {3, 0.55, 0.5};
   EXPECT_EQ(find_thick_slices(g, {}).axis, 0);
-  EXPECT_EQ(find_thick_slices(g, {}).parts, 3);  // 3 / (2 x 0.6), rounded
+  EXPECT_EQ(find_thick_slices(g, {}).parts, 3);  // 3 / (2 x 0.55), rounded
   g.spacing = {0.6, 0.6, 2};
   EXPECT_EQ(find_thick_slices(g, {}).parts, 2);
   g.spacing = {1, 1, 2.5};  // not thick enough to cut
   EXPECT_EQ(find_thick_slices(g, {}).axis, -1);
   g.spacing = {0.2, 0.2, 10};
   EXPECT_EQ(find_thick_slices(g, {}).parts, 8);  // at most max_parts
+  ThickSliceParams small;
+  small.max_voxels = g.voxel_count() * 5;
+  EXPECT_EQ(find_thick_slices(g, small).parts, 5);  // no more voxels than a volume may hold
+  small.max_voxels = g.voxel_count();
+  EXPECT_EQ(find_thick_slices(g, small).axis, -1);
+}
+
+TEST(ThickSlices, RefuseACutThatIsNotOne) {
+  const auto thick = thick_nested_balls();
+  for (const ThickSlices cut : {ThickSlices{2, 1}, ThickSlices{3, 2}, ThickSlices{-1, 2}}) {
+    const auto fine = interpolate_thick_slices(thick, {}, cut, RunContext{});
+    EXPECT_EQ(fine.status().code(), absl::StatusCode::kInvalidArgument);
+  }
+}
+
+// A label two pixels wide on one slice alone: interpolation alone would lose
+// it between slices; the bias brings its volume back.
+TEST(ThickSlices, ALabelOnOneSliceKeepsItsVolume) {
+  const std::array<double, 3> spacing{0.6, 0.6, 2.4};
+  const auto grid = volume::centred_grid({40, 40, 5}, spacing, kIdentity, kCentre);
+  const auto thick = volume::rasterise(grid, [&](const std::array<double, 3>& p) {
+    const auto index = grid.to_index(p);
+    const bool on_slice = std::lround(index[2]) == 2;
+    const bool stripe = std::lround(index[0]) >= 19 && std::lround(index[0]) <= 20 &&
+                        std::lround(index[1]) >= 5 && std::lround(index[1]) <= 34;
+    return on_slice && stripe ? 7 : std::lround(index[1]) < 20 ? 1 : 0;
+  });
+  const ThickSlices cut = find_thick_slices(thick.geometry, {});
+  ASSERT_EQ(cut.parts, 2);
+  const auto fine = interpolated(thick, cut);
+  const auto thick_volumes = label_volumes(thick);
+  const auto fine_volumes = label_volumes(fine);
+  ASSERT_TRUE(fine_volumes.contains(7));
+  EXPECT_NEAR(fine_volumes.at(7) / thick_volumes.at(7), 1.0, 0.02);
+  EXPECT_NEAR(fine_volumes.at(1) / thick_volumes.at(1), 1.0, 0.005);
 }
 
 TEST(ThickSlices, KeepEachSliceAndEachLabelsVolume) {
@@ -72,7 +113,7 @@ TEST(ThickSlices, KeepEachSliceAndEachLabelsVolume) {
   const ThickSlices cut = find_thick_slices(thick.geometry, {});
   ASSERT_EQ(cut.axis, 2);
   ASSERT_EQ(cut.parts, 3);
-  const auto fine = interpolate_thick_slices(thick, {}, cut);
+  const auto fine = interpolated(thick, cut);
   EXPECT_EQ(fine.geometry.dims[2], thick.geometry.dims[2] * 3);
   EXPECT_DOUBLE_EQ(fine.geometry.spacing[2], 1.0);
   // Both grids start and end at the same plane.
@@ -91,7 +132,7 @@ TEST(ThickSlices, KeepEachSliceAndEachLabelsVolume) {
 TEST(ThickSlices, FollowTheShapeBetweenSlicesBetterThanTheSlicesDo) {
   const auto thick = thick_nested_balls();
   const ThickSlices cut = find_thick_slices(thick.geometry, {});
-  const auto fine = interpolate_thick_slices(thick, {}, cut);
+  const auto fine = interpolated(thick, cut);
   const auto fine_labels = labels_of(fine);
   const auto thick_labels = labels_of(thick);
   const auto& d = fine.geometry.dims;
@@ -116,7 +157,7 @@ TEST(ThickSlices, AnyAxisCanBeThick) {
   const auto thick = thick_nested_balls(0);
   const ThickSlices cut = find_thick_slices(thick.geometry, {});
   ASSERT_EQ(cut.axis, 0);
-  const auto fine = interpolate_thick_slices(thick, {}, cut);
+  const auto fine = interpolated(thick, cut);
   const auto thick_volumes = label_volumes(thick);
   const auto fine_volumes = label_volumes(fine);
   for (int32_t label : {1, 2})
