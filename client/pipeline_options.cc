@@ -142,6 +142,12 @@ void add_pipeline_flags(CLI::App& command, PipelineFlags& flags) {
                   "--hex-size under the surface, coarser deeper in); 0 for one size throughout")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
+  command
+      .add_option("--conforming-max-faces", flags.conforming_max_interface_faces,
+                  "Conforming: voxel faces between labels above which blocks of voxels are "
+                  "merged (each keeping its most common label) so the mesh fits in about 1 GiB; "
+                  "0 for no bound")
+      ->capture_default_str();
   auto& tetgen = flags.tetgen;
   command
       .add_option("--tet-radius-edge", tetgen.radius_edge_ratio,
@@ -261,6 +267,7 @@ absl::StatusOr<v1::MeshOptions> to_mesh_options(const PipelineFlags& flags) {
                      : flags.volume == "conforming" ? v1::VOLUME_METHOD_CONFORMING
                                                     : v1::VOLUME_METHOD_TETGEN);
     proto.set_hex_size_mm(flags.hex_size_mm);
+    proto.set_conforming_max_interface_faces(flags.conforming_max_interface_faces);
     proto.set_hex_interior_size_mm(flags.hex_interior_size_mm);
     proto.set_tet_radius_edge(flags.tetgen.radius_edge_ratio);
     proto.set_tet_min_dihedral_deg(flags.tetgen.min_dihedral_deg);

@@ -26,6 +26,7 @@ struct PipelineFlags {
   std::string volume = "none";
   double hex_size_mm = 0;
   double hex_interior_size_mm = 0;
+  uint64_t conforming_max_interface_faces = conforming::kDefaultMaxInterfaceFaces;
   volume_mesh::TetgenParams tetgen;
   volume_mesh::ImproveParams improve;
   bool tet_split_boundary = false;

@@ -81,6 +81,14 @@ std::string report_table(const v1::Report& report) {
         (unsigned long long)f.interfaces(), (unsigned long long)f.interface_faces(),
         (unsigned long long)f.outer_faces(), f.interface_offset_max_mm(), f.volume_gap(),
         100 * f.volume_change_median(), 100 * f.volume_change_p90());
+    if (f.coarsening_factors_size() == 3 &&
+        f.coarsening_factors(0) * f.coarsening_factors(1) * f.coarsening_factors(2) > 1) {
+      table +=
+          row("conforming: %llu voxel faces between labels; blocks of %u x %u x %u voxels merged "
+              "(--conforming-max-faces)\n",
+              (unsigned long long)f.interface_voxel_faces(), f.coarsening_factors(0),
+              f.coarsening_factors(1), f.coarsening_factors(2));
+    }
     if (f.thick_slice_axis() >= 0 && f.thick_slice_parts() > 1) {
       table += row("conforming: thick slices along voxel axis %d cut into %u each\n",
                    f.thick_slice_axis(), f.thick_slice_parts());

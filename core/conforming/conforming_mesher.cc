@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <map>
+#include <optional>
 
 #include "core/util/text.h"
 #include "core/util/vec3.h"
@@ -99,22 +100,34 @@ absl::StatusOr<volume_mesh::TetMesh> mesh_conforming(const volume::LabelVolume& 
         "conforming mesh: no voxel holds any of the selected labels; nothing to mesh");
   }
   context.report("interfaces", 0);
-  // Thick slices are cut into thinner ones first; the voxels counted above
-  // stay the measure of each label's volume.
-  figures.thick_slices = find_thick_slices(volume.geometry, params.thick_slices);
-  std::array<double, 3> spacing = volume.geometry.spacing;
+  // A grid whose interfaces would be too large is coarsened, and thick
+  // slices are cut into thinner ones; the voxels counted above stay the
+  // measure of each label's volume.
+  const auto grid_start = std::chrono::steady_clock::now();
+  figures.coarsening = choose_coarsening(volume, labels, params.max_interface_faces);
+  std::optional<volume::LabelVolume> coarse;
+  if (figures.coarsening.factors != std::array<int, 3>{1, 1, 1}) {
+    auto coarsened = coarsen_labels(volume, labels, figures.coarsening.factors, context);
+    if (!coarsened.ok()) return coarsened.status();
+    coarse = std::move(*coarsened);
+  }
+  const volume::LabelVolume& grid = coarse ? *coarse : volume;
+  figures.thick_slices = find_thick_slices(grid.geometry, params.thick_slices);
+  std::array<double, 3> spacing = grid.geometry.spacing;
   InterfaceSurface surface;
   if (figures.thick_slices.axis >= 0) {
-    const auto cut_start = std::chrono::steady_clock::now();
-    auto thinner = interpolate_thick_slices(volume, labels, figures.thick_slices, context);
+    auto thinner = interpolate_thick_slices(grid, labels, figures.thick_slices, context);
     if (!thinner.ok()) return thinner.status();
-    figures.thick_slice_seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - cut_start).count();
+    figures.grid_seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - grid_start).count();
     surface = label_interfaces(*thinner, labels, params.interfaces, figures.interfaces);
     spacing = thinner->geometry.spacing;
   } else {
-    surface = label_interfaces(volume, labels, params.interfaces, figures.interfaces);
+    figures.grid_seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - grid_start).count();
+    surface = label_interfaces(grid, labels, params.interfaces, figures.interfaces);
   }
+  coarse.reset();
   if (auto status = remove_crossings(surface, params.max_crossing_repairs, context, figures);
       !status.ok()) {
     return status;

@@ -10,6 +10,7 @@
 
 #include "absl/status/statusor.h"
 #include "core/conforming/check_conforming_mesh.h"
+#include "core/conforming/coarsen_labels.h"
 #include "core/conforming/label_interfaces.h"
 #include "core/conforming/slide_interface_points.h"
 #include "core/conforming/tetrahedralize_interfaces.h"
@@ -23,6 +24,9 @@
 namespace labelmesh::conforming {
 
 struct ConformingParams {
+  // Voxel faces between labels above which the grid is coarsened
+  // (coarsen_labels.h); 0 keeps every grid.
+  uint64_t max_interface_faces = kDefaultMaxInterfaceFaces;
   ThickSliceParams thick_slices;
   InterfaceParams interfaces;
   volume_mesh::TetgenParams tetgen;
@@ -53,8 +57,12 @@ struct LabelVolumeFigures {
 struct ConformingFigures {
   // The thick axis cut before the interfaces were made, if any; the
   // interfaces' figures are then on the thinner grid.
+  // The grid the interfaces were made on: the input's, coarsened when its
+  // interfaces were too large, and thick slices cut thinner. The
+  // interfaces' figures are on that grid.
+  Coarsening coarsening;
   ThickSlices thick_slices;
-  double thick_slice_seconds = 0;
+  double grid_seconds = 0;
   InterfaceFigures interfaces;
   // Repair rounds run and the points put back on the staircase; whether
   // every point had to go back.

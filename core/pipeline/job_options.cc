@@ -271,6 +271,8 @@ absl::Status read_volume_options(const v1::MeshOptions& options, MeshParams& par
     default:
       return absl::InvalidArgumentError("volume: unknown volume method");
   }
+  if (options.has_conforming_max_interface_faces())
+    params.conforming_max_interface_faces = options.conforming_max_interface_faces();
   if (options.has_hex_size_mm()) params.hex_size_mm = options.hex_size_mm();
   if (!(params.hex_size_mm == 0 || (params.hex_size_mm >= 0.05 && params.hex_size_mm <= 1000)))
     return absl::InvalidArgumentError(
@@ -372,6 +374,7 @@ v1::MeshOptions make_options(const MeshParams& params) {
                                                                     : v1::VOLUME_METHOD_TETGEN);
     options.set_hex_size_mm(params.hex_size_mm);
     options.set_hex_interior_size_mm(params.hex_interior_size_mm);
+    options.set_conforming_max_interface_faces(params.conforming_max_interface_faces);
     for (auto format : params.volume_formats)
       options.add_formats(std::string(volume_mesh::volume_format_name(format)));
   } else {

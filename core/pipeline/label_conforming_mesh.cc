@@ -37,6 +37,7 @@ absl::Status add_conforming_mesh(const volume::LabelVolume& volume,
                                  const std::vector<int32_t>& labels, const MeshParams& params,
                                  const RunContext& context, MeshResult& result) {
   conforming::ConformingParams conforming;
+  conforming.max_interface_faces = params.conforming_max_interface_faces;
   conforming.tetgen = params.tetgen;
   // Points TetGen added on the interfaces would split the triangles the
   // labels share and the slides follow: the interfaces are always kept.

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "core/conforming/interface_budget.h"
 #include "core/pipeline/scene_format.h"
 #include "core/surface/poisson_surface.h"
 #include "core/surface/smooth_surface.h"
@@ -140,6 +141,9 @@ struct MeshParams {
   // kMixed: the largest octant's edge inside a label, mm; 0 for hex_size_mm
   // throughout (no octree).
   double hex_interior_size_mm = 0;
+  // kConforming: voxel faces between labels above which the grid is
+  // coarsened; 0 for no bound.
+  uint64_t conforming_max_interface_faces = conforming::kDefaultMaxInterfaceFaces;
   volume_mesh::TetgenParams tetgen;
   volume_mesh::ImproveParams improve;
   // Volume mesh files (when `volume` is not kNone).

@@ -440,8 +440,6 @@ int bench_conforming_file(const std::string& path, int pairs) {
     return 1;
   }
   const auto& spacing = volume->geometry.spacing;
-  const double voxel = std::cbrt(spacing[0] * spacing[1] * spacing[2]);
-  bench::Mesh3Sizing sizing{voxel, 0.5 * voxel, voxel};
   std::vector<double> ours_seconds, mesh3_seconds;
   for (int pair = 0; pair < pairs; ++pair) {
     conforming::ConformingFigures figures;
@@ -453,6 +451,11 @@ int bench_conforming_file(const std::string& path, int pairs) {
       std::fprintf(stderr, "%s: %s\n", path.c_str(), std::string(mesh.status().message()).c_str());
       return 1;
     }
+    // Mesh_3 sized by the voxels ours meshed: the input's, or the coarser
+    // blocks when the interfaces were too large.
+    const auto& f = figures.coarsening.factors;
+    const double voxel = std::cbrt(spacing[0] * f[0] * spacing[1] * f[1] * spacing[2] * f[2]);
+    const bench::Mesh3Sizing sizing{voxel, 0.5 * voxel, voxel};
     auto mesh3 = bench::mesh_labels_with_mesh3(*volume, sizing);
     if (!mesh3.ok()) {
       std::fprintf(stderr, "%s: %s\n", path.c_str(), std::string(mesh3.status().message()).c_str());
@@ -478,11 +481,14 @@ int bench_conforming_file(const std::string& path, int pairs) {
         "  interfaces   %8.3f s  %zu points (%zu on junctions, %zu fixed), %zu triangles, "
         "within %.2f mm of the voxel boundary\n",
         i.seconds, i.points, i.junction_points, i.fixed_points, i.triangles, i.max_offset_mm);
+    std::printf("  grid         %8.3f s  %llu voxel faces between labels; blocks %d x %d x %d",
+                figures.grid_seconds, (unsigned long long)figures.coarsening.interface_faces, f[0],
+                f[1], f[2]);
     if (figures.thick_slices.axis >= 0) {
-      std::printf("  thick slices %8.3f s  axis %d cut into %d each (shape-based interpolation)\n",
-                  figures.thick_slice_seconds, figures.thick_slices.axis,
-                  figures.thick_slices.parts);
+      std::printf("; thick axis %d cut into %d (shape-based interpolation)",
+                  figures.thick_slices.axis, figures.thick_slices.parts);
     }
+    std::printf("\n");
     std::printf("  crossings    repairs %d, points restored %zu, staircase only %d\n",
                 figures.crossing_repairs, figures.restored_points, int(figures.staircase_only));
     std::printf("  tetgen       %8.3f s  %zu tetrahedra, %zu regions (%zu outside)\n",
