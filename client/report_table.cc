@@ -84,8 +84,8 @@ std::string report_table(const v1::Report& report) {
     if (f.coarsening_factors_size() == 3 &&
         f.coarsening_factors(0) * f.coarsening_factors(1) * f.coarsening_factors(2) > 1) {
       table +=
-          row("conforming: %llu voxel faces between labels; blocks of %u x %u x %u voxels merged "
-              "(--conforming-max-faces)\n",
+          row("conforming: %llu voxel faces between labels; resampled to %.2f x %.2f x %.2f the "
+              "spacing (--conforming-max-faces)\n",
               (unsigned long long)f.interface_voxel_faces(), f.coarsening_factors(0),
               f.coarsening_factors(1), f.coarsening_factors(2));
     }

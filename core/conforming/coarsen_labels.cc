@@ -5,7 +5,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <utility>
 
 #include "core/util/text.h"
 #include "core/volume/voxel_access.h"
@@ -56,32 +55,37 @@ Coarsening choose_coarsening(const volume::LabelVolume& volume, const std::vecto
   const double scale = std::sqrt(double(coarsening.interface_faces) / double(max_interface_faces));
   const auto& s = volume.geometry.spacing;
   const double least = std::min({s[0], s[1], s[2]});
-  for (int a = 0; a < 3; ++a) {
-    coarsening.factors[a] = static_cast<int>(
-        std::clamp<int64_t>(static_cast<int64_t>(std::ceil(scale * least / s[a] - 1e-9)), 1,
-                            std::max<int64_t>(1, d[a])));
-  }
+  for (int a = 0; a < 3; ++a) coarsening.factors[a] = std::max(1.0, scale * least / s[a]);
   return coarsening;
 }
 
 absl::StatusOr<volume::LabelVolume> coarsen_labels(const volume::LabelVolume& volume,
                                                    const std::vector<int32_t>& labels,
-                                                   const std::array<int, 3>& factors,
+                                                   const std::array<double, 3>& factors,
                                                    const RunContext& context) {
-  for (int factor : factors) {
-    if (factor < 1) return absl::InvalidArgumentError(cat("coarsening: factor ", factor, " < 1"));
+  for (double factor : factors) {
+    if (!(factor >= 1))
+      return absl::InvalidArgumentError(cat("coarsening: factor ", factor, " < 1"));
   }
   const auto& geometry = volume.geometry;
+  const auto& d = geometry.dims;
   volume::LabelVolume coarse;
   coarse.format = volume.format;
   coarse.file_voxel_type = volume.file_voxel_type;
   coarse.descriptions = volume.descriptions;
   coarse.geometry = geometry;
   std::array<double, 3> first{};
+  // Input index of each coarser voxel's centre along each axis.
+  std::array<std::vector<int64_t>, 3> nearest;
   for (int a = 0; a < 3; ++a) {
-    coarse.geometry.dims[a] = (geometry.dims[a] + factors[a] - 1) / factors[a];
+    const auto n = std::max<int64_t>(1, static_cast<int64_t>(std::ceil(d[a] / factors[a] - 1e-9)));
+    coarse.geometry.dims[a] = n;
     coarse.geometry.spacing[a] = geometry.spacing[a] * factors[a];
-    first[a] = 0.5 * (factors[a] - 1);
+    first[a] = 0.5 * factors[a] - 0.5;
+    for (int64_t j = 0; j < n; ++j) {
+      const double centre = (j + 0.5) * factors[a] - 0.5;
+      nearest[a].push_back(std::clamp<int64_t>(std::llround(centre), 0, d[a] - 1));
+    }
   }
   coarse.geometry.origin = geometry.to_physical(first);
   const auto& cd = coarse.geometry.dims;
@@ -95,33 +99,12 @@ absl::StatusOr<volume::LabelVolume> coarsen_labels(const volume::LabelVolume& vo
         cat("coarsening: no memory for ", coarse.geometry.voxel_count(), " voxels"));
   }
   const auto voxels = selected_labels(volume, labels);
-  const auto& d = geometry.dims;
-  std::vector<std::pair<int32_t, int>> counts;
   for (int64_t z = 0; z < cd[2]; ++z) {
     if (auto status = context.check_stop(); !status.ok()) return status;
     for (int64_t y = 0; y < cd[1]; ++y) {
       for (int64_t x = 0; x < cd[0]; ++x) {
-        counts.clear();
-        for (int64_t k = z * factors[2]; k < std::min(d[2], (z + 1) * factors[2]); ++k) {
-          for (int64_t j = y * factors[1]; j < std::min(d[1], (y + 1) * factors[1]); ++j) {
-            for (int64_t i = x * factors[0]; i < std::min(d[0], (x + 1) * factors[0]); ++i) {
-              const int32_t label = voxels[static_cast<size_t>(i + d[0] * (j + d[1] * k))];
-              auto it = std::find_if(counts.begin(), counts.end(),
-                                     [&](const auto& c) { return c.first == label; });
-              if (it == counts.end()) {
-                counts.push_back({label, 1});
-              } else {
-                ++it->second;
-              }
-            }
-          }
-        }
-        const auto winner = std::max_element(counts.begin(), counts.end(), [](auto a, auto b) {
-          if (a.second != b.second) return a.second < b.second;
-          if ((a.first == 0) != (b.first == 0)) return a.first == 0;  // a label over 0
-          return a.first > b.first;                                   // the smaller label
-        });
-        out[x + cd[0] * (y + cd[1] * z)] = winner->first;
+        out[x + cd[0] * (y + cd[1] * z)] = voxels[static_cast<size_t>(
+            nearest[0][x] + d[0] * (nearest[1][y] + d[1] * nearest[2][z]))];
       }
     }
   }

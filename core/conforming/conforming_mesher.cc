@@ -106,7 +106,7 @@ absl::StatusOr<volume_mesh::TetMesh> mesh_conforming(const volume::LabelVolume& 
   const auto grid_start = std::chrono::steady_clock::now();
   figures.coarsening = choose_coarsening(volume, labels, params.max_interface_faces);
   std::optional<volume::LabelVolume> coarse;
-  if (figures.coarsening.factors != std::array<int, 3>{1, 1, 1}) {
+  if (figures.coarsening.factors != std::array<double, 3>{1, 1, 1}) {
     auto coarsened = coarsen_labels(volume, labels, figures.coarsening.factors, context);
     if (!coarsened.ok()) return coarsened.status();
     coarse = std::move(*coarsened);

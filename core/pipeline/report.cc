@@ -110,8 +110,7 @@ void add_conforming_figures(const conforming::ConformingFigures& figures,
   out->set_thick_slice_axis(figures.thick_slices.axis);
   out->set_thick_slice_parts(static_cast<uint32_t>(figures.thick_slices.parts));
   out->set_interface_voxel_faces(figures.coarsening.interface_faces);
-  for (int factor : figures.coarsening.factors)
-    out->add_coarsening_factors(static_cast<uint32_t>(factor));
+  for (double factor : figures.coarsening.factors) out->add_coarsening_factors(factor);
   for (const auto& label : figures.labels) {
     auto* l = out->add_labels();
     l->set_label(label.label);

@@ -481,7 +481,7 @@ int bench_conforming_file(const std::string& path, int pairs) {
         "  interfaces   %8.3f s  %zu points (%zu on junctions, %zu fixed), %zu triangles, "
         "within %.2f mm of the voxel boundary\n",
         i.seconds, i.points, i.junction_points, i.fixed_points, i.triangles, i.max_offset_mm);
-    std::printf("  grid         %8.3f s  %llu voxel faces between labels; blocks %d x %d x %d",
+    std::printf("  grid         %8.3f s  %llu voxel faces between labels; spacing x %.2f %.2f %.2f",
                 figures.grid_seconds, (unsigned long long)figures.coarsening.interface_faces, f[0],
                 f[1], f[2]);
     if (figures.thick_slices.axis >= 0) {
