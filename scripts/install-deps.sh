@@ -12,6 +12,8 @@ packages=(
   # service: schema, RPC, logging, metrics
   libgrpc++-dev libgrpc-dev protobuf-compiler protobuf-compiler-grpc libprotobuf-dev
   libspdlog-dev libfmt-dev prometheus-cpp-dev libcivetweb-dev libssl-dev
+  # jobs shared between machines: the NATS client, and the server the tests start
+  libnats-dev nats-server
   # command line and tests
   libcli11-dev libgtest-dev libgmock-dev
   # tests that prove our files with tools we did not write

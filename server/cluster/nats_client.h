@@ -1,0 +1,46 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// One connection to a NATS server and its JetStream context, for the parts
+// of labelmeshd that share jobs between machines (job_queue.h,
+// job_states.h). The C client (Debian's libnats) does the protocol.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <string_view>
+
+#include <nats/nats.h>
+
+#include "absl/status/statusor.h"
+#include "absl/time/time.h"
+
+namespace labelmesh::cluster {
+
+class NatsClient {
+ public:
+  // Connects to `url` (nats://HOST:PORT), naming the connection `name` in
+  // the server's monitoring, waiting at most `timeout`.
+  // Errors: UNAVAILABLE when no server answers; INVALID_ARGUMENT for a bad
+  // URL; INTERNAL otherwise.
+  static absl::StatusOr<std::unique_ptr<NatsClient>> connect(const std::string& url,
+                                                             const std::string& name,
+                                                             absl::Duration timeout);
+  ~NatsClient();
+  NatsClient(const NatsClient&) = delete;
+  NatsClient& operator=(const NatsClient&) = delete;
+
+  natsConnection* connection() const { return connection_; }
+  jsCtx* jetstream() const { return jetstream_; }
+
+ private:
+  NatsClient(natsConnection* connection, jsCtx* jetstream)
+      : connection_(connection), jetstream_(jetstream) {}
+  natsConnection* connection_;
+  jsCtx* jetstream_;
+};
+
+// A failed call as a status naming `what`: NATS_TIMEOUT is
+// DEADLINE_EXCEEDED, NATS_NOT_FOUND NOT_FOUND, a closed or absent server
+// UNAVAILABLE, the rest INTERNAL with the client's own text.
+absl::Status nats_error(natsStatus status, std::string_view what);
+
+}  // namespace labelmesh::cluster

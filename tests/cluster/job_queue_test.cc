@@ -1,0 +1,188 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// The job queue and job states on a real nats-server with JetStream.
+#include "server/cluster/job_queue.h"
+
+#include <gtest/gtest.h>
+
+#include <set>
+
+#include "cluster/nats_server.h"
+#include "server/cluster/job_states.h"
+#include "support/test_files.h"
+
+namespace labelmesh::cluster {
+namespace {
+
+struct Cluster {
+  explicit Cluster(const std::string& name) : server(testing::scratch_dir(name)) {}
+
+  std::unique_ptr<NatsClient> client() {
+    auto client = NatsClient::connect(server.url(), "labelmesh-test", absl::Seconds(5));
+    EXPECT_TRUE(client.ok()) << client.status();
+    return client.ok() ? std::move(*client) : nullptr;
+  }
+
+  testing::NatsServer server;
+};
+
+JobQueueConfig quick(absl::Duration ack_wait = absl::Seconds(30), int max_deliver = 3) {
+  JobQueueConfig config;
+  config.ack_wait = ack_wait;
+  config.max_deliver = max_deliver;
+  return config;
+}
+
+std::unique_ptr<JobQueue> open_queue(NatsClient& client, const JobQueueConfig& config) {
+  auto queue = JobQueue::open(client, config);
+  EXPECT_TRUE(queue.ok()) << queue.status();
+  return queue.ok() ? std::move(*queue) : nullptr;
+}
+
+TEST(JobQueue, ADuplicateSubmitIsQueuedOnceAndEachJobGoesToOneWorker) {
+  Cluster cluster("duplicates");
+  ASSERT_TRUE(cluster.server.running());
+  auto client = cluster.client();
+  ASSERT_NE(client, nullptr);
+  auto queue = open_queue(*client, quick());
+  ASSERT_NE(queue, nullptr);
+  EXPECT_EQ(queue->enqueue("job-a").value(), true);
+  EXPECT_EQ(queue->enqueue("job-a").value(), false);
+  EXPECT_EQ(queue->enqueue("job-b").value(), true);
+  EXPECT_EQ(queue->stored().value(), 2u);
+
+  // A second worker's connection shares the same consumer.
+  auto other_client = cluster.client();
+  auto other = open_queue(*other_client, quick());
+  ASSERT_NE(other, nullptr);
+  auto first = queue->take(absl::Seconds(2));
+  auto second = other->take(absl::Seconds(2));
+  ASSERT_TRUE(first.ok() && second.ok());
+  ASSERT_TRUE(first->has_value() && second->has_value());
+  EXPECT_EQ((std::set<std::string>{(*first)->job_id(), (*second)->job_id()}),
+            (std::set<std::string>{"job-a", "job-b"}));
+  EXPECT_EQ((*first)->delivered(), 1u);
+  EXPECT_TRUE((*first)->ack().ok());
+  EXPECT_TRUE((*second)->ack().ok());
+  EXPECT_FALSE(queue->take(absl::Milliseconds(300)).value().has_value());
+  EXPECT_EQ(queue->stored().value(), 0u);  // acknowledged jobs leave the stream
+}
+
+TEST(JobQueue, AJobWhoseWorkerDiedGoesToTheNextWorker) {
+  Cluster cluster("redelivery");
+  auto client = cluster.client();
+  ASSERT_NE(client, nullptr);
+  const auto config = quick(absl::Seconds(1));
+  auto queue = open_queue(*client, config);
+  ASSERT_NE(queue, nullptr);
+  ASSERT_TRUE(queue->enqueue("job-a").ok());
+  {
+    // A worker takes the job and dies without a word: its connection ends.
+    auto doomed_client = cluster.client();
+    auto doomed = open_queue(*doomed_client, config);
+    auto taken = doomed->take(absl::Seconds(2));
+    ASSERT_TRUE(taken.ok() && taken->has_value());
+    EXPECT_EQ((*taken)->delivered(), 1u);
+  }
+  auto again = queue->take(absl::Seconds(5));
+  ASSERT_TRUE(again.ok() && again->has_value());
+  EXPECT_EQ((*again)->job_id(), "job-a");
+  EXPECT_EQ((*again)->delivered(), 2u);
+  EXPECT_TRUE((*again)->ack().ok());
+}
+
+TEST(JobQueue, AWorkerThatSaysItIsWorkingKeepsItsJob) {
+  Cluster cluster("in-progress");
+  auto client = cluster.client();
+  ASSERT_NE(client, nullptr);
+  const auto config = quick(absl::Seconds(1));
+  auto queue = open_queue(*client, config);
+  ASSERT_TRUE(queue->enqueue("job-a").ok());
+  auto taken = queue->take(absl::Seconds(2));
+  ASSERT_TRUE(taken.ok() && taken->has_value());
+  auto other_client = cluster.client();
+  auto other = open_queue(*other_client, config);
+  // Three ack waits, the job reported in progress every half wait: nobody
+  // else gets it.
+  for (int i = 0; i < 6; ++i) {
+    EXPECT_TRUE((*taken)->in_progress().ok());
+    auto stolen = other->take(absl::Milliseconds(500));
+    ASSERT_TRUE(stolen.ok());
+    EXPECT_FALSE(stolen->has_value()) << "handed out again after " << i << " half waits";
+  }
+  EXPECT_TRUE((*taken)->ack().ok());
+}
+
+TEST(JobQueue, APoisonJobStopsAfterMaxDeliveries) {
+  Cluster cluster("max-deliver");
+  auto client = cluster.client();
+  ASSERT_NE(client, nullptr);
+  auto queue = open_queue(*client, quick(absl::Seconds(30), 2));
+  ASSERT_TRUE(queue->enqueue("poison").ok());
+  for (uint64_t attempt = 1; attempt <= 2; ++attempt) {
+    auto taken = queue->take(absl::Seconds(2));
+    ASSERT_TRUE(taken.ok() && taken->has_value());
+    EXPECT_EQ((*taken)->delivered(), attempt);
+    EXPECT_TRUE((*taken)->nak().ok());
+  }
+  EXPECT_FALSE(queue->take(absl::Milliseconds(500)).value().has_value());
+}
+
+TEST(JobQueue, QueuedJobsOutliveANatsRestart) {
+  Cluster cluster("restart");
+  {
+    auto client = cluster.client();
+    auto queue = open_queue(*client, quick());
+    for (const char* id : {"job-a", "job-b", "job-c"}) ASSERT_TRUE(queue->enqueue(id).ok());
+  }
+  cluster.server.restart();
+  ASSERT_TRUE(cluster.server.running());
+  auto client = cluster.client();
+  ASSERT_NE(client, nullptr);
+  auto queue = open_queue(*client, quick());
+  ASSERT_NE(queue, nullptr);
+  std::set<std::string> taken;
+  for (int i = 0; i < 3; ++i) {
+    auto job = queue->take(absl::Seconds(2));
+    ASSERT_TRUE(job.ok() && job->has_value());
+    taken.insert((*job)->job_id());
+    EXPECT_TRUE((*job)->ack().ok());
+  }
+  EXPECT_EQ(taken, (std::set<std::string>{"job-a", "job-b", "job-c"}));
+}
+
+TEST(JobStates, AStaleWriterIsRefused) {
+  Cluster cluster("states");
+  auto client = cluster.client();
+  ASSERT_NE(client, nullptr);
+  auto states = JobStates::open(*client, "labelmesh_jobs");
+  ASSERT_TRUE(states.ok()) << states.status();
+  auto& table = **states;
+  const auto created = table.create("job-a", "queued");
+  ASSERT_TRUE(created.ok()) << created.status();
+  EXPECT_EQ(table.create("job-a", "queued").status().code(), absl::StatusCode::kAlreadyExists);
+
+  // Two workers read the same revision; the first to write wins.
+  const auto seen = table.get("job-a").value();
+  EXPECT_EQ(seen.value, "queued");
+  EXPECT_EQ(seen.revision, *created);
+  const auto running = table.update("job-a", "running on worker 2", seen.revision);
+  ASSERT_TRUE(running.ok()) << running.status();
+  const auto stale = table.update("job-a", "finished by worker 1", seen.revision);
+  EXPECT_EQ(stale.status().code(), absl::StatusCode::kAborted) << stale.status();
+  EXPECT_EQ(table.get("job-a").value().value, "running on worker 2");
+
+  EXPECT_TRUE(table.remove("job-a").ok());
+  EXPECT_EQ(table.get("job-a").status().code(), absl::StatusCode::kNotFound);
+  EXPECT_EQ(table.get("never").status().code(), absl::StatusCode::kNotFound);
+}
+
+TEST(NatsClient, NoServerIsUnavailable) {
+  testing::NatsServer server(testing::scratch_dir("gone"));
+  const std::string url = server.url();
+  server.stop();
+  auto client = NatsClient::connect(url, "labelmesh-test", absl::Milliseconds(500));
+  EXPECT_EQ(client.status().code(), absl::StatusCode::kUnavailable) << client.status();
+}
+
+}  // namespace
+}  // namespace labelmesh::cluster
