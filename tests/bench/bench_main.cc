@@ -451,6 +451,8 @@ int bench_conforming_file(const std::string& path, int pairs) {
       std::fprintf(stderr, "%s: %s\n", path.c_str(), std::string(mesh.status().message()).c_str());
       return 1;
     }
+    // Ours runs first, so the peak so far is ours (with the volume read).
+    if (pair == 0) std::printf("  ours peak RSS %.1f MiB\n", peak_rss_mib());
     // Mesh_3 sized by the voxels ours meshed: the input's, or the coarser
     // blocks when the interfaces were too large.
     const auto& f = figures.coarsening.factors;

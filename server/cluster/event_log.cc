@@ -1,0 +1,89 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+#include "server/cluster/event_log.h"
+
+#include "absl/strings/str_cat.h"
+
+namespace labelmesh::cluster {
+
+EventFollower::~EventFollower() { natsSubscription_Destroy(subscription_); }
+
+absl::StatusOr<std::optional<LoggedEvent>> EventFollower::next(absl::Duration wait) {
+  natsMsg* message = nullptr;
+  const natsStatus status =
+      natsSubscription_NextMsg(&message, subscription_, absl::ToInt64Milliseconds(wait));
+  if (status == NATS_TIMEOUT) return std::nullopt;
+  if (status != NATS_OK) return nats_error(status, "following a job's events");
+  LoggedEvent event;
+  event.data.assign(natsMsg_GetData(message), static_cast<size_t>(natsMsg_GetDataLength(message)));
+  jsMsgMetaData* meta = nullptr;
+  if (natsMsg_GetMetaData(&meta, message) == NATS_OK) {
+    event.sequence = meta->Sequence.Stream;
+    jsMsgMetaData_Destroy(meta);
+  }
+  natsMsg_Destroy(message);
+  return std::optional<LoggedEvent>(std::move(event));
+}
+
+absl::StatusOr<std::unique_ptr<EventLog>> EventLog::open(NatsClient& client,
+                                                         const EventLogConfig& config) {
+  const std::string subjects_text = config.subject_prefix + ".>";
+  const char* subjects[] = {subjects_text.c_str()};
+  jsStreamConfig stream;
+  jsStreamConfig_Init(&stream);
+  stream.Name = config.stream.c_str();
+  stream.Subjects = subjects;
+  stream.SubjectsLen = 1;
+  stream.Retention = js_LimitsPolicy;
+  stream.Storage = js_FileStorage;
+  stream.MaxAge = absl::ToInt64Nanoseconds(config.max_age);
+  jsErrCode code = static_cast<jsErrCode>(0);
+  jsStreamInfo* info = nullptr;
+  const natsStatus status = js_AddStream(&info, client.jetstream(), &stream, nullptr, &code);
+  jsStreamInfo_Destroy(info);
+  if (status != NATS_OK && code != JSStreamNameExistErr)
+    return nats_error(status, absl::StrCat("stream ", config.stream));
+  return std::unique_ptr<EventLog>(new EventLog(client, config));
+}
+
+std::string EventLog::subject(const std::string& job_id) const {
+  return absl::StrCat(config_.subject_prefix, ".", job_id);
+}
+
+absl::StatusOr<uint64_t> EventLog::append(const std::string& job_id, const std::string& data) {
+  jsPubAck* ack = nullptr;
+  const natsStatus status =
+      js_Publish(&ack, client_.jetstream(), subject(job_id).c_str(), data.data(),
+                 static_cast<int>(data.size()), nullptr, nullptr);
+  if (status != NATS_OK) return nats_error(status, absl::StrCat("event of ", job_id));
+  const uint64_t sequence = ack->Sequence;
+  jsPubAck_Destroy(ack);
+  return sequence;
+}
+
+absl::StatusOr<std::unique_ptr<EventFollower>> EventLog::follow(const std::string& job_id,
+                                                                uint64_t from) {
+  jsSubOptions options;
+  jsSubOptions_Init(&options);
+  options.Stream = config_.stream.c_str();
+  options.Ordered = true;
+  if (from > 0) {
+    options.Config.DeliverPolicy = js_DeliverByStartSequence;
+    options.Config.OptStartSeq = from;
+  }
+  natsSubscription* subscription = nullptr;
+  const natsStatus status = js_SubscribeSync(&subscription, client_.jetstream(),
+                                             subject(job_id).c_str(), nullptr, &options, nullptr);
+  if (status != NATS_OK) return nats_error(status, absl::StrCat("events of ", job_id));
+  return std::make_unique<EventFollower>(subscription);
+}
+
+absl::Status EventLog::remove(const std::string& job_id) {
+  jsOptions options;
+  jsOptions_Init(&options);
+  const std::string filter = subject(job_id);
+  options.Stream.Purge.Subject = filter.c_str();
+  return nats_error(js_PurgeStream(client_.jetstream(), config_.stream.c_str(), &options, nullptr),
+                    absl::StrCat("removing the events of ", job_id));
+}
+
+}  // namespace labelmesh::cluster

@@ -1,0 +1,71 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// Every job's events (queued, started, progress, finished...) in one NATS
+// JetStream stream on file storage, one subject per job. Any frontend can
+// follow a job from any point: each event's stream sequence is its place,
+// which a client that lost its Watch stream gives back to resume.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "absl/status/statusor.h"
+#include "absl/time/time.h"
+#include "server/cluster/nats_client.h"
+
+namespace labelmesh::cluster {
+
+struct EventLogConfig {
+  std::string stream = "LABELMESH_EVENTS";
+  std::string subject_prefix = "labelmesh.events";
+  // Events older than this are dropped (jobs' results outlive them in the
+  // job states).
+  absl::Duration max_age = absl::Hours(24 * 7);
+};
+
+struct LoggedEvent {
+  uint64_t sequence = 0;  // the event's place in the stream, above 0
+  std::string data;
+};
+
+// One job's events in order, from where the follow began.
+class EventFollower {
+ public:
+  explicit EventFollower(natsSubscription* subscription) : subscription_(subscription) {}
+  ~EventFollower();
+  EventFollower(const EventFollower&) = delete;
+  EventFollower& operator=(const EventFollower&) = delete;
+
+  // The next event, waiting at most `wait`; nullopt when none came.
+  absl::StatusOr<std::optional<LoggedEvent>> next(absl::Duration wait);
+
+ private:
+  natsSubscription* subscription_;
+};
+
+class EventLog {
+ public:
+  // Creates the stream unless it exists. Errors: those of nats_error.
+  static absl::StatusOr<std::unique_ptr<EventLog>> open(NatsClient& client,
+                                                        const EventLogConfig& config);
+
+  // Appends an event to `job_id`'s; its sequence.
+  absl::StatusOr<uint64_t> append(const std::string& job_id, const std::string& data);
+
+  // Follows `job_id`'s events from sequence `from` on (0: from its first).
+  absl::StatusOr<std::unique_ptr<EventFollower>> follow(const std::string& job_id, uint64_t from);
+
+  // Drops every event of `job_id`.
+  absl::Status remove(const std::string& job_id);
+
+ private:
+  EventLog(NatsClient& client, EventLogConfig config)
+      : client_(client), config_(std::move(config)) {}
+  std::string subject(const std::string& job_id) const;
+
+  NatsClient& client_;
+  EventLogConfig config_;
+};
+
+}  // namespace labelmesh::cluster
