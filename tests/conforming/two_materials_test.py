@@ -1,11 +1,12 @@
 #!/usr/bin/env python3
 # SPDX-License-Identifier: AGPL-3.0-or-later
-"""A conforming mesh of three nested labels in solvers nobody here wrote.
+"""Conforming meshes of several labels in solvers nobody here wrote.
 
 The nested-spheres phantom (a ball inside two shells) is meshed with
 --volume conforming; meshio reads every volume format back with the same
 counts and groups, Gmsh checks the MSH, and CalculiX solves a gravity load
-with a stiff core and soft shells. Nodes on the interfaces belong to both
+with a stiff core and soft shells. The prostate's two zones get the same
+load case, the peripheral zone stiff. Nodes on the interfaces belong to both
 materials, so the displacement field is one field across them.
 """
 import json
@@ -88,7 +89,7 @@ def check_gmsh(work, report):
     print("gmsh: coherence check clean")
 
 
-def write_deck(work, nodes, sets):
+def write_deck(work, nodes, sets, job):
     zs = [p[2] for p in nodes.values()]
     z_min, z_max = min(zs), max(zs)
     fixed = sorted(n for n, p in nodes.items() if p[2] <= z_min + 0.1 * (z_max - z_min))
@@ -110,45 +111,62 @@ def write_deck(work, nodes, sets):
         "*NODE PRINT, NSET=EVERY", "U",
         "*END STEP",
     ]
-    (work / "nested.inp").write_text("\n".join(lines) + "\n")
+    (work / f"{job}.inp").write_text("\n".join(lines) + "\n")
     return fixed, core
+
+
+def solve_two_materials(work, report, job):
+    """A stiff label 1 inside or beside soft others under gravity; the nodes they share move as one."""
+    nodes = fe.read_nodes(work / "volume.inp")
+    sets, elements = element_sets(work / "volume.inp")
+    fixed, core = write_deck(work, nodes, sets, job)
+    core_nodes = {n for e in sets[core] for n in elements[e]}
+    shell_nodes = {n for name in sets if name != core for e in sets[name] for n in elements[e]}
+    shared = core_nodes & shell_nodes
+    if not shared:
+        fe.fail(f"{job}: the stiff and the soft labels share no node")
+    displacements = fe.check_calculix(work, nodes, fixed, job=job)
+    moved = sum(1 for n in shared if any(c != 0 for c in displacements[n]))
+    if moved == 0:
+        fe.fail(f"{job}: no interface node moved under gravity")
+    print(f"{job}: {len(shared)} interface nodes shared by the stiff and the soft labels, "
+          f"{moved} of them displaced, one value each")
+
+
+def mesh_conforming(labelmesh, volume, work, formats):
+    run = subprocess.run([labelmesh, "mesh", str(volume), "--volume", "conforming",
+                          "--formats", formats, "--out", str(work), "--json"],
+                         capture_output=True, text=True, timeout=600)
+    if run.returncode != 0:
+        fe.fail(f"labelmesh mesh {volume.name} exited {run.returncode}: {run.stderr[-2000:]}")
+    report = json.loads(run.stdout)
+    volume_report = report["volume"]
+    if volume_report["mesher"] != "conforming" or not volume_report.get("conforming"):
+        fe.fail(f"{volume.name}: not a conforming mesh: {volume_report['mesher']}")
+    return report
 
 
 def main():
     import argparse
     parser = argparse.ArgumentParser()
     parser.add_argument("--labelmesh", required=True)
+    parser.add_argument("--prostate", required=True, help="the two-zone prostate segmentation")
     args = parser.parse_args()
     with tempfile.TemporaryDirectory(prefix="labelmesh-conforming-") as tmp:
         work = pathlib.Path(tmp)
         phantom = work / "nested.nii.gz"
         subprocess.run([args.labelmesh, "phantom", "nested-spheres", "--out", str(phantom)],
                        check=True, capture_output=True, timeout=120)
-        run = subprocess.run([args.labelmesh, "mesh", str(phantom), "--volume", "conforming",
-                              "--formats", "vtu,msh,mesh,inp,xdmf", "--out", str(work), "--json"],
-                             capture_output=True, text=True, timeout=600)
-        if run.returncode != 0:
-            fe.fail(f"labelmesh mesh exited {run.returncode}: {run.stderr[-2000:]}")
-        report = json.loads(run.stdout)
-        volume = report["volume"]
-        if volume["mesher"] != "conforming" or not volume.get("conforming"):
-            fe.fail(f"not a conforming mesh: {volume['mesher']}")
+        report = mesh_conforming(args.labelmesh, phantom, work, "vtu,msh,mesh,inp,xdmf")
         check_meshio(work, report)
         check_gmsh(work, report)
-        nodes = fe.read_nodes(work / "volume.inp")
-        sets, elements = element_sets(work / "volume.inp")
-        fixed, core = write_deck(work, nodes, sets)
-        core_nodes = {n for e in sets[core] for n in elements[e]}
-        shell_nodes = {n for name in sets if name != core for e in sets[name] for n in elements[e]}
-        shared = core_nodes & shell_nodes
-        if not shared:
-            fe.fail("the core and the shells share no node")
-        displacements = fe.check_calculix(work, nodes, fixed, job="nested")
-        moved = sum(1 for n in shared if any(c != 0 for c in displacements[n]))
-        if moved == 0:
-            fe.fail("no interface node moved under gravity")
-        print(f"interface: {len(shared)} nodes shared by the stiff core and the soft shells, "
-              f"{moved} of them displaced, one value each")
+        solve_two_materials(work, report, "nested")
+    # The prostate's two zones (0.6 x 0.6 x 4 mm slices): the peripheral zone
+    # stiff, the transition zone soft.
+    with tempfile.TemporaryDirectory(prefix="labelmesh-conforming-") as tmp:
+        work = pathlib.Path(tmp)
+        report = mesh_conforming(args.labelmesh, pathlib.Path(args.prostate), work, "inp")
+        solve_two_materials(work, report, "prostate")
     print("PASS")
 
 
