@@ -12,19 +12,20 @@
 namespace labelmesh::conforming {
 namespace {
 
-// The volume's labels as int32, unselected ones 0.
-std::vector<int32_t> selected_labels(const volume::LabelVolume& volume,
-                                     std::vector<int32_t> selected) {
+// Calls f(label_at) with label_at(i) the selected label (or 0) of voxel i,
+// reading the voxels in their own type: no copy of a large volume.
+template <typename F>
+void with_selected_labels(const volume::LabelVolume& volume, std::vector<int32_t> selected, F&& f) {
   std::sort(selected.begin(), selected.end());
-  std::vector<int32_t> out(static_cast<size_t>(volume.geometry.voxel_count()), 0);
+  const auto voxel_count = static_cast<size_t>(volume.geometry.voxel_count());
   volume::visit_voxels(volume.voxels, [&](const auto* voxels, size_t count) {
-    for (size_t i = 0; i < std::min(count, out.size()); ++i) {
+    if (count != voxel_count) return;
+    f([&](size_t i) {
       const auto label = static_cast<int32_t>(voxels[i]);
-      if (selected.empty() || std::binary_search(selected.begin(), selected.end(), label))
-        out[i] = label;
-    }
+      return selected.empty() || std::binary_search(selected.begin(), selected.end(), label) ? label
+                                                                                             : 0;
+    });
   });
-  return out;
 }
 
 }  // namespace
@@ -32,24 +33,24 @@ std::vector<int32_t> selected_labels(const volume::LabelVolume& volume,
 Coarsening choose_coarsening(const volume::LabelVolume& volume, const std::vector<int32_t>& labels,
                              uint64_t max_interface_faces) {
   Coarsening coarsening;
-  const auto voxels = selected_labels(volume, labels);
   const auto& d = volume.geometry.dims;
   const int64_t stride[3] = {1, d[0], d[0] * d[1]};
-  for (int64_t z = 0; z < d[2]; ++z) {
-    for (int64_t y = 0; y < d[1]; ++y) {
-      for (int64_t x = 0; x < d[0]; ++x) {
-        const int64_t i = x + y * stride[1] + z * stride[2];
-        const int64_t at[3] = {x, y, z};
-        for (int a = 0; a < 3; ++a) {
-          if (at[a] + 1 < d[a]) coarsening.interface_faces += voxels[i] != voxels[i + stride[a]];
-        }
-        // Faces on the volume's outer walls count too: the padding is outside.
-        for (int a = 0; a < 3; ++a) {
-          if (voxels[i] != 0 && (at[a] == 0 || at[a] + 1 == d[a])) ++coarsening.interface_faces;
+  with_selected_labels(volume, labels, [&](const auto& label_at) {
+    for (int64_t z = 0; z < d[2]; ++z) {
+      for (int64_t y = 0; y < d[1]; ++y) {
+        for (int64_t x = 0; x < d[0]; ++x) {
+          const auto i = static_cast<size_t>(x + y * stride[1] + z * stride[2]);
+          const int32_t label = label_at(i);
+          const int64_t at[3] = {x, y, z};
+          for (int a = 0; a < 3; ++a) {
+            if (at[a] + 1 < d[a]) coarsening.interface_faces += label != label_at(i + stride[a]);
+            // Faces on the volume's outer walls count too: beyond is outside.
+            if (label != 0 && (at[a] == 0 || at[a] + 1 == d[a])) ++coarsening.interface_faces;
+          }
         }
       }
     }
-  }
+  });
   if (max_interface_faces == 0 || coarsening.interface_faces <= max_interface_faces)
     return coarsening;
   const double scale = std::sqrt(double(coarsening.interface_faces) / double(max_interface_faces));
@@ -98,16 +99,19 @@ absl::StatusOr<volume::LabelVolume> coarsen_labels(const volume::LabelVolume& vo
     return absl::ResourceExhaustedError(
         cat("coarsening: no memory for ", coarse.geometry.voxel_count(), " voxels"));
   }
-  const auto voxels = selected_labels(volume, labels);
-  for (int64_t z = 0; z < cd[2]; ++z) {
-    if (auto status = context.check_stop(); !status.ok()) return status;
-    for (int64_t y = 0; y < cd[1]; ++y) {
-      for (int64_t x = 0; x < cd[0]; ++x) {
-        out[x + cd[0] * (y + cd[1] * z)] = voxels[static_cast<size_t>(
-            nearest[0][x] + d[0] * (nearest[1][y] + d[1] * nearest[2][z]))];
+  absl::Status status = absl::OkStatus();
+  with_selected_labels(volume, labels, [&](const auto& label_at) {
+    for (int64_t z = 0; z < cd[2] && status.ok(); ++z) {
+      status = context.check_stop();
+      for (int64_t y = 0; y < cd[1]; ++y) {
+        for (int64_t x = 0; x < cd[0]; ++x) {
+          out[x + cd[0] * (y + cd[1] * z)] = label_at(
+              static_cast<size_t>(nearest[0][x] + d[0] * (nearest[1][y] + d[1] * nearest[2][z])));
+        }
       }
     }
-  }
+  });
+  if (!status.ok()) return status;
   return coarse;
 }
 

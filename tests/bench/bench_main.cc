@@ -562,6 +562,8 @@ int bench_conforming(const std::vector<std::string>& files) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  // Line by line, so a run stopped by a time limit keeps what it printed.
+  std::setvbuf(stdout, nullptr, _IOLBF, 0);
   const std::string liver_path = std::string(LABELMESH_SHARED_DATA) + "/liver.inr.gz";
   // The cancellation figures alone: labelmesh_bench --cancellation.
   if (argc == 2 && std::string(argv[1]) == "--cancellation")
