@@ -58,6 +58,17 @@ absl::StatusOr<std::unique_ptr<JobQueue>> JobQueue::open(NatsClient& client,
   natsSubscription* subscription = nullptr;
   status = js_PullSubscribe(&subscription, client.jetstream(), config.subject.c_str(),
                             config.consumer.c_str(), nullptr, &options, &code);
+  if (status != NATS_OK) {
+    // The consumer exists with other settings (another machine's): bind to
+    // it as it is.
+    jsSubOptions bind;
+    jsSubOptions_Init(&bind);
+    bind.Stream = config.stream.c_str();
+    bind.Consumer = config.consumer.c_str();
+    bind.ManualAck = true;
+    status = js_PullSubscribe(&subscription, client.jetstream(), config.subject.c_str(),
+                              config.consumer.c_str(), nullptr, &bind, &code);
+  }
   if (status != NATS_OK) return nats_error(status, absl::StrCat("consumer ", config.consumer));
   return std::unique_ptr<JobQueue>(new JobQueue(client, config, subscription));
 }

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <signal.h>
+#include <sys/prctl.h>
 #include <sys/types.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -56,6 +57,7 @@ class NatsServer {
     const std::string log = (dir_ / "nats.log").string();
     pid_ = fork();
     if (pid_ == 0) {
+      prctl(PR_SET_PDEATHSIG, SIGKILL);  // never outlive a test that crashed
       execlp("nats-server", "nats-server", "-js", "-a", "127.0.0.1", "-p", port_text.c_str(), "-sd",
              store.c_str(), "--ports_file_dir", ports_text.c_str(), "-l", log.c_str(),
              static_cast<char*>(nullptr));

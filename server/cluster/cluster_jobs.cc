@@ -1,0 +1,145 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+#include "server/cluster/cluster_jobs.h"
+
+#include "absl/strings/str_cat.h"
+
+namespace labelmesh::cluster {
+namespace {
+
+bool ended(v1::JobState state) {
+  return state == v1::JOB_STATE_SUCCEEDED || state == v1::JOB_STATE_FAILED ||
+         state == v1::JOB_STATE_CANCELLED;
+}
+
+absl::StatusOr<v1::JobRecord> parse(const Versioned& stored, const std::string& job_id) {
+  v1::JobRecord record;
+  if (!record.ParseFromString(stored.value))
+    return absl::DataLossError(absl::StrCat("job state ", job_id, " is unreadable"));
+  return record;
+}
+
+}  // namespace
+
+absl::Status ClusterJobs::log_state(const v1::JobRecord& record) {
+  const v1::Job& job = record.job();
+  v1::JobEvent event;
+  event.set_job_id(job.job_id());
+  switch (job.state()) {
+    case v1::JOB_STATE_QUEUED:
+      event.mutable_queued();
+      break;
+    case v1::JOB_STATE_RUNNING:
+      event.mutable_started()->set_attempt(job.attempts());
+      break;
+    case v1::JOB_STATE_SUCCEEDED:
+      *event.mutable_finished()->mutable_report() = job.report();
+      break;
+    case v1::JOB_STATE_FAILED:
+      *event.mutable_failed() = job.error();
+      break;
+    case v1::JOB_STATE_CANCELLED:
+      event.mutable_cancelled();
+      break;
+    default:
+      return absl::OkStatus();
+  }
+  return events_.append(job.job_id(), event.SerializeAsString()).status();
+}
+
+template <typename Change>
+absl::StatusOr<v1::JobRecord> ClusterJobs::change_record(const std::string& job_id,
+                                                         Change&& change) {
+  for (;;) {
+    auto stored = states_.get(job_id);
+    if (!stored.ok()) return stored.status();
+    auto record = parse(*stored, job_id);
+    if (!record.ok()) return record.status();
+    if (auto status = change(*record); !status.ok()) return status;
+    auto written = states_.update(job_id, record->SerializeAsString(), stored->revision);
+    if (written.ok()) return record;
+    if (written.status().code() != absl::StatusCode::kAborted) return written.status();
+    // Another writer came in between: read again and decide again.
+  }
+}
+
+absl::StatusOr<v1::JobRecord> ClusterJobs::submit(v1::JobRecord record) {
+  const std::string job_id = record.job().job_id();
+  if (job_id.empty()) return absl::InvalidArgumentError("a job to submit needs its id");
+  record.mutable_job()->set_state(v1::JOB_STATE_QUEUED);
+  record.mutable_job()->set_attempts(0);
+  auto created = states_.create(job_id, record.SerializeAsString());
+  if (created.status().code() == absl::StatusCode::kAlreadyExists) {
+    // A retried submit: the job is recorded; queueing it again is harmless
+    // (the queue's duplicate window drops it) and covers a submit that died
+    // between the two steps.
+    if (auto queued = queue_.enqueue(job_id); !queued.ok()) return queued.status();
+    return get(job_id);
+  }
+  if (!created.ok()) return created.status();
+  if (auto queued = queue_.enqueue(job_id); !queued.ok()) return queued.status();
+  if (auto status = log_state(record); !status.ok()) return status;
+  return record;
+}
+
+absl::StatusOr<v1::JobRecord> ClusterJobs::get(const std::string& job_id) {
+  auto stored = states_.get(job_id);
+  if (!stored.ok()) return stored.status();
+  return parse(*stored, job_id);
+}
+
+absl::StatusOr<Claim> ClusterJobs::claim(const std::string& job_id) {
+  Claim claim{job_id, 0};
+  auto record = change_record(job_id, [&](v1::JobRecord& r) {
+    if (ended(r.job().state())) {
+      return absl::FailedPreconditionError(absl::StrCat("job ", job_id, " has ended"));
+    }
+    r.mutable_job()->set_state(v1::JOB_STATE_RUNNING);
+    r.mutable_job()->set_attempts(r.job().attempts() + 1);
+    claim.attempt = r.job().attempts();
+    return absl::OkStatus();
+  });
+  if (!record.ok()) return record.status();
+  if (auto status = log_state(*record); !status.ok()) return status;
+  return claim;
+}
+
+absl::StatusOr<v1::JobRecord> ClusterJobs::finish(const Claim& claim, v1::JobState state,
+                                                  const v1::JobRecord& result) {
+  if (!ended(state)) return absl::InvalidArgumentError("a job can only end as it ends");
+  auto record = change_record(claim.job_id, [&](v1::JobRecord& r) {
+    if (r.job().state() != v1::JOB_STATE_RUNNING || r.job().attempts() != claim.attempt) {
+      return absl::AbortedError(absl::StrCat("job ", claim.job_id, " attempt ", claim.attempt,
+                                             " is no longer the job's: its result is refused"));
+    }
+    auto* job = r.mutable_job();
+    job->set_state(state);
+    if (result.job().has_report()) *job->mutable_report() = result.job().report();
+    if (result.job().has_error()) *job->mutable_error() = result.job().error();
+    *r.mutable_artifacts() = result.artifacts();
+    return absl::OkStatus();
+  });
+  if (!record.ok()) return record.status();
+  if (auto status = log_state(*record); !status.ok()) return status;
+  return record;
+}
+
+absl::StatusOr<v1::JobRecord> ClusterJobs::cancel(const std::string& job_id) {
+  auto record = change_record(job_id, [&](v1::JobRecord& r) {
+    if (ended(r.job().state())) {
+      return absl::FailedPreconditionError(absl::StrCat("job ", job_id, " has ended"));
+    }
+    if (r.job().state() == v1::JOB_STATE_QUEUED) {
+      r.mutable_job()->set_state(v1::JOB_STATE_CANCELLED);
+    } else {
+      r.set_cancel_requested(true);
+    }
+    return absl::OkStatus();
+  });
+  if (!record.ok()) return record.status();
+  if (record->job().state() == v1::JOB_STATE_CANCELLED) {
+    if (auto status = log_state(*record); !status.ok()) return status;
+  }
+  return record;
+}
+
+}  // namespace labelmesh::cluster

@@ -1,0 +1,70 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// A job's life when frontends and workers run on different machines: its
+// record in the job states (key-value, every change naming the revision it
+// read), its id in the job queue, its events in the event log. Delivery is
+// at least once, so every step is safe to repeat: a submit of a known id
+// gives the job back, a claim bumps the attempt, and only the worker
+// holding the current attempt can end the job; any other (one the queue
+// gave up on, come back late) is refused, and the job ends exactly once.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "absl/status/statusor.h"
+#include "labelmesh/v1/service.pb.h"
+#include "server/cluster/event_log.h"
+#include "server/cluster/job_queue.h"
+#include "server/cluster/job_states.h"
+
+namespace labelmesh::cluster {
+
+// A worker's hold on a job: the attempt it runs.
+struct Claim {
+  std::string job_id;
+  uint32_t attempt = 0;
+};
+
+class ClusterJobs {
+ public:
+  ClusterJobs(JobStates& states, JobQueue& queue, EventLog& events)
+      : states_(states), queue_(queue), events_(events) {}
+
+  // Records `record` (its job id set) as QUEUED and queues it. A job id
+  // already recorded gives its record back unchanged (a retried submit).
+  absl::StatusOr<v1::JobRecord> submit(v1::JobRecord record);
+
+  // The job's record. Errors: NOT_FOUND.
+  absl::StatusOr<v1::JobRecord> get(const std::string& job_id);
+
+  // Starts the next attempt of a delivered job: QUEUED, or RUNNING under a
+  // worker the queue gave up on, becomes RUNNING with one more attempt.
+  // Errors: FAILED_PRECONDITION when the job has ended (the delivery is
+  // done with); NOT_FOUND.
+  absl::StatusOr<Claim> claim(const std::string& job_id);
+
+  // Ends a claimed job in `state` (SUCCEEDED, FAILED or CANCELLED) with
+  // `result` filling the record's report, artifacts or error, and logs it.
+  // Errors: ABORTED when the claim is no longer the job's current attempt
+  // (the result is refused); INVALID_ARGUMENT for a state that is not an end.
+  absl::StatusOr<v1::JobRecord> finish(const Claim& claim, v1::JobState state,
+                                       const v1::JobRecord& result);
+
+  // A queued job ends CANCELLED; a running one is asked to stop (its
+  // worker sees cancel_requested). Errors: FAILED_PRECONDITION when it has
+  // ended; NOT_FOUND.
+  absl::StatusOr<v1::JobRecord> cancel(const std::string& job_id);
+
+ private:
+  // Reads, changes and writes the record until no other writer came in
+  // between; `change` returns an error to give up.
+  template <typename Change>
+  absl::StatusOr<v1::JobRecord> change_record(const std::string& job_id, Change&& change);
+  absl::Status log_state(const v1::JobRecord& record);
+
+  JobStates& states_;
+  JobQueue& queue_;
+  EventLog& events_;
+};
+
+}  // namespace labelmesh::cluster

@@ -1,0 +1,129 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// A job's life across machines on a real nats-server: retried submits,
+// a worker that dies mid-job, a late result refused, cancellation.
+#include "server/cluster/cluster_jobs.h"
+
+#include <gtest/gtest.h>
+
+#include "cluster/nats_server.h"
+#include "support/test_files.h"
+
+namespace labelmesh::cluster {
+namespace {
+
+// One machine's view: its own connection, queue, states and events.
+struct Node {
+  // Every machine of a cluster has the same queue settings: here a short
+  // ack wait, so a silent worker loses its job within a second.
+  explicit Node(const testing::NatsServer& server, absl::Duration ack_wait = absl::Seconds(1)) {
+    auto connected = NatsClient::connect(server.url(), "labelmesh-test", absl::Seconds(5));
+    EXPECT_TRUE(connected.ok()) << connected.status();
+    client = std::move(*connected);
+    JobQueueConfig config;
+    config.ack_wait = ack_wait;
+    queue = std::move(*JobQueue::open(*client, config));
+    states = std::move(*JobStates::open(*client, "labelmesh_jobs"));
+    events = std::move(*EventLog::open(*client, {}));
+    jobs = std::make_unique<ClusterJobs>(*states, *queue, *events);
+  }
+  std::unique_ptr<NatsClient> client;
+  std::unique_ptr<JobQueue> queue;
+  std::unique_ptr<JobStates> states;
+  std::unique_ptr<EventLog> events;
+  std::unique_ptr<ClusterJobs> jobs;
+};
+
+v1::JobRecord new_job(const std::string& id) {
+  v1::JobRecord record;
+  record.mutable_job()->set_job_id(id);
+  record.set_input_extension(".nii.gz");
+  return record;
+}
+
+// The job's logged events, by kind.
+std::vector<v1::JobEvent::EventCase> logged(EventLog& events, const std::string& job_id) {
+  std::vector<v1::JobEvent::EventCase> kinds;
+  auto follower = events.follow(job_id, 0);
+  EXPECT_TRUE(follower.ok());
+  while (true) {
+    auto next = (*follower)->next(absl::Milliseconds(300));
+    if (!next.ok() || !next->has_value()) break;
+    v1::JobEvent event;
+    EXPECT_TRUE(event.ParseFromString((*next)->data));
+    kinds.push_back(event.event_case());
+  }
+  return kinds;
+}
+
+TEST(ClusterJobs, ARetriedSubmitGivesTheSameJobQueuedOnce) {
+  testing::NatsServer server(testing::scratch_dir("submit"));
+  Node frontend(server), other_frontend(server);
+  ASSERT_TRUE(frontend.jobs->submit(new_job("j1")).ok());
+  auto again = other_frontend.jobs->submit(new_job("j1"));
+  ASSERT_TRUE(again.ok()) << again.status();
+  EXPECT_EQ(again->job().state(), v1::JOB_STATE_QUEUED);
+  EXPECT_EQ(frontend.queue->stored().value(), 1u);
+}
+
+TEST(ClusterJobs, ALateResultFromAWorkerThatLostItsJobIsRefused) {
+  testing::NatsServer server(testing::scratch_dir("fencing"));
+  Node frontend(server);
+  ASSERT_TRUE(frontend.jobs->submit(new_job("j1")).ok());
+
+  // Worker A takes the job and falls silent; the queue hands it to B.
+  Node a(server), b(server);
+  auto first = a.queue->take(absl::Seconds(2));
+  ASSERT_TRUE(first.ok() && first->has_value());
+  auto a_claim = a.jobs->claim("j1");
+  ASSERT_TRUE(a_claim.ok()) << a_claim.status();
+  EXPECT_EQ(a_claim->attempt, 1u);
+  auto second = b.queue->take(absl::Seconds(5));
+  ASSERT_TRUE(second.ok() && second->has_value());
+  EXPECT_EQ((*second)->delivered(), 2u);
+  auto b_claim = b.jobs->claim("j1");
+  ASSERT_TRUE(b_claim.ok());
+  EXPECT_EQ(b_claim->attempt, 2u);
+
+  v1::JobRecord result;
+  result.add_artifacts()->set_name("volume.vtu");
+  EXPECT_TRUE(b.jobs->finish(*b_claim, v1::JOB_STATE_SUCCEEDED, result).ok());
+  EXPECT_TRUE((*second)->ack().ok());
+  // A comes back late: its result is refused and the job stays B's.
+  const auto late = a.jobs->finish(*a_claim, v1::JOB_STATE_FAILED, {});
+  EXPECT_EQ(late.status().code(), absl::StatusCode::kAborted) << late.status();
+  const auto job = frontend.jobs->get("j1").value();
+  EXPECT_EQ(job.job().state(), v1::JOB_STATE_SUCCEEDED);
+  EXPECT_EQ(job.job().attempts(), 2u);
+  ASSERT_EQ(job.artifacts_size(), 1);
+  // A delivery of an ended job is not run again.
+  EXPECT_EQ(a.jobs->claim("j1").status().code(), absl::StatusCode::kFailedPrecondition);
+  // Exactly one end: queued, two starts, one finish.
+  using E = v1::JobEvent;
+  EXPECT_EQ(logged(*frontend.events, "j1"),
+            (std::vector<E::EventCase>{E::kQueued, E::kStarted, E::kStarted, E::kFinished}));
+}
+
+TEST(ClusterJobs, CancelEndsAQueuedJobAndAsksARunningOneToStop) {
+  testing::NatsServer server(testing::scratch_dir("cancel"));
+  Node frontend(server), worker(server);
+  ASSERT_TRUE(frontend.jobs->submit(new_job("queued")).ok());
+  ASSERT_TRUE(frontend.jobs->submit(new_job("running")).ok());
+  auto claim = worker.jobs->claim("running");
+  ASSERT_TRUE(claim.ok());
+
+  EXPECT_EQ(frontend.jobs->cancel("queued").value().job().state(), v1::JOB_STATE_CANCELLED);
+  EXPECT_EQ(worker.jobs->claim("queued").status().code(), absl::StatusCode::kFailedPrecondition);
+
+  const auto asked = frontend.jobs->cancel("running");
+  ASSERT_TRUE(asked.ok());
+  EXPECT_EQ(asked->job().state(), v1::JOB_STATE_RUNNING);
+  EXPECT_TRUE(worker.jobs->get("running").value().cancel_requested());
+  EXPECT_EQ(worker.jobs->finish(*claim, v1::JOB_STATE_CANCELLED, {}).value().job().state(),
+            v1::JOB_STATE_CANCELLED);
+  EXPECT_EQ(frontend.jobs->cancel("running").status().code(),
+            absl::StatusCode::kFailedPrecondition);
+  EXPECT_EQ(frontend.jobs->cancel("unknown").status().code(), absl::StatusCode::kNotFound);
+}
+
+}  // namespace
+}  // namespace labelmesh::cluster
