@@ -1,0 +1,43 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+#include "server/cluster/cluster_worker.h"
+
+#include <future>
+
+namespace labelmesh::cluster {
+
+absl::StatusOr<bool> ClusterWorker::run_one() {
+  auto taken = queue_.take(config_.poll);
+  if (!taken.ok()) return taken.status();
+  if (!taken->has_value()) return false;
+  JobDelivery& delivery = **taken;
+  auto claim = jobs_.claim(delivery.job_id());
+  if (claim.status().code() == absl::StatusCode::kFailedPrecondition ||
+      claim.status().code() == absl::StatusCode::kNotFound) {
+    // Ended, or deleted: nothing to run, and nothing to deliver again.
+    if (auto status = delivery.ack(); !status.ok()) return status;
+    return true;
+  }
+  if (!claim.ok()) return claim.status();
+  auto record = jobs_.get(delivery.job_id());
+  if (!record.ok()) return record.status();
+
+  std::atomic<bool> cancelled = false;
+  auto running = std::async(std::launch::async, [&] { return run_(*record, *claim, cancelled); });
+  while (running.wait_for(absl::ToChronoMilliseconds(config_.heartbeat)) !=
+         std::future_status::ready) {
+    // The queue keeps the job ours while we say so; a failed heartbeat
+    // (NATS away for a moment) only risks a second attempt, which the
+    // attempt fencing settles.
+    (void)delivery.in_progress();
+    if (auto now = jobs_.get(delivery.job_id()); now.ok() && now->cancel_requested())
+      cancelled = true;
+  }
+  const JobOutcome outcome = running.get();
+  auto ended = jobs_.finish(*claim, outcome.state, outcome.result);
+  if (ended.status().code() == absl::StatusCode::kAborted) return true;
+  if (!ended.ok()) return ended.status();
+  if (auto status = delivery.ack(); !status.ok()) return status;
+  return true;
+}
+
+}  // namespace labelmesh::cluster

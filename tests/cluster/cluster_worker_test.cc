@@ -1,0 +1,131 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// The worker loop on a real nats-server, with runs that take longer than
+// the queue's ack wait, fail, or are cancelled.
+#include "server/cluster/cluster_worker.h"
+
+#include <gtest/gtest.h>
+
+#include <thread>
+
+#include "cluster/nats_server.h"
+#include "support/test_files.h"
+
+namespace labelmesh::cluster {
+namespace {
+
+struct Node {
+  explicit Node(const testing::NatsServer& server) {
+    client =
+        std::move(NatsClient::connect(server.url(), "labelmesh-test", absl::Seconds(5)).value());
+    JobQueueConfig config;
+    config.ack_wait = absl::Seconds(1);
+    queue = std::move(JobQueue::open(*client, config).value());
+    states = std::move(JobStates::open(*client, "labelmesh_jobs").value());
+    events = std::move(EventLog::open(*client, {}).value());
+    jobs = std::make_unique<ClusterJobs>(*states, *queue, *events);
+  }
+  std::unique_ptr<NatsClient> client;
+  std::unique_ptr<JobQueue> queue;
+  std::unique_ptr<JobStates> states;
+  std::unique_ptr<EventLog> events;
+  std::unique_ptr<ClusterJobs> jobs;
+};
+
+v1::JobRecord new_job(const std::string& id) {
+  v1::JobRecord record;
+  record.mutable_job()->set_job_id(id);
+  return record;
+}
+
+constexpr ClusterWorkerConfig kQuick{absl::Seconds(1), absl::Milliseconds(250)};
+
+TEST(ClusterWorker, ARunLongerThanTheAckWaitStaysWithItsWorker) {
+  testing::NatsServer server(testing::scratch_dir("long-run"));
+  Node frontend(server), worker_node(server), idle_node(server);
+  ASSERT_TRUE(frontend.jobs->submit(new_job("long")).ok());
+  std::atomic<int> runs = 0;
+  ClusterWorker worker(
+      *worker_node.queue, *worker_node.jobs,
+      [&](const v1::JobRecord&, const Claim& claim, const std::atomic<bool>&) {
+        ++runs;
+        std::this_thread::sleep_for(std::chrono::milliseconds(2500));  // 2.5 ack waits
+        JobOutcome outcome{v1::JOB_STATE_SUCCEEDED, {}};
+        outcome.result.add_artifacts()->set_name("attempt-" + std::to_string(claim.attempt));
+        return outcome;
+      },
+      kQuick);
+  // Meanwhile another worker polls the same queue and must get nothing.
+  std::atomic<bool> stolen = false;
+  std::thread idle([&] {
+    for (int i = 0; i < 5; ++i) {
+      auto taken = idle_node.queue->take(absl::Milliseconds(500));
+      if (taken.ok() && taken->has_value()) stolen = true;
+    }
+  });
+  EXPECT_EQ(worker.run_one().value(), true);
+  idle.join();
+  EXPECT_FALSE(stolen);
+  EXPECT_EQ(runs, 1);
+  const auto record = frontend.jobs->get("long").value();
+  EXPECT_EQ(record.job().state(), v1::JOB_STATE_SUCCEEDED);
+  EXPECT_EQ(record.job().attempts(), 1u);
+  ASSERT_EQ(record.artifacts_size(), 1);
+  EXPECT_EQ(record.artifacts(0).name(), "attempt-1");
+  EXPECT_EQ(frontend.queue->stored().value(), 0u);
+  EXPECT_EQ(worker.run_one().value(), false);  // nothing left
+}
+
+TEST(ClusterWorker, ACancelReachesTheRunOnItsMachine) {
+  testing::NatsServer server(testing::scratch_dir("cancel-run"));
+  Node frontend(server), worker_node(server);
+  ASSERT_TRUE(frontend.jobs->submit(new_job("doomed")).ok());
+  ClusterWorker worker(
+      *worker_node.queue, *worker_node.jobs,
+      [&](const v1::JobRecord&, const Claim&, const std::atomic<bool>& cancelled) {
+        const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(20);
+        while (!cancelled && std::chrono::steady_clock::now() < deadline)
+          std::this_thread::sleep_for(std::chrono::milliseconds(20));
+        return JobOutcome{cancelled ? v1::JOB_STATE_CANCELLED : v1::JOB_STATE_SUCCEEDED, {}};
+      },
+      kQuick);
+  std::thread client([&] {
+    std::this_thread::sleep_for(std::chrono::milliseconds(500));
+    EXPECT_TRUE(frontend.jobs->cancel("doomed").ok());
+  });
+  const auto start = std::chrono::steady_clock::now();
+  EXPECT_EQ(worker.run_one().value(), true);
+  client.join();
+  EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(5));
+  EXPECT_EQ(frontend.jobs->get("doomed").value().job().state(), v1::JOB_STATE_CANCELLED);
+}
+
+TEST(ClusterWorker, AFailedRunEndsTheJobFailedAndARetriedSubmitDoesNotRunItAgain) {
+  testing::NatsServer server(testing::scratch_dir("failed-run"));
+  Node frontend(server), worker_node(server);
+  ASSERT_TRUE(frontend.jobs->submit(new_job("bad")).ok());
+  int runs = 0;
+  ClusterWorker worker(
+      *worker_node.queue, *worker_node.jobs,
+      [&](const v1::JobRecord&, const Claim&, const std::atomic<bool>&) {
+        ++runs;
+        JobOutcome outcome{v1::JOB_STATE_FAILED, {}};
+        outcome.result.mutable_job()->mutable_error()->set_message("unreadable volume");
+        return outcome;
+      },
+      kQuick);
+  EXPECT_EQ(worker.run_one().value(), true);
+  const auto record = frontend.jobs->get("bad").value();
+  EXPECT_EQ(record.job().state(), v1::JOB_STATE_FAILED);
+  EXPECT_EQ(record.job().error().message(), "unreadable volume");
+  // The same id submitted again is the same ended job, and the queue's
+  // duplicate window keeps it from being queued again.
+  const auto again = frontend.jobs->submit(new_job("bad"));
+  ASSERT_TRUE(again.ok());
+  EXPECT_EQ(again->job().state(), v1::JOB_STATE_FAILED);
+  EXPECT_EQ(worker.run_one().value(), false);
+  EXPECT_EQ(runs, 1);
+  EXPECT_EQ(frontend.queue->stored().value(), 0u);
+}
+
+}  // namespace
+}  // namespace labelmesh::cluster
