@@ -18,7 +18,8 @@ struct Node {
     client =
         std::move(NatsClient::connect(server.url(), "labelmesh-test", absl::Seconds(5)).value());
     JobQueueConfig config;
-    config.ack_wait = absl::Seconds(1);
+    // Short, yet twice any pause between heartbeats on a loaded machine.
+    config.ack_wait = absl::Seconds(2);
     queue = std::move(JobQueue::open(*client, config).value());
     states = std::move(JobStates::open(*client, "labelmesh_jobs").value());
     events = std::move(EventLog::open(*client, {}).value());
@@ -44,26 +45,28 @@ TEST(ClusterWorker, ARunLongerThanTheAckWaitStaysWithItsWorker) {
   Node frontend(server), worker_node(server), idle_node(server);
   ASSERT_TRUE(frontend.jobs->submit(new_job("long")).ok());
   std::atomic<int> runs = 0;
+  // While the job runs, another worker polls the same queue and must get
+  // nothing.
+  std::atomic<bool> stolen = false;
+  std::thread idle;
   ClusterWorker worker(
       *worker_node.queue, *worker_node.jobs,
       [&](const v1::JobRecord&, const Claim& claim, const std::atomic<bool>&) {
         ++runs;
-        std::this_thread::sleep_for(std::chrono::milliseconds(2500));  // 2.5 ack waits
+        idle = std::thread([&] {
+          for (int i = 0; i < 10; ++i) {
+            auto taken = idle_node.queue->take(absl::Milliseconds(400));
+            if (taken.ok() && taken->has_value()) stolen = true;
+          }
+        });
+        std::this_thread::sleep_for(std::chrono::milliseconds(4500));  // 2.25 ack waits
         JobOutcome outcome{v1::JOB_STATE_SUCCEEDED, {}};
         outcome.result.add_artifacts()->set_name("attempt-" + std::to_string(claim.attempt));
         return outcome;
       },
       kQuick);
-  // Meanwhile another worker polls the same queue and must get nothing.
-  std::atomic<bool> stolen = false;
-  std::thread idle([&] {
-    for (int i = 0; i < 5; ++i) {
-      auto taken = idle_node.queue->take(absl::Milliseconds(500));
-      if (taken.ok() && taken->has_value()) stolen = true;
-    }
-  });
   EXPECT_EQ(worker.run_one().value(), true);
-  idle.join();
+  if (idle.joinable()) idle.join();
   EXPECT_FALSE(stolen);
   EXPECT_EQ(runs, 1);
   const auto record = frontend.jobs->get("long").value();

@@ -94,20 +94,20 @@ TEST(JobQueue, AWorkerThatSaysItIsWorkingKeepsItsJob) {
   Cluster cluster("in-progress");
   auto client = cluster.client();
   ASSERT_NE(client, nullptr);
-  const auto config = quick(absl::Seconds(1));
+  const auto config = quick(absl::Seconds(2));
   auto queue = open_queue(*client, config);
   ASSERT_TRUE(queue->enqueue("job-a").ok());
   auto taken = queue->take(absl::Seconds(2));
   ASSERT_TRUE(taken.ok() && taken->has_value());
   auto other_client = cluster.client();
   auto other = open_queue(*other_client, config);
-  // Three ack waits, the job reported in progress every half wait: nobody
+  // Two ack waits, the job reported in progress every quarter wait: nobody
   // else gets it.
-  for (int i = 0; i < 6; ++i) {
+  for (int i = 0; i < 8; ++i) {
     EXPECT_TRUE((*taken)->in_progress().ok());
     auto stolen = other->take(absl::Milliseconds(500));
     ASSERT_TRUE(stolen.ok());
-    EXPECT_FALSE(stolen->has_value()) << "handed out again after " << i << " half waits";
+    EXPECT_FALSE(stolen->has_value()) << "handed out again after " << i << " quarter waits";
   }
   EXPECT_TRUE((*taken)->ack().ok());
 }
