@@ -47,6 +47,40 @@ absl::Status remove_crossings(InterfaceSurface& surface, int max_rounds, const R
   }
 }
 
+// The interfaces on the grid they are made on: the input's, coarsened when
+// its interfaces would be too large, with thick slices cut thinner. The
+// voxels counted for each label stay the measure of its volume. `spacing`
+// gets that grid's spacing.
+absl::StatusOr<InterfaceSurface> grid_interfaces(const volume::LabelVolume& volume,
+                                                 const std::vector<int32_t>& labels,
+                                                 const ConformingParams& params,
+                                                 const RunContext& context,
+                                                 ConformingFigures& figures,
+                                                 std::array<double, 3>& spacing) {
+  const auto start = std::chrono::steady_clock::now();
+  figures.coarsening = choose_coarsening(volume, labels, params.max_interface_faces);
+  std::optional<volume::LabelVolume> coarse, thinner;
+  const volume::LabelVolume* grid = &volume;
+  if (figures.coarsening.factors != std::array<double, 3>{1, 1, 1}) {
+    auto coarsened = coarsen_labels(volume, labels, figures.coarsening.factors, context);
+    if (!coarsened.ok()) return coarsened.status();
+    coarse = std::move(*coarsened);
+    grid = &*coarse;
+  }
+  figures.thick_slices = find_thick_slices(grid->geometry, params.thick_slices);
+  if (figures.thick_slices.axis >= 0) {
+    auto cut = interpolate_thick_slices(*grid, labels, figures.thick_slices, context);
+    if (!cut.ok()) return cut.status();
+    thinner = std::move(*cut);
+    grid = &*thinner;
+    coarse.reset();
+  }
+  figures.grid_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  spacing = grid->geometry.spacing;
+  return label_interfaces(*grid, labels, params.interfaces, figures.interfaces);
+}
+
 }  // namespace
 
 double LabelVolumeFigures::volume_change() const {
@@ -100,34 +134,10 @@ absl::StatusOr<volume_mesh::TetMesh> mesh_conforming(const volume::LabelVolume& 
         "conforming mesh: no voxel holds any of the selected labels; nothing to mesh");
   }
   context.report("interfaces", 0);
-  // A grid whose interfaces would be too large is coarsened, and thick
-  // slices are cut into thinner ones; the voxels counted above stay the
-  // measure of each label's volume.
-  const auto grid_start = std::chrono::steady_clock::now();
-  figures.coarsening = choose_coarsening(volume, labels, params.max_interface_faces);
-  std::optional<volume::LabelVolume> coarse;
-  if (figures.coarsening.factors != std::array<double, 3>{1, 1, 1}) {
-    auto coarsened = coarsen_labels(volume, labels, figures.coarsening.factors, context);
-    if (!coarsened.ok()) return coarsened.status();
-    coarse = std::move(*coarsened);
-  }
-  const volume::LabelVolume& grid = coarse ? *coarse : volume;
-  figures.thick_slices = find_thick_slices(grid.geometry, params.thick_slices);
-  std::array<double, 3> spacing = grid.geometry.spacing;
-  InterfaceSurface surface;
-  if (figures.thick_slices.axis >= 0) {
-    auto thinner = interpolate_thick_slices(grid, labels, figures.thick_slices, context);
-    if (!thinner.ok()) return thinner.status();
-    figures.grid_seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - grid_start).count();
-    surface = label_interfaces(*thinner, labels, params.interfaces, figures.interfaces);
-    spacing = thinner->geometry.spacing;
-  } else {
-    figures.grid_seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - grid_start).count();
-    surface = label_interfaces(grid, labels, params.interfaces, figures.interfaces);
-  }
-  coarse.reset();
+  std::array<double, 3> spacing{};
+  auto interfaces = grid_interfaces(volume, labels, params, context, figures, spacing);
+  if (!interfaces.ok()) return interfaces.status();
+  InterfaceSurface surface = std::move(*interfaces);
   if (auto status = remove_crossings(surface, params.max_crossing_repairs, context, figures);
       !status.ok()) {
     return status;

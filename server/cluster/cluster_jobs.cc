@@ -88,7 +88,7 @@ absl::StatusOr<v1::JobRecord> ClusterJobs::get(const std::string& job_id) {
 }
 
 absl::StatusOr<Claim> ClusterJobs::claim(const std::string& job_id) {
-  Claim claim{job_id, 0};
+  Claim claim{job_id, 0, {}};
   auto record = change_record(job_id, [&](v1::JobRecord& r) {
     if (ended(r.job().state())) {
       return absl::FailedPreconditionError(absl::StrCat("job ", job_id, " has ended"));
@@ -100,6 +100,7 @@ absl::StatusOr<Claim> ClusterJobs::claim(const std::string& job_id) {
   });
   if (!record.ok()) return record.status();
   if (auto status = log_state(*record); !status.ok()) return status;
+  claim.record = std::move(*record);
   return claim;
 }
 

@@ -19,10 +19,12 @@
 
 namespace labelmesh::cluster {
 
-// A worker's hold on a job: the attempt it runs.
+// A worker's hold on a job: the attempt it runs, and the record as it
+// claimed it.
 struct Claim {
   std::string job_id;
   uint32_t attempt = 0;
+  v1::JobRecord record;
 };
 
 class ClusterJobs {

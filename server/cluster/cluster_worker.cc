@@ -18,11 +18,10 @@ absl::StatusOr<bool> ClusterWorker::run_one() {
     return true;
   }
   if (!claim.ok()) return claim.status();
-  auto record = jobs_.get(delivery.job_id());
-  if (!record.ok()) return record.status();
 
   std::atomic<bool> cancelled = false;
-  auto running = std::async(std::launch::async, [&] { return run_(*record, *claim, cancelled); });
+  auto running =
+      std::async(std::launch::async, [&] { return run_(claim->record, *claim, cancelled); });
   while (running.wait_for(absl::ToChronoMilliseconds(config_.heartbeat)) !=
          std::future_status::ready) {
     // The queue keeps the job ours while we say so; a failed heartbeat

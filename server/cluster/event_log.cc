@@ -36,12 +36,7 @@ absl::StatusOr<std::unique_ptr<EventLog>> EventLog::open(NatsClient& client,
   stream.Retention = js_LimitsPolicy;
   stream.Storage = js_FileStorage;
   stream.MaxAge = absl::ToInt64Nanoseconds(config.max_age);
-  jsErrCode code = static_cast<jsErrCode>(0);
-  jsStreamInfo* info = nullptr;
-  const natsStatus status = js_AddStream(&info, client.jetstream(), &stream, nullptr, &code);
-  jsStreamInfo_Destroy(info);
-  if (status != NATS_OK && code != JSStreamNameExistErr)
-    return nats_error(status, absl::StrCat("stream ", config.stream));
+  if (auto status = add_stream(client, stream); !status.ok()) return status;
   return std::unique_ptr<EventLog>(new EventLog(client, config));
 }
 

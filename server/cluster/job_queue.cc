@@ -40,12 +40,7 @@ absl::StatusOr<std::unique_ptr<JobQueue>> JobQueue::open(NatsClient& client,
   stream.Retention = js_WorkQueuePolicy;
   stream.Storage = js_FileStorage;
   stream.Duplicates = absl::ToInt64Nanoseconds(config.duplicate_window);
-  jsErrCode code = static_cast<jsErrCode>(0);
-  jsStreamInfo* info = nullptr;
-  natsStatus status = js_AddStream(&info, client.jetstream(), &stream, nullptr, &code);
-  jsStreamInfo_Destroy(info);
-  if (status != NATS_OK && code != JSStreamNameExistErr)
-    return nats_error(status, absl::StrCat("stream ", config.stream));
+  if (auto status = add_stream(client, stream); !status.ok()) return status;
 
   jsSubOptions options;
   jsSubOptions_Init(&options);
@@ -56,8 +51,8 @@ absl::StatusOr<std::unique_ptr<JobQueue>> JobQueue::open(NatsClient& client,
   options.Config.MaxDeliver = config.max_deliver;
   options.Config.DeliverPolicy = js_DeliverAll;
   natsSubscription* subscription = nullptr;
-  status = js_PullSubscribe(&subscription, client.jetstream(), config.subject.c_str(),
-                            config.consumer.c_str(), nullptr, &options, &code);
+  natsStatus status = js_PullSubscribe(&subscription, client.jetstream(), config.subject.c_str(),
+                                       config.consumer.c_str(), nullptr, &options, nullptr);
   if (status != NATS_OK) {
     // The consumer exists with other settings (another machine's): bind to
     // it as it is.
@@ -67,7 +62,7 @@ absl::StatusOr<std::unique_ptr<JobQueue>> JobQueue::open(NatsClient& client,
     bind.Consumer = config.consumer.c_str();
     bind.ManualAck = true;
     status = js_PullSubscribe(&subscription, client.jetstream(), config.subject.c_str(),
-                              config.consumer.c_str(), nullptr, &bind, &code);
+                              config.consumer.c_str(), nullptr, &bind, nullptr);
   }
   if (status != NATS_OK) return nats_error(status, absl::StrCat("consumer ", config.consumer));
   return std::unique_ptr<JobQueue>(new JobQueue(client, config, subscription));

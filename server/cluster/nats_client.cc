@@ -52,6 +52,15 @@ absl::StatusOr<std::unique_ptr<NatsClient>> NatsClient::connect(const std::strin
   return std::unique_ptr<NatsClient>(new NatsClient(connection, jetstream));
 }
 
+absl::Status add_stream(NatsClient& client, jsStreamConfig& config) {
+  jsErrCode code = static_cast<jsErrCode>(0);
+  jsStreamInfo* info = nullptr;
+  const natsStatus status = js_AddStream(&info, client.jetstream(), &config, nullptr, &code);
+  jsStreamInfo_Destroy(info);
+  if (status == NATS_OK || code == JSStreamNameExistErr) return absl::OkStatus();
+  return nats_error(status, absl::StrCat("stream ", config.Name));
+}
+
 NatsClient::~NatsClient() {
   jsCtx_Destroy(jetstream_);
   natsConnection_Destroy(connection_);

@@ -38,6 +38,10 @@ class NatsClient {
   jsCtx* jetstream_;
 };
 
+// Creates the stream `config` describes, or keeps the one of that name that
+// exists (another machine made it). Errors: those of nats_error.
+absl::Status add_stream(NatsClient& client, jsStreamConfig& config);
+
 // A failed call as a status naming `what`: NATS_TIMEOUT is
 // DEADLINE_EXCEEDED, NATS_NOT_FOUND NOT_FOUND, a closed or absent server
 // UNAVAILABLE, the rest INTERNAL with the client's own text.

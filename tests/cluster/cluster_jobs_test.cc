@@ -5,40 +5,18 @@
 
 #include <gtest/gtest.h>
 
-#include "cluster/nats_server.h"
+#include "cluster/cluster_node.h"
 #include "support/test_files.h"
 
 namespace labelmesh::cluster {
 namespace {
 
-// One machine's view: its own connection, queue, states and events.
-struct Node {
-  // Every machine of a cluster has the same queue settings: here a short
-  // ack wait, so a silent worker loses its job within a second.
-  explicit Node(const testing::NatsServer& server, absl::Duration ack_wait = absl::Seconds(1)) {
-    auto connected = NatsClient::connect(server.url(), "labelmesh-test", absl::Seconds(5));
-    EXPECT_TRUE(connected.ok()) << connected.status();
-    client = std::move(*connected);
-    JobQueueConfig config;
-    config.ack_wait = ack_wait;
-    queue = std::move(*JobQueue::open(*client, config));
-    states = std::move(*JobStates::open(*client, "labelmesh_jobs"));
-    events = std::move(*EventLog::open(*client, {}));
-    jobs = std::make_unique<ClusterJobs>(*states, *queue, *events);
-  }
-  std::unique_ptr<NatsClient> client;
-  std::unique_ptr<JobQueue> queue;
-  std::unique_ptr<JobStates> states;
-  std::unique_ptr<EventLog> events;
-  std::unique_ptr<ClusterJobs> jobs;
+// A silent worker loses its job within a second.
+struct Node : testing::ClusterNode {
+  explicit Node(const testing::NatsServer& server) : ClusterNode(server, absl::Seconds(1)) {}
 };
 
-v1::JobRecord new_job(const std::string& id) {
-  v1::JobRecord record;
-  record.mutable_job()->set_job_id(id);
-  record.set_input_extension(".nii.gz");
-  return record;
-}
+using testing::new_job;
 
 // The job's logged events, by kind.
 std::vector<v1::JobEvent::EventCase> logged(EventLog& events, const std::string& job_id) {

@@ -7,36 +7,18 @@
 
 #include <thread>
 
-#include "cluster/nats_server.h"
+#include "cluster/cluster_node.h"
 #include "support/test_files.h"
 
 namespace labelmesh::cluster {
 namespace {
 
-struct Node {
-  explicit Node(const testing::NatsServer& server) {
-    client =
-        std::move(NatsClient::connect(server.url(), "labelmesh-test", absl::Seconds(5)).value());
-    JobQueueConfig config;
-    // Short, yet twice any pause between heartbeats on a loaded machine.
-    config.ack_wait = absl::Seconds(2);
-    queue = std::move(JobQueue::open(*client, config).value());
-    states = std::move(JobStates::open(*client, "labelmesh_jobs").value());
-    events = std::move(EventLog::open(*client, {}).value());
-    jobs = std::make_unique<ClusterJobs>(*states, *queue, *events);
-  }
-  std::unique_ptr<NatsClient> client;
-  std::unique_ptr<JobQueue> queue;
-  std::unique_ptr<JobStates> states;
-  std::unique_ptr<EventLog> events;
-  std::unique_ptr<ClusterJobs> jobs;
+// Short, yet twice any pause between heartbeats on a loaded machine.
+struct Node : testing::ClusterNode {
+  explicit Node(const testing::NatsServer& server) : ClusterNode(server, absl::Seconds(2)) {}
 };
 
-v1::JobRecord new_job(const std::string& id) {
-  v1::JobRecord record;
-  record.mutable_job()->set_job_id(id);
-  return record;
-}
+using testing::new_job;
 
 constexpr ClusterWorkerConfig kQuick{absl::Seconds(1), absl::Milliseconds(250)};
 
