@@ -5,7 +5,6 @@
 #include <chrono>
 #include <cmath>
 
-#include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "server/client_identity.h"
 #include "spdlog/spdlog.h"
@@ -17,66 +16,7 @@ namespace {
 // many are applied to the job but not kept.
 constexpr size_t kMaxStoredEvents = 4096;
 
-bool has_ended(v1::JobState state) {
-  return state == v1::JOB_STATE_SUCCEEDED || state == v1::JOB_STATE_FAILED ||
-         state == v1::JOB_STATE_CANCELLED;
-}
-
-// The event that tells a watcher where a job stands, for jobs loaded from the
-// spool (their history was not kept).
-v1::JobEvent state_event(const v1::Job& job, uint32_t position) {
-  v1::JobEvent event;
-  switch (job.state()) {
-    case v1::JOB_STATE_SUCCEEDED:
-      *event.mutable_finished()->mutable_report() = job.report();
-      break;
-    case v1::JOB_STATE_FAILED:
-      *event.mutable_failed() = job.error();
-      break;
-    case v1::JOB_STATE_CANCELLED:
-      event.mutable_cancelled();
-      break;
-    default:
-      event.mutable_queued()->set_position(position);
-  }
-  return event;
-}
-
-google::protobuf::Timestamp to_timestamp(double unix_seconds) {
-  google::protobuf::Timestamp stamp;
-  const double whole = std::floor(unix_seconds);
-  stamp.set_seconds(static_cast<int64_t>(whole));
-  stamp.set_nanos(std::min(999'999'999, static_cast<int>((unix_seconds - whole) * 1e9)));
-  return stamp;
-}
-
-// Where a page of ListJobs ends: the last job's creation time (microseconds)
-// and id, the order of the listing.
-using ListPosition = std::pair<int64_t, std::string>;
-
-ListPosition list_position(const v1::Job& job) {
-  return {static_cast<int64_t>(std::llround(job.created_at() * 1e6)), job.job_id()};
-}
-
-std::string page_token(const ListPosition& position) {
-  return absl::StrCat(position.first, "-", position.second);
-}
-
-std::optional<ListPosition> parse_page_token(std::string_view token) {
-  const size_t dash = token.find('-');
-  if (dash == std::string_view::npos) return std::nullopt;
-  int64_t micros = 0;
-  if (!absl::SimpleAtoi(std::string(token.substr(0, dash)), &micros)) return std::nullopt;
-  const std::string_view id = token.substr(dash + 1);
-  if (!is_job_id(id)) return std::nullopt;
-  return ListPosition{micros, std::string(id)};
-}
-
 }  // namespace
-
-double unix_now() {
-  return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
-}
 
 JobTable::JobTable(const Spool& spool, int queue_capacity, Metrics& metrics)
     : spool_(spool),
@@ -363,11 +303,8 @@ void JobTable::requeue_interrupted(const std::string& job_id) {
 }
 
 v1::Job JobTable::view(const std::string& job_id, const v1::Job& stored) const {
-  v1::Job job = stored;
+  v1::Job job = with_timestamps(stored);
   if (job.state() == v1::JOB_STATE_QUEUED) job.set_queue_position(position_of(job_id));
-  if (job.created_at() > 0) *job.mutable_created_time() = to_timestamp(job.created_at());
-  if (job.started_at() > 0) *job.mutable_started_time() = to_timestamp(job.started_at());
-  if (job.finished_at() > 0) *job.mutable_finished_time() = to_timestamp(job.finished_at());
   return job;
 }
 
@@ -386,39 +323,30 @@ absl::StatusOr<std::string> JobTable::owner(const std::string& job_id) const {
 }
 
 absl::StatusOr<JobTable::JobPage> JobTable::list(const JobQuery& query) const {
-  std::optional<ListPosition> after;
-  if (!query.page_token.empty()) {
-    after = parse_page_token(query.page_token);
-    if (!after) return absl::InvalidArgumentError("page_token: not one a reply gave");
-  }
-  auto wanted = [&query](const v1::Job& job) {
-    if (!query.owner.empty() && job.owner() != query.owner) return false;
-    return query.states.empty() ||
-           std::find(query.states.begin(), query.states.end(), job.state()) != query.states.end();
-  };
-  std::lock_guard lock(mutex_);
-  // Newest first; ties by id, so that every job has one place in the order.
-  std::vector<std::pair<ListPosition, const Entry*>> order;
-  for (const auto& [id, entry] : jobs_) {
-    const v1::Job& job = entry.record.job();
-    if (entry.remove_when_ended || !wanted(job)) continue;
-    ListPosition position = list_position(job);
-    if (after && !(position < *after)) continue;
-    order.emplace_back(std::move(position), &entry);
-  }
-  std::sort(order.begin(), order.end(),
-            [](const auto& a, const auto& b) { return b.first < a.first; });
-  JobPage page;
-  for (const auto& [position, entry] : order) {
-    if (page.jobs.size() == query.page_size) {
-      page.next_page_token = page_token(list_position(page.jobs.back()));
-      break;
+  std::vector<v1::Job> jobs;
+  {
+    std::lock_guard lock(mutex_);
+    for (const auto& [id, entry] : jobs_) {
+      if (entry.remove_when_ended) continue;
+      if (!query.owner.empty() && entry.record.job().owner() != query.owner) continue;
+      jobs.push_back(view(id, entry.record.job()));
     }
-    v1::Job job = view(entry->record.job().job_id(), entry->record.job());
-    job.clear_report();
-    page.jobs.push_back(std::move(job));
   }
-  return page;
+  return page_of(std::move(jobs), query);
+}
+
+std::string JobTable::new_job_id_for(const std::string&, const std::string&) {
+  return new_job_id();
+}
+
+std::string JobTable::upload_path(const std::string& job_id, const std::string& extension) {
+  return spool_.upload_path(job_id, extension);
+}
+
+absl::StatusOr<uint64_t> JobTable::free_bytes() const { return spool_.free_bytes(); }
+
+std::string JobTable::artifact_path(const v1::Job& job, const std::string& name) const {
+  return absl::StrCat(spool_.output_dir(job.job_id(), job.attempts()), "/", name);
 }
 
 std::optional<JobTable::PriorRequest> JobTable::find_request(const std::string& owner,

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-// Every job the server knows: the queue, each job's state and event history,
-// and the waits of workers and watchers. Each state change is written to the
-// spool before it is visible to anyone.
+// Every job one server knows (the single-machine JobStore): the queue, each job's state and event
+// history, and the waits of workers and watchers. Each state change is written to the spool before
+// it is visible to anyone.
 #pragma once
 
 #include <condition_variable>
@@ -16,12 +16,13 @@
 #include "absl/status/statusor.h"
 #include "absl/time/time.h"
 #include "labelmesh/v1/service.pb.h"
+#include "server/job_store.h"
 #include "server/metrics.h"
 #include "server/spool.h"
 
 namespace labelmesh::server {
 
-class JobTable {
+class JobTable final : public JobStore {
  public:
   JobTable(const Spool& spool, int queue_capacity, Metrics& metrics);
 
@@ -30,10 +31,13 @@ class JobTable {
   // ended, older ones are deleted.
   void recover(absl::Duration result_ttl);
 
-  bool queue_full() const;
-  // Moves the upload into a new job and queues it; returns the queue position.
-  // RESOURCE_EXHAUSTED when the queue is full, UNAVAILABLE after close().
-  absl::StatusOr<uint32_t> accept(v1::JobRecord record, const std::string& upload_path);
+  std::string new_job_id_for(const std::string& owner, const std::string& request_id) override;
+  std::string upload_path(const std::string& job_id, const std::string& extension) override;
+  absl::StatusOr<uint64_t> free_bytes() const override;
+  std::string artifact_path(const v1::Job& job, const std::string& name) const override;
+
+  bool queue_full() const override;
+  absl::StatusOr<uint32_t> accept(v1::JobRecord record, const std::string& upload_path) override;
 
   // Blocks for the next queued job and marks it running; nullopt after close().
   std::optional<v1::JobRecord> take_next();
@@ -46,68 +50,26 @@ class JobTable {
   // A running job stopped by shutdown: queued again on disk for the next start.
   void requeue_interrupted(const std::string& job_id);
 
-  // NOT_FOUND for an unknown id.
-  absl::StatusOr<v1::Job> get(const std::string& job_id) const;
-  // The identity that submitted the job; NOT_FOUND for an unknown id.
-  absl::StatusOr<std::string> owner(const std::string& job_id) const;
+  absl::StatusOr<v1::Job> get(const std::string& job_id) const override;
+  absl::StatusOr<std::string> owner(const std::string& job_id) const override;
 
-  struct JobQuery {
-    // Only this owner's jobs; empty for every owner's.
-    std::string owner;
-    std::vector<v1::JobState> states;
-    size_t page_size = 100;
-    std::string page_token;
-  };
-  struct JobPage {
-    std::vector<v1::Job> jobs;
-    std::string next_page_token;
-  };
-  // Newest first, without reports. INVALID_ARGUMENT for a page token that
-  // no reply gave.
-  absl::StatusOr<JobPage> list(const JobQuery& query) const;
+  absl::StatusOr<JobPage> list(const JobQuery& query) const override;
 
-  // The job `owner` submitted with `request_id`, if any.
-  struct PriorRequest {
-    std::string job_id;
-    std::string sha256;
-    uint32_t queue_position = 0;
-  };
   std::optional<PriorRequest> find_request(const std::string& owner,
-                                           const std::string& request_id) const;
+                                           const std::string& request_id) const override;
 
-  // Deletes a job with its input and results; a running job is stopped and
-  // deleted when its worker has gone. Returns the state it was in. The
-  // spool's error when a queued job's cancellation cannot be saved.
-  absl::StatusOr<v1::JobState> remove(const std::string& job_id);
-  // A queued job is cancelled at once; a running one is flagged for its
-  // worker to stop. FAILED_PRECONDITION for a job that ended; the spool's
-  // error (RESOURCE_EXHAUSTED when its disk is full) when the cancelled
-  // record cannot be saved, and the job stays queued.
-  absl::StatusOr<v1::Job> cancel(const std::string& job_id);
+  // The spool's error when a queued job's cancellation cannot be saved.
+  absl::StatusOr<v1::JobState> remove(const std::string& job_id) override;
+  // The spool's error (RESOURCE_EXHAUSTED when its disk is full) when the
+  // cancelled record cannot be saved, and the job stays queued.
+  absl::StatusOr<v1::Job> cancel(const std::string& job_id) override;
   bool cancel_requested(const std::string& job_id) const;
-  // FAILED_PRECONDITION unless the job succeeded.
-  absl::StatusOr<std::vector<v1::Artifact>> artifacts(const std::string& job_id) const;
+  absl::StatusOr<std::vector<v1::Artifact>> artifacts(const std::string& job_id) const override;
 
-  // Told of a job's events as they are added, with no thread of its own.
-  // Called with the table locked: it must not call the table back.
-  class EventListener {
-   public:
-    virtual ~EventListener() = default;
-    // `last`: the job ended and this is its last event.
-    virtual void on_event(const v1::JobEvent& event, bool last) = 0;
-    // No event follows: OK when the job had ended with nothing left to
-    // replay, NOT_FOUND when it was deleted, UNAVAILABLE at shutdown.
-    virtual void on_closed(const absl::Status& status) = 0;
-  };
-  // Replays the job's events from `from` to `listener`, then tells it of
-  // each new one. NOT_FOUND for an unknown job, UNAVAILABLE after close().
-  absl::Status listen(const std::string& job_id, uint64_t from, EventListener* listener);
-  // Once this returns, `listener` is not called again.
-  void unlisten(const std::string& job_id, EventListener* listener);
+  absl::Status listen(const std::string& job_id, uint64_t from, EventListener* listener) override;
+  void unlisten(const std::string& job_id, EventListener* listener) override;
 
-  // Deletes jobs that ended more than `result_ttl` ago, and the oldest ended
-  // jobs beyond `max_ended`; returns their ids.
-  std::vector<std::string> expire(absl::Duration result_ttl, size_t max_ended);
+  std::vector<std::string> expire(absl::Duration result_ttl, size_t max_ended) override;
   // Wakes every waiter; take_next() returns nullopt from now on.
   void close();
   // Stops handing out jobs but still accepts them (drain before shutdown).
@@ -163,7 +125,5 @@ class JobTable {
   bool closed_ = false;
   bool dispatching_ = true;
 };
-
-double unix_now();
 
 }  // namespace labelmesh::server

@@ -5,12 +5,16 @@
 #include <grpcpp/grpcpp.h>
 #include <grpcpp/health_check_service_interface.h>
 
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 
 #include "absl/strings/str_cat.h"
 #include "server/audit_log.h"
 #include "server/client_identity.h"
+#include "server/cluster/cluster_job_store.h"
+#include "server/cluster/cluster_worker_role.h"
+#include "server/cluster/shared_artifacts.h"
 #include "server/job_table.h"
 #include "server/meshing_service.h"
 #include "server/metrics.h"
@@ -83,19 +87,12 @@ absl::StatusOr<std::unique_ptr<LabelmeshServer>> LabelmeshServer::start(ServerCo
   if (!c.metrics_listen.empty()) {
     if (auto status = server->metrics_->expose(c.metrics_listen); !status.ok()) return status;
   }
-  auto spool = Spool::open(c.spool_dir);
-  if (!spool.ok()) return spool.status();
-  server->spool_ = std::make_unique<Spool>(std::move(*spool));
-  kill_stale_workers(server->spool_->root());
-  auto audit =
-      AuditLog::open(c.audit_log.empty() ? server->spool_->root() + "/audit.log" : c.audit_log);
-  if (!audit.ok()) return audit.status();
-  server->audit_ = std::move(*audit);
-  server->table_ = std::make_unique<JobTable>(*server->spool_, c.queue_capacity, *server->metrics_);
-  server->table_->recover(c.result_ttl);
-  server->service_ =
-      std::make_unique<MeshingService>(*server->table_, *server->spool_, c, *server->metrics_,
-                                       *server->authenticator_, *server->audit_);
+  if (auto status = c.clustered() ? server->open_cluster() : server->open_spool(); !status.ok())
+    return status;
+  if (server->store_ != nullptr) {
+    server->service_ = std::make_unique<MeshingService>(*server->store_, c, *server->metrics_,
+                                                        *server->authenticator_, *server->audit_);
+  }
 
   grpc::EnableDefaultHealthCheckService(true);
   grpc::ServerBuilder builder;
@@ -103,20 +100,24 @@ absl::StatusOr<std::unique_ptr<LabelmeshServer>> LabelmeshServer::start(ServerCo
   // is anonymous anyway. Health says only SERVING or not, for probes.
   builder.SetOption(std::make_unique<ReflectionOption>(server->authenticator_->anonymous()));
   builder.AddListeningPort(c.listen, *creds, &server->port_);
-  builder.RegisterService(server->service_.get());
+  if (server->service_) builder.RegisterService(server->service_.get());
   builder.SetMaxReceiveMessageSize(c.max_message_bytes);
   builder.SetMaxSendMessageSize(c.max_message_bytes);
   server->server_ = builder.BuildAndStart();
   if (!server->server_ || server->port_ == 0) {
     return absl::UnavailableError(absl::StrCat("--listen: cannot serve on ", c.listen));
   }
-  server->pool_ = std::make_unique<WorkerPool>(*server->table_, *server->spool_, c);
-  server->pool_->start();
-  server->check_spool_space();
+  if (server->table_) {
+    server->pool_ = std::make_unique<WorkerPool>(*server->table_, *server->spool_, c);
+    server->pool_->start();
+  }
+  server->update_health();
   server->housekeeper_ = std::thread([s = server.get()] { s->housekeeping_loop(); });
   spdlog::info(
-      "labelmeshd listening on {} (port {}), {} workers, queue capacity {}, TLS {}, clients {}",
-      c.listen, server->port_, c.workers, c.queue_capacity, c.tls() ? "on" : "off",
+      "labelmeshd ({}) listening on {} (port {}), {} workers, queue capacity {}, TLS {}, "
+      "clients {}",
+      c.role, c.listen, server->port_, c.role == "frontend" ? 0 : c.workers, c.queue_capacity,
+      c.tls() ? "on" : "off",
       !c.clients_file.empty()      ? "by token from the clients file"
       : !c.auth_token_file.empty() ? "by one shared token"
       : !c.client_ca.empty()       ? "by certificate"
@@ -124,8 +125,56 @@ absl::StatusOr<std::unique_ptr<LabelmeshServer>> LabelmeshServer::start(ServerCo
   return server;
 }
 
-void LabelmeshServer::check_spool_space() {
-  auto free = spool_->free_bytes();
+absl::Status LabelmeshServer::open_spool() {
+  const ServerConfig& c = config_;
+  auto spool = Spool::open(c.spool_dir);
+  if (!spool.ok()) return spool.status();
+  spool_ = std::make_unique<Spool>(std::move(*spool));
+  kill_stale_workers(spool_->root());
+  auto audit = AuditLog::open(c.audit_log.empty() ? spool_->root() + "/audit.log" : c.audit_log);
+  if (!audit.ok()) return audit.status();
+  audit_ = std::move(*audit);
+  table_ = std::make_unique<JobTable>(*spool_, c.queue_capacity, *metrics_);
+  table_->recover(c.result_ttl);
+  store_ = table_.get();
+  return absl::OkStatus();
+}
+
+absl::Status LabelmeshServer::open_cluster() {
+  const ServerConfig& c = config_;
+  auto files = cluster::SharedArtifacts::open(c.artifact_dir);
+  if (!files.ok()) return files.status();
+  files_ = std::make_unique<cluster::SharedArtifacts>(std::move(*files));
+  cluster::ClusterSettings settings;
+  settings.nats_url = c.nats_url;
+  settings.connection_name = absl::StrCat("labelmeshd ", c.role);
+  settings.queue.ack_wait = c.cluster_ack_wait;
+  if (c.role == "worker") {
+    auto workers = ClusterWorkerRole::start(c, settings, *files_);
+    if (!workers.ok()) return workers.status();
+    cluster_workers_ = std::move(*workers);
+    return absl::OkStatus();
+  }
+  // The frontend keeps only its audit log locally.
+  std::error_code error;
+  std::filesystem::create_directories(c.spool_dir, error);
+  auto audit = AuditLog::open(c.audit_log.empty() ? c.spool_dir + "/audit.log" : c.audit_log);
+  if (!audit.ok()) return audit.status();
+  audit_ = std::move(*audit);
+  auto connection = cluster::ClusterConnection::open(settings);
+  if (!connection.ok()) return connection.status();
+  cluster_ = std::move(*connection);
+  cluster_store_ = std::make_unique<ClusterJobStore>(*cluster_, *files_, c.queue_capacity);
+  store_ = cluster_store_.get();
+  return absl::OkStatus();
+}
+
+void LabelmeshServer::update_health() {
+  if (cluster_workers_) {
+    server_->GetHealthCheckService()->SetServingStatus(cluster_workers_->healthy());
+    return;
+  }
+  auto free = store_->free_bytes();
   const bool under_reserve = !free.ok() || *free < config_.spool_reserve_bytes;
   metrics_->set_spool_space(free.ok() ? *free : 0, under_reserve);
   if (under_reserve != under_reserve_) {
@@ -145,10 +194,12 @@ void LabelmeshServer::housekeeping_loop() {
       std::min(absl::ToChronoMilliseconds(config_.result_ttl), std::chrono::milliseconds(2'000));
   std::unique_lock lock(mutex_);
   while (!stopping_.wait_for(lock, period, [this] { return stopped_; })) {
-    for (const auto& id : table_->expire(config_.result_ttl, size_t(config_.max_ended_jobs))) {
-      audit_->record({.event = "expired", .job_id = id, .identity = "labelmeshd"});
+    if (store_ != nullptr) {
+      for (const auto& id : store_->expire(config_.result_ttl, size_t(config_.max_ended_jobs))) {
+        audit_->record({.event = "expired", .job_id = id, .identity = "labelmeshd"});
+      }
     }
-    check_spool_space();
+    update_health();
   }
 }
 
@@ -161,13 +212,17 @@ void LabelmeshServer::shutdown() {
   stopping_.notify_all();
   spdlog::info("shutting down: no new uploads or jobs; running jobs have {} s to finish",
                absl::ToDoubleSeconds(config_.shutdown_grace));
-  if (!server_ || !pool_) return;  // start() failed half way: nothing runs yet.
-  service_->stop_accepting();
-  table_->stop_dispatch();
-  pool_->drain(config_.shutdown_grace);
-  table_->close();
+  if (!server_) return;  // start() failed half way: nothing runs yet.
+  if (service_) service_->stop_accepting();
+  if (pool_) {
+    table_->stop_dispatch();
+    pool_->drain(config_.shutdown_grace);
+    table_->close();
+  }
+  if (cluster_workers_) cluster_workers_->drain(config_.shutdown_grace);
+  if (cluster_store_) cluster_store_->close();
   server_->Shutdown(std::chrono::system_clock::now() + std::chrono::seconds(2));
-  pool_->join();
+  if (pool_) pool_->join();
   if (housekeeper_.joinable()) housekeeper_.join();
   spdlog::info("labelmeshd stopped");
 }

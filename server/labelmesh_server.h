@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-// labelmeshd assembled: spool, job table, worker pool, gRPC services
-// (meshing, health, reflection), metrics and the expiry of old results.
+// labelmeshd assembled for its role. all: spool, job table, worker pool.
+// frontend: the cluster's jobs behind the same gRPC service. worker: the
+// cluster's job slots, with health only. Each with gRPC services (meshing,
+// health, reflection), metrics and the expiry of old results.
 #pragma once
 
 #include <condition_variable>
@@ -15,9 +17,17 @@ namespace grpc {
 class Server;
 }
 
+namespace labelmesh::cluster {
+struct ClusterConnection;
+class SharedArtifacts;
+}  // namespace labelmesh::cluster
+
 namespace labelmesh::server {
 
 class AuditLog;
+class ClusterJobStore;
+class ClusterWorkerRole;
+class JobStore;
 class ClientAuthenticator;
 class JobTable;
 class MeshingService;
@@ -41,12 +51,16 @@ class LabelmeshServer {
 
  private:
   LabelmeshServer() = default;
-  // Every few seconds: deletes expired jobs and checks the spool's free
-  // space against its reserve.
+  // The local spool and its job table, for the role all.
+  absl::Status open_spool();
+  // The shared directory and the cluster, for the frontend and worker roles.
+  absl::Status open_cluster();
+  // Every few seconds: deletes expired jobs and updates health.
   void housekeeping_loop();
-  // Health NOT_SERVING and the disk-pressure gauge while the spool's disk is
-  // under its reserve.
-  void check_spool_space();
+  // Health NOT_SERVING while a worker cannot reach the cluster, or (other
+  // roles) while the disk of uploads and results is under its reserve, with
+  // the disk-pressure gauge.
+  void update_health();
 
   ServerConfig config_;
   std::unique_ptr<ClientAuthenticator> authenticator_;
@@ -55,6 +69,12 @@ class LabelmeshServer {
   std::unique_ptr<Spool> spool_;
   std::unique_ptr<JobTable> table_;
   std::unique_ptr<WorkerPool> pool_;
+  std::unique_ptr<cluster::SharedArtifacts> files_;
+  std::unique_ptr<cluster::ClusterConnection> cluster_;
+  std::unique_ptr<ClusterJobStore> cluster_store_;
+  std::unique_ptr<ClusterWorkerRole> cluster_workers_;
+  // The table or the cluster store: what the service serves.
+  JobStore* store_ = nullptr;
   std::unique_ptr<MeshingService> service_;
   std::unique_ptr<grpc::Server> server_;
   int port_ = 0;

@@ -37,6 +37,24 @@ CLI::Option* add_duration(CLI::App& app, const std::string& name, absl::Duration
 
 void add_server_flags(CLI::App& app, ServerConfig& c) {
   auto env = [](CLI::Option* option, const char* variable) { option->envname(variable); };
+  env(app.add_option("--role", c.role,
+                     "all: one machine, local spool; frontend: serves clients over the cluster's "
+                     "jobs; worker: runs the cluster's jobs")
+          ->check(CLI::IsMember({"all", "frontend", "worker"}))
+          ->capture_default_str(),
+      "LABELMESHD_ROLE");
+  env(app.add_option(
+          "--nats-url", c.nats_url,
+          "The cluster's NATS server with JetStream, nats://HOST:PORT (frontend, worker)"),
+      "LABELMESHD_NATS_URL");
+  env(app.add_option("--artifact-dir", c.artifact_dir,
+                     "Directory every frontend and worker shares for uploads and results "
+                     "(frontend, worker)"),
+      "LABELMESHD_ARTIFACT_DIR");
+  env(add_duration(app, "--cluster-ack-wait", c.cluster_ack_wait,
+                   "A cluster worker silent this long loses its job to another; the same on "
+                   "every machine"),
+      "LABELMESHD_CLUSTER_ACK_WAIT");
   env(app.add_option("--listen", c.listen, "gRPC address")->capture_default_str(),
       "LABELMESHD_LISTEN");
   env(app.add_option("--metrics-listen", c.metrics_listen,

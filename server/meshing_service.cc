@@ -10,6 +10,7 @@
 #include "server/durable_file.h"
 #include "server/error_details.h"
 #include "server/sha256.h"
+#include "server/spool.h"
 #include "server/upload_checks.h"
 #include "server/watch_reactor.h"
 #include "server/worker_process.h"
@@ -101,11 +102,9 @@ class UploadFile {
 
 }  // namespace
 
-MeshingService::MeshingService(JobTable& table, const Spool& spool, const ServerConfig& config,
-                               Metrics& metrics, ClientAuthenticator& authenticator,
-                               AuditLog& audit)
-    : table_(table),
-      spool_(spool),
+MeshingService::MeshingService(JobStore& store, const ServerConfig& config, Metrics& metrics,
+                               ClientAuthenticator& authenticator, AuditLog& audit)
+    : store_(store),
       config_(config),
       metrics_(metrics),
       authenticator_(authenticator),
@@ -139,7 +138,7 @@ absl::StatusOr<ClientIdentity> MeshingService::identify(const grpc::ServerContex
 grpc::Status MeshingService::authorize(const ClientIdentity& identity,
                                        const std::string& job_id) const {
   if (auto status = check_job_id(job_id); !status.ok()) return status;
-  auto owner = table_.owner(job_id);
+  auto owner = store_.owner(job_id);
   if (!owner.ok() || (!identity.admin && *owner != identity.name)) {
     return grpc::Status(grpc::StatusCode::NOT_FOUND, absl::StrCat("no job ", job_id));
   }
@@ -147,7 +146,7 @@ grpc::Status MeshingService::authorize(const ClientIdentity& identity,
 }
 
 absl::Status MeshingService::check_spool_space(uint64_t upload_bytes) const {
-  auto free = spool_.free_bytes();
+  auto free = store_.free_bytes();
   if (!free.ok()) return free.status();
   // The job's results must fit too; what they will come to is not known
   // before the job runs, so its output limit stands for them.
@@ -279,7 +278,7 @@ grpc::Status MeshingService::submit(grpc::ServerContext& context,
                         "a Submit with this request_id is still in progress; retry later");
   }
   if (!spec.request_id().empty()) {
-    if (auto prior = table_.find_request(identity.name, spec.request_id())) {
+    if (auto prior = store_.find_request(identity.name, spec.request_id())) {
       if (prior->sha256 != spec.sha256()) {
         reason = "request_id_reused";
         return grpc::Status(grpc::StatusCode::ALREADY_EXISTS,
@@ -291,7 +290,7 @@ grpc::Status MeshingService::submit(grpc::ServerContext& context,
       return grpc::Status::OK;
     }
   }
-  if (table_.queue_full()) {
+  if (store_.queue_full()) {
     reason = "queue_full";
     return grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED,
                         "the job queue is full; try again later");
@@ -311,9 +310,9 @@ grpc::Status MeshingService::submit(grpc::ServerContext& context,
   const MeshParams params = *params_from_options(options);
   options = make_options(params);
 
-  const std::string job_id = new_job_id();
+  const std::string job_id = store_.new_job_id_for(identity.name, spec.request_id());
   const std::string extension = *upload_extension(spec.file_name());
-  UploadFile upload(spool_.upload_path(job_id, extension));
+  UploadFile upload(store_.upload_path(job_id, extension));
   if (auto status = receive_upload(reader, spec, upload.path(), *ticket, reason); !status.ok())
     return status;
   auto geometry = check_uploaded_volume(upload.path(), voxel_limit, config_.worker_memory_bytes);
@@ -368,7 +367,7 @@ grpc::Status MeshingService::submit(grpc::ServerContext& context,
     reason = "stalled";
     return stalled_or(*ticket, grpc::Status(grpc::StatusCode::CANCELLED, "the client left"));
   }
-  auto position = table_.accept(std::move(record), upload.path());
+  auto position = store_.accept(std::move(record), upload.path());
   if (!position.ok()) {
     if (position.status().code() == absl::StatusCode::kResourceExhausted) {
       reason = absl::StartsWith(position.status().message(), "spool disk full") ? "disk_full"
@@ -391,7 +390,7 @@ grpc::ServerWriteReactor<v1::JobEvent>* MeshingService::Watch(grpc::CallbackServ
   if (auto status = authorize(*identity, request->job_id()); !status.ok()) return refuse(status);
   auto stream = open_stream(*context);
   if (!stream.ok()) return refuse(to_grpc(stream.status()));
-  return WatchReactor::start(table_, watchdog_, config_.stream_idle_timeout, context,
+  return WatchReactor::start(store_, watchdog_, config_.stream_idle_timeout, context,
                              request->job_id(), std::move(*stream));
 }
 
@@ -400,7 +399,7 @@ grpc::Status MeshingService::GetJob(grpc::ServerContext* context, const v1::GetJ
   auto identity = identify(*context, "GetJob");
   if (!identity.ok()) return to_grpc(identity.status());
   if (auto status = authorize(*identity, request->job_id()); !status.ok()) return status;
-  auto job = table_.get(request->job_id());
+  auto job = store_.get(request->job_id());
   if (!job.ok()) return to_grpc(job.status());
   *reply = std::move(*job);
   return grpc::Status::OK;
@@ -412,12 +411,12 @@ grpc::Status MeshingService::ListJobs(grpc::ServerContext* context,
   auto identity = identify(*context, "ListJobs");
   if (!identity.ok()) return to_grpc(identity.status());
   if (request->page_size() > 1000) return invalid("page_size: must be at most 1000");
-  JobTable::JobQuery query;
+  JobStore::JobQuery query;
   if (!identity->admin) query.owner = identity->name;
   for (int state : request->states()) query.states.push_back(static_cast<v1::JobState>(state));
   query.page_size = request->page_size() == 0 ? 100 : request->page_size();
   query.page_token = request->page_token();
-  auto page = table_.list(query);
+  auto page = store_.list(query);
   if (!page.ok()) return to_grpc(page.status());
   for (auto& job : page->jobs) *reply->add_jobs() = std::move(job);
   reply->set_next_page_token(page->next_page_token);
@@ -429,7 +428,7 @@ grpc::Status MeshingService::Cancel(grpc::ServerContext* context, const v1::Canc
   auto identity = identify(*context, "Cancel");
   if (!identity.ok()) return to_grpc(identity.status());
   if (auto status = authorize(*identity, request->job_id()); !status.ok()) return status;
-  auto job = table_.cancel(request->job_id());
+  auto job = store_.cancel(request->job_id());
   if (!job.ok()) return to_grpc(job.status());
   *reply = std::move(*job);
   return grpc::Status::OK;
@@ -441,7 +440,7 @@ grpc::Status MeshingService::ListArtifacts(grpc::ServerContext* context,
   auto identity = identify(*context, "ListArtifacts");
   if (!identity.ok()) return to_grpc(identity.status());
   if (auto status = authorize(*identity, request->job_id()); !status.ok()) return status;
-  auto artifacts = table_.artifacts(request->job_id());
+  auto artifacts = store_.artifacts(request->job_id());
   if (!artifacts.ok()) return to_grpc(artifacts.status());
   for (auto& artifact : *artifacts) *reply->add_artifacts() = std::move(artifact);
   return grpc::Status::OK;
@@ -452,7 +451,7 @@ grpc::Status MeshingService::Fetch(grpc::ServerContext* context, const v1::Fetch
   auto identity = identify(*context, "Fetch");
   if (!identity.ok()) return to_grpc(identity.status());
   if (auto status = authorize(*identity, request->job_id()); !status.ok()) return status;
-  auto artifacts = table_.artifacts(request->job_id());
+  auto artifacts = store_.artifacts(request->job_id());
   if (!artifacts.ok()) return to_grpc(artifacts.status());
   // Only names the job recorded are served: nothing else in the spool is reachable.
   const v1::Artifact* artifact = nullptr;
@@ -463,11 +462,9 @@ grpc::Status MeshingService::Fetch(grpc::ServerContext* context, const v1::Fetch
     return grpc::Status(grpc::StatusCode::NOT_FOUND,
                         absl::StrCat("job has no artifact '", request->artifact(), "'"));
   }
-  auto job = table_.get(request->job_id());
+  auto job = store_.get(request->job_id());
   if (!job.ok()) return to_grpc(job.status());
-  std::ifstream in(
-      absl::StrCat(spool_.output_dir(request->job_id(), job->attempts()), "/", artifact->name()),
-      std::ios::binary);
+  std::ifstream in(store_.artifact_path(*job, artifact->name()), std::ios::binary);
   if (!in) return grpc::Status(grpc::StatusCode::NOT_FOUND, "the artifact expired or was removed");
   auto stream = open_stream(*context);
   if (!stream.ok()) return to_grpc(stream.status());
@@ -493,7 +490,7 @@ grpc::Status MeshingService::DeleteJob(grpc::ServerContext* context,
   auto identity = identify(*context, "DeleteJob");
   if (!identity.ok()) return to_grpc(identity.status());
   if (auto status = authorize(*identity, request->job_id()); !status.ok()) return status;
-  auto state = table_.remove(request->job_id());
+  auto state = store_.remove(request->job_id());
   if (!state.ok()) return to_grpc(state.status());
   audit_.record({.event = "deleted",
                  .job_id = request->job_id(),

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 // The gRPC MeshingService: uploads become jobs, jobs are watched, cancelled,
-// listed, and their results fetched. The work itself is the worker pool's.
+// listed, and their results fetched. The work itself is the workers'.
 #pragma once
 
 #include <atomic>
@@ -11,10 +11,9 @@
 #include "labelmesh/v1/service.grpc.pb.h"
 #include "server/audit_log.h"
 #include "server/client_identity.h"
-#include "server/job_table.h"
+#include "server/job_store.h"
 #include "server/metrics.h"
 #include "server/server_config.h"
-#include "server/spool.h"
 #include "server/stream_limits.h"
 
 namespace labelmesh::server {
@@ -24,7 +23,7 @@ namespace labelmesh::server {
 class MeshingService final
     : public v1::MeshingService::WithCallbackMethod_Watch<v1::MeshingService::Service> {
  public:
-  MeshingService(JobTable& table, const Spool& spool, const ServerConfig& config, Metrics& metrics,
+  MeshingService(JobStore& store, const ServerConfig& config, Metrics& metrics,
                  ClientAuthenticator& authenticator, AuditLog& audit);
 
   // Refuses new uploads (UNAVAILABLE) from now on.
@@ -66,8 +65,7 @@ class MeshingService final
   // leave less than the reserve free.
   absl::Status check_spool_space(uint64_t upload_bytes) const;
 
-  JobTable& table_;
-  const Spool& spool_;
+  JobStore& store_;
   const ServerConfig& config_;
   Metrics& metrics_;
   ClientAuthenticator& authenticator_;

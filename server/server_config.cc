@@ -38,6 +38,14 @@ absl::Status validate_config(const ServerConfig& c) {
   auto bad = [](const std::string& flag, const std::string& why) {
     return absl::InvalidArgumentError(absl::StrCat("--", flag, ": ", why));
   };
+  if (c.role != "all" && c.role != "frontend" && c.role != "worker")
+    return bad("role", "must be all, frontend or worker");
+  if (c.clustered() && c.nats_url.empty())
+    return bad("nats-url", "the " + c.role + " role needs it");
+  if (c.clustered() && c.artifact_dir.empty())
+    return bad("artifact-dir", "the " + c.role + " role needs it");
+  if (c.cluster_ack_wait < absl::Seconds(1)) return bad("cluster-ack-wait", "must be at least 1s");
+  if (c.role == "worker" && c.workers < 1) return bad("workers", "a worker needs at least 1");
   if (c.workers < 0 || c.workers > 256) return bad("workers", "must be in [0, 256]");
   if (c.queue_capacity < 1) return bad("queue-capacity", "must be at least 1");
   if (c.job_timeout <= absl::ZeroDuration()) return bad("job-timeout", "must be positive");

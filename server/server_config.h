@@ -14,6 +14,17 @@
 namespace labelmesh::server {
 
 struct ServerConfig {
+  // all: one process with a local spool runs everything. frontend: serves
+  // clients over the cluster's shared jobs. worker: runs the cluster's jobs.
+  std::string role = "all";
+  // The cluster's NATS server and the directory every frontend and worker
+  // shares (uploads and results), for the frontend and worker roles.
+  std::string nats_url;
+  std::string artifact_dir;
+  // How long a cluster worker may stay silent before its job goes to
+  // another; the same on every machine (the first one to start sets it).
+  absl::Duration cluster_ack_wait = absl::Seconds(30);
+
   std::string listen = "127.0.0.1:50051";
   // Prometheus metrics endpoint; empty for none.
   std::string metrics_listen;
@@ -88,6 +99,7 @@ struct ServerConfig {
   std::string worker_executable;
 
   bool tls() const { return !tls_cert.empty(); }
+  bool clustered() const { return role != "all"; }
   // Clients prove who they are: tokens or client certificates.
   bool authenticates_clients() const {
     return !auth_token_file.empty() || !clients_file.empty() || !client_ca.empty();

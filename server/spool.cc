@@ -167,8 +167,12 @@ void Spool::adopt_output(const std::string& job_id, uint32_t attempt) const {
 
 absl::StatusOr<std::vector<v1::Artifact>> Spool::collect_artifacts(const std::string& job_id,
                                                                    uint32_t attempt) const {
+  return list_artifacts(output_dir(job_id, attempt));
+}
+
+absl::StatusOr<std::vector<v1::Artifact>> list_artifacts(const std::string& dir) {
   std::vector<v1::Artifact> artifacts;
-  const fs::path out = output_dir(job_id, attempt);
+  const fs::path out = dir;
   std::error_code error;
   for (const auto& entry : fs::recursive_directory_iterator(out, error)) {
     if (!entry.is_regular_file()) continue;

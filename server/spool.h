@@ -53,8 +53,7 @@ class Spool {
   // Moves the results of a spool written before attempts had directories
   // of their own (out/) to the attempt's (out-<n>/).
   void adopt_output(const std::string& job_id, uint32_t attempt) const;
-  // Every regular file of the attempt's output, with size and SHA-256,
-  // sorted by name.
+  // list_artifacts of the attempt's output.
   absl::StatusOr<std::vector<v1::Artifact>> collect_artifacts(const std::string& job_id,
                                                               uint32_t attempt) const;
   // Bytes an unprivileged writer may still use on the spool's file system.
@@ -65,6 +64,10 @@ class Spool {
   explicit Spool(std::string root) : root_(std::move(root)) {}
   std::string root_;
 };
+
+// Every regular file under `dir`, named relative to it, with size and
+// SHA-256, sorted by name.
+absl::StatusOr<std::vector<v1::Artifact>> list_artifacts(const std::string& dir);
 
 // A fresh job id: 32 random lowercase hex digits.
 std::string new_job_id();

@@ -6,23 +6,23 @@
 
 namespace labelmesh::server {
 
-WatchReactor* WatchReactor::start(JobTable& table, StreamWatchdog& watchdog,
+WatchReactor* WatchReactor::start(JobStore& store, StreamWatchdog& watchdog,
                                   absl::Duration idle_timeout, grpc::CallbackServerContext* context,
                                   std::string job_id, std::unique_ptr<StreamCounts::Slot> slot) {
-  auto* reactor = new WatchReactor(table, std::move(job_id), std::move(slot));
+  auto* reactor = new WatchReactor(store, std::move(job_id), std::move(slot));
   reactor->ticket_ = watchdog.watch_writes(
       context, idle_timeout, [reactor] { return reactor->write_started_.load(); }, "watch");
   // Replays what happened so far, then follows; events may arrive at once.
-  const absl::Status listening = table.listen(reactor->job_id_, 0, reactor);
+  const absl::Status listening = store.listen(reactor->job_id_, 0, reactor);
   std::lock_guard lock(reactor->mutex_);
   reactor->listening_ = listening.ok();
   if (!listening.ok()) reactor->finish(to_grpc(listening));
   return reactor;
 }
 
-WatchReactor::WatchReactor(JobTable& table, std::string job_id,
+WatchReactor::WatchReactor(JobStore& store, std::string job_id,
                            std::unique_ptr<StreamCounts::Slot> slot)
-    : table_(table), job_id_(std::move(job_id)), slot_(std::move(slot)) {}
+    : store_(store), job_id_(std::move(job_id)), slot_(std::move(slot)) {}
 
 void WatchReactor::on_event(const v1::JobEvent& event, bool last) {
   std::lock_guard lock(mutex_);
@@ -90,8 +90,8 @@ void WatchReactor::OnDone() {
     std::lock_guard lock(mutex_);
     listening = listening_;
   }
-  // After unlisten returns, the table never calls this reactor again.
-  if (listening) table_.unlisten(job_id_, this);
+  // After unlisten returns, the store never calls this reactor again.
+  if (listening) store_.unlisten(job_id_, this);
   delete this;
 }
 

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-// One Watch stream on gRPC's callback API: the job table hands it each event
+// One Watch stream on gRPC's callback API: the job store hands it each event
 // as it is added and the reactor writes them in order, so a watcher waiting
 // for news holds no thread. A watcher that stops reading is cancelled by the
 // stream watchdog once a write has been outstanding for the idle timeout.
@@ -14,22 +14,22 @@
 #include <string>
 
 #include "labelmesh/v1/service.pb.h"
-#include "server/job_table.h"
+#include "server/job_store.h"
 #include "server/stream_limits.h"
 
 namespace labelmesh::server {
 
 class WatchReactor final : public grpc::ServerWriteReactor<v1::JobEvent>,
-                           private JobTable::EventListener {
+                           private JobStore::EventListener {
  public:
   // Starts streaming the job's events; the reactor deletes itself when gRPC
   // is done with it. `slot` holds the stream's place among the client's.
-  static WatchReactor* start(JobTable& table, StreamWatchdog& watchdog, absl::Duration idle_timeout,
+  static WatchReactor* start(JobStore& store, StreamWatchdog& watchdog, absl::Duration idle_timeout,
                              grpc::CallbackServerContext* context, std::string job_id,
                              std::unique_ptr<StreamCounts::Slot> slot);
 
  private:
-  WatchReactor(JobTable& table, std::string job_id, std::unique_ptr<StreamCounts::Slot> slot);
+  WatchReactor(JobStore& store, std::string job_id, std::unique_ptr<StreamCounts::Slot> slot);
 
   void on_event(const v1::JobEvent& event, bool last) override;
   void on_closed(const absl::Status& status) override;
@@ -43,7 +43,7 @@ class WatchReactor final : public grpc::ServerWriteReactor<v1::JobEvent>,
   void finish(const grpc::Status& status);
   grpc::Status left_or_stalled() const;
 
-  JobTable& table_;
+  JobStore& store_;
   const std::string job_id_;
   std::unique_ptr<StreamCounts::Slot> slot_;
   // When the outstanding write started (ns since the epoch), 0 when none:

@@ -1,12 +1,10 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 #include "server/worker_pool.h"
 
-#include <algorithm>
-#include <thread>
-
 #include <unistd.h>
 
 #include "absl/strings/str_cat.h"
+#include "server/job_limits.h"
 #include "server/worker_process.h"
 #include "spdlog/spdlog.h"
 
@@ -43,25 +41,17 @@ void WorkerPool::run_job(const v1::JobRecord& record) {
     table_.fail(id, static_cast<int>(status.code()), std::string(status.message()));
     return;
   }
+  auto room = output_room(spool_.free_bytes(), config_);
+  if (!room.ok()) {
+    table_.fail(id, static_cast<int>(room.status().code()), std::string(room.status().message()));
+    return;
+  }
   WorkerRun run;
   run.executable = executable_;
   run.job_dir = spool_.job_dir(id);
   run.output_dir = spool_.output_dir(id, attempt);
   run.log_path = spool_.worker_log(id);
-  run.limits.memory_bytes = config_.worker_memory_bytes;
-  // Each worker meshes its labels on its share of the cores.
-  run.limits.threads = std::max(1u, std::thread::hardware_concurrency() /
-                                        static_cast<unsigned>(std::max(config_.workers, 1)));
-  run.limits.cpu_seconds =
-      config_.worker_cpu_seconds > 0
-          ? config_.worker_cpu_seconds
-          : static_cast<uint64_t>(2 * absl::ToDoubleSeconds(config_.job_timeout)) + 1;
-  auto room = output_room();
-  if (!room.ok()) {
-    table_.fail(id, static_cast<int>(room.status().code()), std::string(room.status().message()));
-    return;
-  }
-  run.limits.output_file_bytes = *room;
+  run.limits = worker_limits(config_, *room);
   run.deadline = absl::Now() + config_.job_timeout;
   run.on_event = [this, &id](v1::JobEvent event) { table_.publish(id, std::move(event)); };
   run.stop_request = [this, &id] {
@@ -73,7 +63,7 @@ void WorkerPool::run_job(const v1::JobRecord& record) {
   switch (outcome.kind) {
     case WorkerOutcome::Kind::kSucceeded: {
       auto artifacts = spool_.collect_artifacts(id, attempt);
-      if (artifacts.ok()) artifacts = within_output_limit(std::move(*artifacts));
+      if (artifacts.ok()) artifacts = within_output_limit(std::move(*artifacts), config_);
       if (!artifacts.ok()) {
         // Results that cannot be delivered take no space.
         (void)spool_.reset_output(id, attempt);
@@ -95,32 +85,6 @@ void WorkerPool::run_job(const v1::JobRecord& record) {
       table_.requeue_interrupted(id);
       break;
   }
-}
-
-absl::StatusOr<uint64_t> WorkerPool::output_room() const {
-  auto free = spool_.free_bytes();
-  if (!free.ok()) return free.status();
-  const uint64_t over_reserve =
-      *free > config_.spool_reserve_bytes ? *free - config_.spool_reserve_bytes : 0;
-  if (over_reserve < kLeastOutputRoom) {
-    return absl::ResourceExhaustedError(
-        absl::StrCat("spool disk full: ", *free, " bytes free, no room over the reserve of ",
-                     config_.spool_reserve_bytes, " bytes for the job's results"));
-  }
-  return config_.max_job_output_bytes > 0 ? std::min(config_.max_job_output_bytes, over_reserve)
-                                          : over_reserve;
-}
-
-absl::StatusOr<std::vector<v1::Artifact>> WorkerPool::within_output_limit(
-    std::vector<v1::Artifact> artifacts) const {
-  uint64_t total = 0;
-  for (const auto& artifact : artifacts) total += artifact.size_bytes();
-  if (config_.max_job_output_bytes > 0 && total > config_.max_job_output_bytes) {
-    return absl::ResourceExhaustedError(
-        absl::StrCat("the results came to ", total, " bytes, over the job's output limit of ",
-                     config_.max_job_output_bytes, " bytes; ask for fewer labels or formats"));
-  }
-  return artifacts;
 }
 
 void WorkerPool::drain(absl::Duration grace) {

@@ -32,15 +32,6 @@ class WorkerPool {
  private:
   void run_thread();
   void run_job(const v1::JobRecord& record);
-  // The largest file a job starting now may write: its output limit, or the
-  // free space over the spool's reserve if that is less.
-  absl::StatusOr<uint64_t> output_room() const;
-  // The results, or an error if together they are over the output limit.
-  absl::StatusOr<std::vector<v1::Artifact>> within_output_limit(
-      std::vector<v1::Artifact> artifacts) const;
-
-  // Less room than this over the reserve and a job does not start.
-  static constexpr uint64_t kLeastOutputRoom = uint64_t{1} << 20;
 
   JobTable& table_;
   const Spool& spool_;

@@ -2,6 +2,7 @@
 #include "server/cluster/cluster_jobs.h"
 
 #include "absl/strings/str_cat.h"
+#include "absl/time/clock.h"
 
 namespace labelmesh::cluster {
 namespace {
@@ -18,12 +19,15 @@ absl::StatusOr<v1::JobRecord> parse(const Versioned& stored, const std::string& 
   return record;
 }
 
+double unix_seconds() { return absl::ToDoubleSeconds(absl::Now() - absl::UnixEpoch()); }
+
 }  // namespace
 
 absl::Status ClusterJobs::log_state(const v1::JobRecord& record) {
   const v1::Job& job = record.job();
   v1::JobEvent event;
   event.set_job_id(job.job_id());
+  event.set_time(unix_seconds());
   switch (job.state()) {
     case v1::JOB_STATE_QUEUED:
       event.mutable_queued();
@@ -95,6 +99,9 @@ absl::StatusOr<Claim> ClusterJobs::claim(const std::string& job_id) {
     }
     r.mutable_job()->set_state(v1::JOB_STATE_RUNNING);
     r.mutable_job()->set_attempts(r.job().attempts() + 1);
+    r.mutable_job()->set_started_at(unix_seconds());
+    r.mutable_job()->clear_stage();
+    r.mutable_job()->set_progress(0);
     claim.attempt = r.job().attempts();
     return absl::OkStatus();
   });
@@ -114,6 +121,9 @@ absl::StatusOr<v1::JobRecord> ClusterJobs::finish(const Claim& claim, v1::JobSta
     }
     auto* job = r.mutable_job();
     job->set_state(state);
+    job->set_finished_at(unix_seconds());
+    job->clear_stage();
+    if (state == v1::JOB_STATE_SUCCEEDED) job->set_progress(1);
     if (result.job().has_report()) *job->mutable_report() = result.job().report();
     if (result.job().has_error()) *job->mutable_error() = result.job().error();
     *r.mutable_artifacts() = result.artifacts();
@@ -131,6 +141,9 @@ absl::StatusOr<v1::JobRecord> ClusterJobs::cancel(const std::string& job_id) {
     }
     if (r.job().state() == v1::JOB_STATE_QUEUED) {
       r.mutable_job()->set_state(v1::JOB_STATE_CANCELLED);
+      r.mutable_job()->set_finished_at(unix_seconds());
+      r.mutable_job()->mutable_error()->set_code(static_cast<int>(absl::StatusCode::kCancelled));
+      r.mutable_job()->mutable_error()->set_message("cancelled by a client");
     } else {
       r.set_cancel_requested(true);
     }
@@ -141,6 +154,44 @@ absl::StatusOr<v1::JobRecord> ClusterJobs::cancel(const std::string& job_id) {
     if (auto status = log_state(*record); !status.ok()) return status;
   }
   return record;
+}
+
+absl::Status ClusterJobs::publish(const Claim& claim, v1::JobEvent event) {
+  event.set_job_id(claim.job_id);
+  event.set_time(unix_seconds());
+  if (event.has_stage_started()) {
+    auto recorded = change_record(claim.job_id, [&](v1::JobRecord& r) {
+      if (r.job().state() != v1::JOB_STATE_RUNNING || r.job().attempts() != claim.attempt)
+        return absl::AbortedError("another attempt holds the job");
+      r.mutable_job()->set_stage(event.stage_started().stage());
+      r.mutable_job()->set_progress(0);
+      return absl::OkStatus();
+    });
+    // A stale attempt's events are not logged either.
+    if (!recorded.ok()) return recorded.status();
+  }
+  return events_.append(claim.job_id, event.SerializeAsString()).status();
+}
+
+absl::StatusOr<bool> ClusterJobs::remove(const std::string& job_id) {
+  bool running = false;
+  auto record = change_record(job_id, [&](v1::JobRecord& r) {
+    running = r.job().state() == v1::JOB_STATE_RUNNING;
+    if (running) {
+      r.set_deleted(true);
+      r.set_cancel_requested(true);
+    }
+    return absl::OkStatus();
+  });
+  if (!record.ok()) return record.status();
+  if (running) return false;
+  if (auto status = erase(job_id); !status.ok()) return status;
+  return true;
+}
+
+absl::Status ClusterJobs::erase(const std::string& job_id) {
+  if (auto status = states_.remove(job_id); !status.ok()) return status;
+  return events_.remove(job_id);
 }
 
 }  // namespace labelmesh::cluster

@@ -10,6 +10,7 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "absl/status/statusor.h"
 #include "labelmesh/v1/service.pb.h"
@@ -51,6 +52,18 @@ class ClusterJobs {
   // (the result is refused); INVALID_ARGUMENT for a state that is not an end.
   absl::StatusOr<v1::JobRecord> finish(const Claim& claim, v1::JobState state,
                                        const v1::JobRecord& result);
+
+  // A running claim's stage or progress event, logged for watchers; a stage
+  // start is also recorded (fenced by the attempt), for GetJob.
+  absl::Status publish(const Claim& claim, v1::JobEvent event);
+  // A running job is marked deleted and asked to stop: its worker removes
+  // it once it ends. Any other is removed at once (record and events);
+  // true when it was. Errors: NOT_FOUND.
+  absl::StatusOr<bool> remove(const std::string& job_id);
+  // The record and events of `job_id`, whatever its state.
+  absl::Status erase(const std::string& job_id);
+  // Every job id recorded.
+  absl::StatusOr<std::vector<std::string>> job_ids() { return states_.keys(); }
 
   // A queued job ends CANCELLED; a running one is asked to stop (its
   // worker sees cancel_requested). Errors: FAILED_PRECONDITION when it has

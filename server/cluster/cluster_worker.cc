@@ -32,9 +32,19 @@ absl::StatusOr<bool> ClusterWorker::run_one() {
       cancelled = true;
   }
   const JobOutcome outcome = running.get();
+  if (outcome.state == v1::JOB_STATE_QUEUED) {
+    // This worker is stopping: the next one takes the job at once.
+    if (auto status = delivery.nak(); !status.ok()) return status;
+    return true;
+  }
   auto ended = jobs_.finish(*claim, outcome.state, outcome.result);
   if (ended.status().code() == absl::StatusCode::kAborted) return true;
+  if (ended.status().code() == absl::StatusCode::kNotFound) {
+    if (auto status = delivery.ack(); !status.ok()) return status;
+    return true;
+  }
   if (!ended.ok()) return ended.status();
+  if (ended_) ended_(*ended);
   if (auto status = delivery.ack(); !status.ok()) return status;
   return true;
 }

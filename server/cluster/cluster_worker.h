@@ -23,7 +23,8 @@ struct ClusterWorkerConfig {
 };
 
 // How a run ended: SUCCEEDED, FAILED or CANCELLED, and what to record
-// (report, artifacts or error).
+// (report, artifacts or error); QUEUED for a run stopped by the worker's own
+// shutdown, which gives the job back to the queue.
 struct JobOutcome {
   v1::JobState state = v1::JOB_STATE_FAILED;
   v1::JobRecord result;
@@ -32,16 +33,24 @@ struct JobOutcome {
 // Runs one attempt; `cancelled` turns true when a client cancels the job.
 using RunJob = std::function<JobOutcome(const v1::JobRecord& record, const Claim& claim,
                                         const std::atomic<bool>& cancelled)>;
+// Told of a job this worker ended, as recorded, before the queue hears.
+using JobEnded = std::function<void(const v1::JobRecord& record)>;
 
 class ClusterWorker {
  public:
-  ClusterWorker(JobQueue& queue, ClusterJobs& jobs, RunJob run, ClusterWorkerConfig config = {})
-      : queue_(queue), jobs_(jobs), run_(std::move(run)), config_(config) {}
+  ClusterWorker(JobQueue& queue, ClusterJobs& jobs, RunJob run, ClusterWorkerConfig config = {},
+                JobEnded ended = nullptr)
+      : queue_(queue),
+        jobs_(jobs),
+        run_(std::move(run)),
+        config_(config),
+        ended_(std::move(ended)) {}
 
   // Takes and handles one job if one comes within config.poll; true when
   // one came. A job that has ended or is gone is acknowledged without a
   // run; a result the job states refuse (another worker holds a newer
-  // attempt) is dropped, unacknowledged.
+  // attempt) is dropped, unacknowledged; a job deleted while it ran is
+  // acknowledged.
   absl::StatusOr<bool> run_one();
 
  private:
@@ -49,6 +58,7 @@ class ClusterWorker {
   ClusterJobs& jobs_;
   RunJob run_;
   ClusterWorkerConfig config_;
+  JobEnded ended_;
 };
 
 }  // namespace labelmesh::cluster

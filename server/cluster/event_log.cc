@@ -1,9 +1,53 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 #include "server/cluster/event_log.h"
 
+#include <mutex>
+
 #include "absl/strings/str_cat.h"
 
 namespace labelmesh::cluster {
+
+namespace {
+
+// Takes the message: its data and stream sequence.
+LoggedEvent logged_event(natsMsg* message) {
+  LoggedEvent event;
+  event.data.assign(natsMsg_GetData(message), static_cast<size_t>(natsMsg_GetDataLength(message)));
+  jsMsgMetaData* meta = nullptr;
+  if (natsMsg_GetMetaData(&meta, message) == NATS_OK) {
+    event.sequence = meta->Sequence.Stream;
+    jsMsgMetaData_Destroy(meta);
+  }
+  natsMsg_Destroy(message);
+  return event;
+}
+
+}  // namespace
+
+// Shared by the subscription and the client's delivery thread; the client
+// frees it once the subscription is closed and its last callback returned.
+struct EventSubscription::Delivery {
+  std::mutex mutex;
+  bool active = true;
+  std::function<void(LoggedEvent)> on_event;
+
+  static void on_message(natsConnection*, natsSubscription*, natsMsg* message, void* closure) {
+    auto* delivery = static_cast<Delivery*>(closure);
+    LoggedEvent event = logged_event(message);
+    std::lock_guard lock(delivery->mutex);
+    if (delivery->active) delivery->on_event(std::move(event));
+  }
+  static void on_complete(void* closure) { delete static_cast<Delivery*>(closure); }
+};
+
+EventSubscription::~EventSubscription() {
+  {
+    std::lock_guard lock(delivery_->mutex);
+    delivery_->active = false;
+  }
+  natsSubscription_Unsubscribe(subscription_);
+  natsSubscription_Destroy(subscription_);
+}
 
 EventFollower::~EventFollower() { natsSubscription_Destroy(subscription_); }
 
@@ -13,15 +57,7 @@ absl::StatusOr<std::optional<LoggedEvent>> EventFollower::next(absl::Duration wa
       natsSubscription_NextMsg(&message, subscription_, absl::ToInt64Milliseconds(wait));
   if (status == NATS_TIMEOUT) return std::nullopt;
   if (status != NATS_OK) return nats_error(status, "following a job's events");
-  LoggedEvent event;
-  event.data.assign(natsMsg_GetData(message), static_cast<size_t>(natsMsg_GetDataLength(message)));
-  jsMsgMetaData* meta = nullptr;
-  if (natsMsg_GetMetaData(&meta, message) == NATS_OK) {
-    event.sequence = meta->Sequence.Stream;
-    jsMsgMetaData_Destroy(meta);
-  }
-  natsMsg_Destroy(message);
-  return std::optional<LoggedEvent>(std::move(event));
+  return std::optional<LoggedEvent>(logged_event(message));
 }
 
 absl::StatusOr<std::unique_ptr<EventLog>> EventLog::open(NatsClient& client,
@@ -55,8 +91,7 @@ absl::StatusOr<uint64_t> EventLog::append(const std::string& job_id, const std::
   return sequence;
 }
 
-absl::StatusOr<std::unique_ptr<EventFollower>> EventLog::follow(const std::string& job_id,
-                                                                uint64_t from) {
+jsSubOptions EventLog::follow_options(uint64_t from) const {
   jsSubOptions options;
   jsSubOptions_Init(&options);
   options.Stream = config_.stream.c_str();
@@ -65,11 +100,45 @@ absl::StatusOr<std::unique_ptr<EventFollower>> EventLog::follow(const std::strin
     options.Config.DeliverPolicy = js_DeliverByStartSequence;
     options.Config.OptStartSeq = from;
   }
+  return options;
+}
+
+absl::StatusOr<std::unique_ptr<EventFollower>> EventLog::follow(const std::string& job_id,
+                                                                uint64_t from) {
+  jsSubOptions options = follow_options(from);
   natsSubscription* subscription = nullptr;
   const natsStatus status = js_SubscribeSync(&subscription, client_.jetstream(),
                                              subject(job_id).c_str(), nullptr, &options, nullptr);
   if (status != NATS_OK) return nats_error(status, absl::StrCat("events of ", job_id));
   return std::make_unique<EventFollower>(subscription);
+}
+
+absl::StatusOr<std::unique_ptr<EventSubscription>> EventLog::subscribe(
+    const std::string& job_id, uint64_t from, std::function<void(LoggedEvent)> on_event) {
+  jsSubOptions options = follow_options(from);
+  auto* delivery = new EventSubscription::Delivery{{}, true, std::move(on_event)};
+  natsSubscription* subscription = nullptr;
+  natsStatus status =
+      js_Subscribe(&subscription, client_.jetstream(), subject(job_id).c_str(),
+                   &EventSubscription::Delivery::on_message, delivery, nullptr, &options, nullptr);
+  if (status == NATS_OK) {
+    status = natsSubscription_SetOnCompleteCB(subscription,
+                                              &EventSubscription::Delivery::on_complete, delivery);
+    if (status != NATS_OK) {
+      // The client never frees the delivery now, and a callback may still
+      // hold it: it is stopped and left, never freed.
+      {
+        std::lock_guard lock(delivery->mutex);
+        delivery->active = false;
+      }
+      natsSubscription_Unsubscribe(subscription);
+      natsSubscription_Destroy(subscription);
+      return nats_error(status, absl::StrCat("events of ", job_id));
+    }
+    return std::make_unique<EventSubscription>(subscription, delivery);
+  }
+  delete delivery;
+  return nats_error(status, absl::StrCat("events of ", job_id));
 }
 
 absl::Status EventLog::remove(const std::string& job_id) {

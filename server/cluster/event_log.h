@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -44,6 +45,23 @@ class EventFollower {
   natsSubscription* subscription_;
 };
 
+// A live follow of one job's events, each handed to a callback on the NATS
+// client's own thread, so a follower holds no thread while it waits.
+class EventSubscription {
+ public:
+  struct Delivery;
+  EventSubscription(natsSubscription* subscription, Delivery* delivery)
+      : subscription_(subscription), delivery_(delivery) {}
+  // Once it returns, the callback is not called again.
+  ~EventSubscription();
+  EventSubscription(const EventSubscription&) = delete;
+  EventSubscription& operator=(const EventSubscription&) = delete;
+
+ private:
+  natsSubscription* subscription_;
+  Delivery* delivery_;
+};
+
 class EventLog {
  public:
   // Creates the stream unless it exists. Errors: those of nats_error.
@@ -56,6 +74,10 @@ class EventLog {
   // Follows `job_id`'s events from sequence `from` on (0: from its first).
   absl::StatusOr<std::unique_ptr<EventFollower>> follow(const std::string& job_id, uint64_t from);
 
+  // Hands each of `job_id`'s events from sequence `from` on (0: from its
+  // first) to `on_event`, as they come.
+  absl::StatusOr<std::unique_ptr<EventSubscription>> subscribe(
+      const std::string& job_id, uint64_t from, std::function<void(LoggedEvent)> on_event);
   // Drops every event of `job_id`.
   absl::Status remove(const std::string& job_id);
 
@@ -63,6 +85,8 @@ class EventLog {
   EventLog(NatsClient& client, EventLogConfig config)
       : client_(client), config_(std::move(config)) {}
   std::string subject(const std::string& job_id) const;
+  // Ordered consumer options for one job's events from `from`.
+  jsSubOptions follow_options(uint64_t from) const;
 
   NatsClient& client_;
   EventLogConfig config_;

@@ -58,6 +58,17 @@ absl::StatusOr<uint64_t> JobStates::update(const std::string& key, const std::st
   return nats_error(status, absl::StrCat("updating job state ", key));
 }
 
+absl::StatusOr<std::vector<std::string>> JobStates::keys() {
+  kvKeysList list{nullptr, 0};
+  const natsStatus status = kvStore_Keys(&list, store_, nullptr);
+  // An empty bucket answers "not found".
+  if (status == NATS_NOT_FOUND) return std::vector<std::string>();
+  if (status != NATS_OK) return nats_error(status, "listing job states");
+  std::vector<std::string> keys(list.Keys, list.Keys + list.Count);
+  kvKeysList_Destroy(&list);
+  return keys;
+}
+
 absl::Status JobStates::remove(const std::string& key) {
   return nats_error(kvStore_Purge(store_, key.c_str(), nullptr),
                     absl::StrCat("removing job state ", key));

@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "absl/status/statusor.h"
 #include "server/cluster/nats_client.h"
@@ -43,6 +44,8 @@ class JobStates {
   absl::StatusOr<uint64_t> update(const std::string& key, const std::string& value,
                                   uint64_t revision);
 
+  // Every key that holds a value.
+  absl::StatusOr<std::vector<std::string>> keys();
   // Removes the key (its history too).
   absl::Status remove(const std::string& key);
 

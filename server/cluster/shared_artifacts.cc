@@ -28,7 +28,7 @@ absl::StatusOr<SharedArtifacts> SharedArtifacts::open(const std::string& root) {
 }
 
 std::string SharedArtifacts::attempt_dir(const std::string& job_id, uint32_t attempt) const {
-  return (fs::path(root_) / "jobs" / job_id / absl::StrCat("attempt-", attempt)).string();
+  return (fs::path(root_) / "jobs" / job_id / absl::StrCat("out-", attempt)).string();
 }
 
 absl::StatusOr<std::string> SharedArtifacts::resolve(std::string_view relative) const {
@@ -84,12 +84,12 @@ absl::StatusOr<size_t> SharedArtifacts::remove_other_attempts(const std::string&
                                                               uint32_t kept) const {
   auto job_dir = resolve(absl::StrCat("jobs/", job_id));
   if (!job_dir.ok()) return job_dir.status();
-  const std::string keep = absl::StrCat("attempt-", kept);
+  const std::string keep = absl::StrCat("out-", kept);
   size_t removed = 0;
   std::error_code error;
   for (const auto& entry : fs::directory_iterator(*job_dir, error)) {
     const std::string name = entry.path().filename().string();
-    if (name.rfind("attempt-", 0) != 0 || name == keep) continue;
+    if (name.rfind("out-", 0) != 0 || name == keep) continue;
     fs::remove_all(entry.path(), error);
     if (error) return server::spool_io_error(entry.path().string(), error.value());
     ++removed;

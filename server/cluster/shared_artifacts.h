@@ -22,7 +22,7 @@ class SharedArtifacts {
   static absl::StatusOr<SharedArtifacts> open(const std::string& root);
 
   const std::string& root() const { return root_; }
-  // jobs/<job id>/attempt-<n>, under the root.
+  // jobs/<job id>/out-<n> (the layout the worker program expects), under the root.
   std::string attempt_dir(const std::string& job_id, uint32_t attempt) const;
 
   // Writes `bytes` to `relative` (a path under the root) so that readers

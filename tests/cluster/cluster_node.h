@@ -8,7 +8,7 @@
 
 #include "absl/time/time.h"
 #include "cluster/nats_server.h"
-#include "server/cluster/cluster_jobs.h"
+#include "server/cluster/cluster_connection.h"
 
 namespace labelmesh::testing {
 
@@ -16,20 +16,24 @@ struct ClusterNode {
   // Every machine of a cluster has the same queue settings; tests pass a
   // short ack wait so a silent worker loses its job quickly.
   ClusterNode(const NatsServer& server, absl::Duration ack_wait) {
-    client = std::move(
-        cluster::NatsClient::connect(server.url(), "labelmesh-test", absl::Seconds(5)).value());
-    cluster::JobQueueConfig config;
-    config.ack_wait = ack_wait;
-    queue = std::move(cluster::JobQueue::open(*client, config).value());
-    states = std::move(cluster::JobStates::open(*client, "labelmesh_jobs").value());
-    events = std::move(cluster::EventLog::open(*client, {}).value());
-    jobs = std::make_unique<cluster::ClusterJobs>(*states, *queue, *events);
+    cluster::ClusterSettings settings;
+    settings.nats_url = server.url();
+    settings.connection_name = "labelmesh-test";
+    settings.queue.ack_wait = ack_wait;
+    settings.connect_timeout = absl::Seconds(5);
+    connection = std::move(cluster::ClusterConnection::open(settings).value());
+    client = connection->client.get();
+    queue = connection->queue.get();
+    states = connection->states.get();
+    events = connection->events.get();
+    jobs = connection->jobs.get();
   }
-  std::unique_ptr<cluster::NatsClient> client;
-  std::unique_ptr<cluster::JobQueue> queue;
-  std::unique_ptr<cluster::JobStates> states;
-  std::unique_ptr<cluster::EventLog> events;
-  std::unique_ptr<cluster::ClusterJobs> jobs;
+  std::unique_ptr<cluster::ClusterConnection> connection;
+  cluster::NatsClient* client = nullptr;
+  cluster::JobQueue* queue = nullptr;
+  cluster::JobStates* states = nullptr;
+  cluster::EventLog* events = nullptr;
+  cluster::ClusterJobs* jobs = nullptr;
 };
 
 // A job record with only its id set.

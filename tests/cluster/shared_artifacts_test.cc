@@ -19,16 +19,16 @@ TEST(SharedArtifacts, FilesAppearWholeUnderTheirName) {
   EXPECT_TRUE(fs::is_directory(root / "uploads"));
   EXPECT_TRUE(fs::is_directory(root / "jobs"));
   const std::string bytes(1 << 20, 'x');
-  ASSERT_TRUE(store->put("jobs/j1/attempt-1/volume.vtu", bytes).ok());
-  EXPECT_EQ(store->get("jobs/j1/attempt-1/volume.vtu").value(), bytes);
+  ASSERT_TRUE(store->put("jobs/j1/out-1/volume.vtu", bytes).ok());
+  EXPECT_EQ(store->get("jobs/j1/out-1/volume.vtu").value(), bytes);
   // Nothing but the file itself is left in its directory.
   size_t entries = 0;
-  for (const auto& entry : fs::directory_iterator(root / "jobs/j1/attempt-1")) {
+  for (const auto& entry : fs::directory_iterator(root / "jobs/j1/out-1")) {
     EXPECT_EQ(entry.path().filename(), "volume.vtu");
     ++entries;
   }
   EXPECT_EQ(entries, 1u);
-  EXPECT_EQ(store->get("jobs/j1/attempt-1/missing").status().code(), absl::StatusCode::kNotFound);
+  EXPECT_EQ(store->get("jobs/j1/out-1/missing").status().code(), absl::StatusCode::kNotFound);
 }
 
 TEST(SharedArtifacts, PathsOutsideTheStoreAreRefused) {
@@ -44,15 +44,15 @@ TEST(SharedArtifacts, OnlyTheFinalAttemptsFilesRemain) {
   const auto root = testing::scratch_dir("artifacts-attempts");
   auto store = SharedArtifacts::open(root.string());
   ASSERT_TRUE(store.ok());
-  EXPECT_EQ(store->attempt_dir("j1", 2), (root / "jobs/j1/attempt-2").string());
+  EXPECT_EQ(store->attempt_dir("j1", 2), (root / "jobs/j1/out-2").string());
   for (int attempt : {1, 2, 3}) {
     ASSERT_TRUE(
-        store->put("jobs/j1/attempt-" + std::to_string(attempt) + "/report.json", "{}").ok());
+        store->put("jobs/j1/out-" + std::to_string(attempt) + "/report.json", "{}").ok());
   }
   EXPECT_EQ(store->remove_other_attempts("j1", 2).value(), 2u);
-  EXPECT_FALSE(fs::exists(root / "jobs/j1/attempt-1"));
-  EXPECT_TRUE(fs::exists(root / "jobs/j1/attempt-2/report.json"));
-  EXPECT_FALSE(fs::exists(root / "jobs/j1/attempt-3"));
+  EXPECT_FALSE(fs::exists(root / "jobs/j1/out-1"));
+  EXPECT_TRUE(fs::exists(root / "jobs/j1/out-2/report.json"));
+  EXPECT_FALSE(fs::exists(root / "jobs/j1/out-3"));
   EXPECT_EQ(store->remove_other_attempts("../x", 1).status().code(),
             absl::StatusCode::kInvalidArgument);
 }

@@ -1,0 +1,27 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+#include "server/cluster/cluster_connection.h"
+
+namespace labelmesh::cluster {
+
+absl::StatusOr<std::unique_ptr<ClusterConnection>> ClusterConnection::open(
+    const ClusterSettings& settings) {
+  auto connection = std::make_unique<ClusterConnection>();
+  auto client =
+      NatsClient::connect(settings.nats_url, settings.connection_name, settings.connect_timeout);
+  if (!client.ok()) return client.status();
+  connection->client = std::move(*client);
+  auto queue = JobQueue::open(*connection->client, settings.queue);
+  if (!queue.ok()) return queue.status();
+  connection->queue = std::move(*queue);
+  auto states = JobStates::open(*connection->client, settings.states_bucket);
+  if (!states.ok()) return states.status();
+  connection->states = std::move(*states);
+  auto events = EventLog::open(*connection->client, settings.events);
+  if (!events.ok()) return events.status();
+  connection->events = std::move(*events);
+  connection->jobs =
+      std::make_unique<ClusterJobs>(*connection->states, *connection->queue, *connection->events);
+  return connection;
+}
+
+}  // namespace labelmesh::cluster

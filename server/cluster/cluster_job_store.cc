@@ -1,0 +1,269 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+#include "server/cluster/cluster_job_store.h"
+
+#include <algorithm>
+#include <filesystem>
+
+#include "absl/strings/str_cat.h"
+#include "server/durable_file.h"
+#include "server/sha256.h"
+#include "server/spool.h"
+#include "spdlog/spdlog.h"
+
+namespace labelmesh::server {
+namespace fs = std::filesystem;
+namespace {
+
+// Longest an ended job's replay waits for an event it knows is logged.
+constexpr absl::Duration kReplayWait = absl::Milliseconds(500);
+
+bool is_last(const v1::JobEvent& event) {
+  return event.has_finished() || event.has_failed() || event.has_cancelled();
+}
+
+// The same on every frontend for the same client and request.
+std::string job_id_of_request(const std::string& owner, const std::string& request_id) {
+  digest::Sha256 hash;
+  hash.update(absl::StrCat("labelmesh request\n", owner, "\n", request_id));
+  return hash.hex_digest().substr(0, 32);
+}
+
+}  // namespace
+
+v1::JobEvent watched_event(const cluster::LoggedEvent& logged) {
+  v1::JobEvent event;
+  if (!event.ParseFromString(logged.data)) event.Clear();
+  event.set_sequence(logged.sequence);
+  if (event.time() > 0) *event.mutable_timestamp() = to_timestamp(event.time());
+  return event;
+}
+
+std::string ClusterJobStore::new_job_id_for(const std::string& owner,
+                                            const std::string& request_id) {
+  return request_id.empty() ? new_job_id() : job_id_of_request(owner, request_id);
+}
+
+std::string ClusterJobStore::upload_path(const std::string& job_id, const std::string& extension) {
+  // Two frontends may receive the same retried request at once.
+  return absl::StrCat(files_.root(), "/uploads/", job_id, "-", new_job_id().substr(0, 8),
+                      extension);
+}
+
+absl::StatusOr<uint64_t> ClusterJobStore::free_bytes() const {
+  std::error_code error;
+  const fs::space_info space = fs::space(files_.root(), error);
+  if (error)
+    return spool_io_error(absl::StrCat("cannot read the free space of ", files_.root()),
+                          error.value());
+  return space.available;
+}
+
+bool ClusterJobStore::queue_full() const {
+  auto stored = cluster_.queue->stored();
+  return stored.ok() && *stored >= queue_capacity_;
+}
+
+absl::StatusOr<uint32_t> ClusterJobStore::accept(v1::JobRecord record,
+                                                 const std::string& upload_path) {
+  const std::string id = record.job().job_id();
+  std::error_code error;
+  if (cluster_.jobs->get(id).ok()) {
+    // A retry that raced its first try here: the job exists already.
+    fs::remove(upload_path, error);
+    return 0;
+  }
+  record.mutable_job()->set_state(v1::JOB_STATE_QUEUED);
+  const std::string dir = absl::StrCat("jobs/", id);
+  if (auto status = files_.put(dir + "/job.pb", record.SerializeAsString()); !status.ok())
+    return status;
+  fs::rename(upload_path, absl::StrCat(files_.root(), "/", dir, "/input", record.input_extension()),
+             error);
+  if (error) return spool_io_error("cannot move the upload into its job", error.value());
+  auto submitted = cluster_.jobs->submit(std::move(record));
+  if (!submitted.ok()) {
+    (void)erase(id);
+    return submitted.status();
+  }
+  spdlog::info("job {} queued", id);
+  auto stored = cluster_.queue->stored();
+  return stored.ok() && *stored > 0 ? static_cast<uint32_t>(*stored - 1) : 0;
+}
+
+absl::StatusOr<v1::JobRecord> ClusterJobStore::record(const std::string& job_id) const {
+  auto record = cluster_.jobs->get(job_id);
+  if (!record.ok() && record.status().code() == absl::StatusCode::kNotFound)
+    return absl::NotFoundError(absl::StrCat("no job ", job_id));
+  if (record.ok() && record->deleted()) return absl::NotFoundError(absl::StrCat("no job ", job_id));
+  return record;
+}
+
+absl::StatusOr<v1::Job> ClusterJobStore::get(const std::string& job_id) const {
+  auto found = record(job_id);
+  if (!found.ok()) return found.status();
+  return with_timestamps(found->job());
+}
+
+absl::StatusOr<std::string> ClusterJobStore::owner(const std::string& job_id) const {
+  auto found = record(job_id);
+  if (!found.ok()) return found.status();
+  return found->job().owner();
+}
+
+absl::StatusOr<JobStore::JobPage> ClusterJobStore::list(const JobQuery& query) const {
+  auto ids = cluster_.jobs->job_ids();
+  if (!ids.ok()) return ids.status();
+  std::vector<v1::Job> jobs;
+  for (const auto& id : *ids) {
+    auto found = record(id);
+    if (!found.ok()) continue;  // deleted meanwhile
+    if (!query.owner.empty() && found->job().owner() != query.owner) continue;
+    jobs.push_back(with_timestamps(found->job()));
+  }
+  return page_of(std::move(jobs), query);
+}
+
+std::optional<JobStore::PriorRequest> ClusterJobStore::find_request(
+    const std::string& owner, const std::string& request_id) const {
+  const std::string id = job_id_of_request(owner, request_id);
+  auto found = record(id);
+  if (!found.ok()) return std::nullopt;
+  return PriorRequest{id, found->spec().sha256(), 0};
+}
+
+absl::Status ClusterJobStore::erase(const std::string& job_id) const {
+  std::error_code error;
+  fs::remove_all(absl::StrCat(files_.root(), "/jobs/", job_id), error);
+  return cluster_.jobs->erase(job_id);
+}
+
+absl::StatusOr<v1::JobState> ClusterJobStore::remove(const std::string& job_id) {
+  auto found = record(job_id);
+  if (!found.ok()) return found.status();
+  auto removed = cluster_.jobs->remove(job_id);
+  if (!removed.ok()) return removed.status();
+  // A running job's worker removes its files once it stops.
+  if (*removed) {
+    std::error_code error;
+    fs::remove_all(absl::StrCat(files_.root(), "/jobs/", job_id), error);
+  }
+  spdlog::info("job {} deleted by a client", job_id);
+  return found->job().state();
+}
+
+absl::StatusOr<v1::Job> ClusterJobStore::cancel(const std::string& job_id) {
+  auto found = record(job_id);
+  if (!found.ok()) return found.status();
+  auto cancelled = cluster_.jobs->cancel(job_id);
+  if (!cancelled.ok()) return cancelled.status();
+  return with_timestamps(cancelled->job());
+}
+
+absl::StatusOr<std::vector<v1::Artifact>> ClusterJobStore::artifacts(
+    const std::string& job_id) const {
+  auto found = record(job_id);
+  if (!found.ok()) return found.status();
+  if (found->job().state() != v1::JOB_STATE_SUCCEEDED) {
+    return absl::FailedPreconditionError(absl::StrCat("job ", job_id, " has no results: it is ",
+                                                      v1::JobState_Name(found->job().state())));
+  }
+  return std::vector<v1::Artifact>(found->artifacts().begin(), found->artifacts().end());
+}
+
+std::string ClusterJobStore::artifact_path(const v1::Job& job, const std::string& name) const {
+  return absl::StrCat(files_.attempt_dir(job.job_id(), job.attempts()), "/", name);
+}
+
+absl::Status ClusterJobStore::replay_ended(const v1::JobRecord& record, uint64_t from,
+                                           EventListener* listener) {
+  auto follower = cluster_.events->follow(record.job().job_id(), from);
+  if (!follower.ok()) return follower.status();
+  for (;;) {
+    auto next = (*follower)->next(kReplayWait);
+    if (!next.ok()) return next.status();
+    if (!next->has_value()) break;
+    const v1::JobEvent event = watched_event(**next);
+    const bool last = is_last(event);
+    listener->on_event(event, last);
+    if (last) return absl::OkStatus();
+  }
+  // Its end was not logged (a worker died between the two writes) or has
+  // aged out of the log: the record tells it.
+  if (from == 0) {
+    listener->on_event(state_event(record.job(), 0), true);
+  } else {
+    listener->on_closed(absl::OkStatus());
+  }
+  return absl::OkStatus();
+}
+
+absl::Status ClusterJobStore::listen(const std::string& job_id, uint64_t from,
+                                     EventListener* listener) {
+  {
+    std::lock_guard lock(mutex_);
+    if (closed_) return absl::UnavailableError("the server is shutting down");
+  }
+  auto found = record(job_id);
+  if (!found.ok()) return found.status();
+  if (has_ended(found->job().state())) return replay_ended(*found, from, listener);
+  auto subscription =
+      cluster_.events->subscribe(job_id, from, [listener](cluster::LoggedEvent logged) {
+        const v1::JobEvent event = watched_event(logged);
+        listener->on_event(event, is_last(event));
+      });
+  if (!subscription.ok()) return subscription.status();
+  std::lock_guard lock(mutex_);
+  follows_[listener] = std::move(*subscription);
+  return absl::OkStatus();
+}
+
+void ClusterJobStore::unlisten(const std::string&, EventListener* listener) {
+  std::unique_ptr<cluster::EventSubscription> follow;
+  {
+    std::lock_guard lock(mutex_);
+    auto it = follows_.find(listener);
+    if (it == follows_.end()) return;
+    follow = std::move(it->second);
+    follows_.erase(it);
+  }
+  // Destroyed outside the lock: it waits for a callback in progress.
+  follow.reset();
+}
+
+std::vector<std::string> ClusterJobStore::expire(absl::Duration result_ttl, size_t max_ended) {
+  std::vector<std::string> removed;
+  auto ids = cluster_.jobs->job_ids();
+  if (!ids.ok()) return removed;
+  const double cutoff = unix_now() - absl::ToDoubleSeconds(result_ttl);
+  std::vector<std::pair<double, std::string>> ended;
+  for (const auto& id : *ids) {
+    auto found = cluster_.jobs->get(id);
+    if (found.ok() && has_ended(found->job().state()))
+      ended.emplace_back(found->job().finished_at(), id);
+  }
+  std::sort(ended.begin(), ended.end());
+  const size_t over_cap = ended.size() > max_ended ? ended.size() - max_ended : 0;
+  for (size_t i = 0; i < ended.size(); ++i) {
+    const auto& [finished_at, id] = ended[i];
+    if (finished_at >= cutoff && i >= over_cap) continue;
+    if (!erase(id).ok()) continue;
+    spdlog::info("job {} results expired and deleted", id);
+    removed.push_back(id);
+  }
+  return removed;
+}
+
+void ClusterJobStore::close() {
+  std::map<EventListener*, std::unique_ptr<cluster::EventSubscription>> follows;
+  {
+    std::lock_guard lock(mutex_);
+    closed_ = true;
+    follows.swap(follows_);
+  }
+  const absl::Status closing = absl::UnavailableError("the server is shutting down");
+  for (auto& [listener, follow] : follows) {
+    follow.reset();
+    listener->on_closed(closing);
+  }
+}
+
+}  // namespace labelmesh::server

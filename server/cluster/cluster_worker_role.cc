@@ -1,0 +1,201 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+#include "server/cluster/cluster_worker_role.h"
+
+#include <filesystem>
+
+#include "absl/strings/str_cat.h"
+#include "server/durable_file.h"
+#include "server/job_limits.h"
+#include "server/spool.h"
+#include "server/worker_process.h"
+#include "spdlog/spdlog.h"
+
+namespace labelmesh::server {
+namespace fs = std::filesystem;
+namespace {
+
+cluster::JobOutcome failed(int code, const std::string& message) {
+  cluster::JobOutcome outcome;
+  outcome.state = v1::JOB_STATE_FAILED;
+  outcome.result.mutable_job()->mutable_error()->set_code(code);
+  outcome.result.mutable_job()->mutable_error()->set_message(message);
+  return outcome;
+}
+
+cluster::JobOutcome failed(const absl::Status& status) {
+  return failed(static_cast<int>(status.code()), std::string(status.message()));
+}
+
+// An empty directory at `dir`, whatever was there.
+absl::Status fresh_directory(const std::string& dir) {
+  std::error_code error;
+  fs::remove_all(dir, error);
+  fs::create_directories(dir, error);
+  if (error) return spool_io_error(absl::StrCat("cannot create ", dir), error.value());
+  return absl::OkStatus();
+}
+
+absl::StatusOr<uint64_t> free_bytes(const std::string& dir) {
+  std::error_code error;
+  const fs::space_info space = fs::space(dir, error);
+  if (error)
+    return spool_io_error(absl::StrCat("cannot read the free space of ", dir), error.value());
+  return space.available;
+}
+
+}  // namespace
+
+ClusterWorkerRole::ClusterWorkerRole(const ServerConfig& config,
+                                     const cluster::SharedArtifacts& files)
+    : config_(config), files_(files), executable_(worker_executable(config)) {
+  // Heartbeats well inside the ack wait, so that a live worker never loses
+  // its job; cancels are seen within a heartbeat.
+  loop_.heartbeat = std::min(absl::Seconds(5), config.cluster_ack_wait / 4);
+  loop_.poll = absl::Seconds(1);
+}
+
+absl::StatusOr<std::unique_ptr<ClusterWorkerRole>> ClusterWorkerRole::start(
+    const ServerConfig& config, const cluster::ClusterSettings& settings,
+    const cluster::SharedArtifacts& files) {
+  std::unique_ptr<ClusterWorkerRole> role(new ClusterWorkerRole(config, files));
+  for (int i = 0; i < config.workers; ++i) {
+    auto connection = cluster::ClusterConnection::open(settings);
+    if (!connection.ok()) return connection.status();
+    role->connections_.push_back(std::move(*connection));
+  }
+  for (auto& connection : role->connections_) {
+    role->slots_.emplace_back([r = role.get(), c = connection.get()] { r->run_slot(*c); });
+  }
+  return role;
+}
+
+ClusterWorkerRole::~ClusterWorkerRole() { drain(absl::ZeroDuration()); }
+
+void ClusterWorkerRole::run_slot(cluster::ClusterConnection& connection) {
+  cluster::ClusterWorker worker(
+      *connection.queue, *connection.jobs,
+      [this, &connection](const v1::JobRecord& record, const cluster::Claim& claim,
+                          const std::atomic<bool>& cancelled) {
+        {
+          std::lock_guard lock(mutex_);
+          ++busy_;
+        }
+        cluster::JobOutcome outcome = run_job(connection, record, claim, cancelled);
+        std::lock_guard lock(mutex_);
+        --busy_;
+        idle_.notify_all();
+        return outcome;
+      },
+      loop_, [this, &connection](const v1::JobRecord& record) { job_ended(connection, record); });
+  bool failing = false;
+  while (!stopping_.load()) {
+    auto handled = worker.run_one();
+    if (handled.ok() == !failing) {
+      // NATS away (or back): the slot says so once, and health follows.
+      failing = !handled.ok();
+      failing_slots_ += failing ? 1 : -1;
+      if (failing) {
+        spdlog::error("worker slot: {}", std::string(handled.status().message()));
+      } else {
+        spdlog::info("worker slot: the queue answers again");
+      }
+    }
+    if (failing) std::this_thread::sleep_for(std::chrono::seconds(1));
+  }
+  if (failing) --failing_slots_;
+}
+
+cluster::JobOutcome ClusterWorkerRole::run_job(cluster::ClusterConnection& connection,
+                                               const v1::JobRecord& record,
+                                               const cluster::Claim& claim,
+                                               const std::atomic<bool>& cancelled) {
+  const std::string& id = claim.job_id;
+  spdlog::info("job {} started (attempt {})", id, claim.attempt);
+  const std::string out = files_.attempt_dir(id, claim.attempt);
+  if (auto status = fresh_directory(out); !status.ok()) return failed(status);
+  auto room = output_room(free_bytes(files_.root()), config_);
+  if (!room.ok()) return failed(room.status());
+  // The worker program wants its output directory right under the job's.
+  const std::string job_dir = fs::path(out).parent_path().string();
+  WorkerRun run;
+  run.executable = executable_;
+  run.job_dir = job_dir;
+  run.output_dir = out;
+  run.log_path = absl::StrCat(job_dir, "/worker-", claim.attempt, ".log");
+  run.limits = worker_limits(config_, *room);
+  run.deadline = absl::Now() + config_.job_timeout;
+  run.on_event = [&](v1::JobEvent event) {
+    (void)connection.jobs->publish(claim, std::move(event));
+  };
+  run.stop_request = [&] {
+    if (cancelled.load()) return StopRequest::kCancel;
+    if (interrupt_.load()) return StopRequest::kShutdown;
+    return StopRequest::kNone;
+  };
+  WorkerOutcome outcome = run_worker_process(run);
+  cluster::JobOutcome result;
+  switch (outcome.kind) {
+    case WorkerOutcome::Kind::kSucceeded: {
+      auto artifacts = list_artifacts(out);
+      if (artifacts.ok()) artifacts = within_output_limit(std::move(*artifacts), config_);
+      if (!artifacts.ok()) {
+        (void)fresh_directory(out);  // results that cannot be delivered take no space
+        return failed(artifacts.status());
+      }
+      result.state = v1::JOB_STATE_SUCCEEDED;
+      *result.result.mutable_job()->mutable_report() = outcome.report;
+      for (auto& artifact : *artifacts) *result.result.add_artifacts() = std::move(artifact);
+      spdlog::info("job {} succeeded", id);
+      return result;
+    }
+    case WorkerOutcome::Kind::kFailed:
+      (void)fresh_directory(out);
+      // The message may quote the volume's fields; the log keeps the code only.
+      spdlog::warn("job {} failed with status code {}", id, outcome.code);
+      return failed(outcome.code, outcome.message);
+    case WorkerOutcome::Kind::kCancelled:
+      result = failed(static_cast<int>(absl::StatusCode::kCancelled), "cancelled by a client");
+      result.state = v1::JOB_STATE_CANCELLED;
+      spdlog::info("job {} cancelled", id);
+      return result;
+    case WorkerOutcome::Kind::kInterrupted:
+      break;
+  }
+  spdlog::info("job {} interrupted by shutdown; it goes back to the queue", id);
+  result.state = v1::JOB_STATE_QUEUED;
+  return result;
+}
+
+void ClusterWorkerRole::job_ended(cluster::ClusterConnection& connection,
+                                  const v1::JobRecord& record) {
+  const std::string& id = record.job().job_id();
+  const std::string job_dir = absl::StrCat(files_.root(), "/jobs/", id);
+  std::error_code error;
+  if (record.deleted()) {
+    fs::remove_all(job_dir, error);
+    (void)connection.jobs->erase(id);
+    spdlog::info("job {} deleted by a client once it stopped", id);
+    return;
+  }
+  (void)files_.remove_other_attempts(id, record.job().attempts());
+  if (!record.spec().keep_input())
+    fs::remove(absl::StrCat(job_dir, "/input", record.input_extension()), error);
+}
+
+void ClusterWorkerRole::drain(absl::Duration grace) {
+  stopping_ = true;
+  {
+    std::unique_lock lock(mutex_);
+    if (!idle_.wait_for(lock, absl::ToChronoMilliseconds(grace), [this] { return busy_ == 0; })) {
+      spdlog::warn("shutdown: {} jobs still running after the grace period; giving them back",
+                   busy_);
+      interrupt_ = true;
+    }
+  }
+  for (auto& slot : slots_) {
+    if (slot.joinable()) slot.join();
+  }
+  slots_.clear();
+}
+
+}  // namespace labelmesh::server

@@ -1,0 +1,61 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// labelmeshd --role worker: `workers` job slots, each with its own cluster
+// connection, pulling jobs from the shared queue and running each in a
+// labelmesh-worker process under the same limits as on one machine. Inputs
+// and results live in the shared directory, one out-<attempt> per attempt.
+#pragma once
+
+#include <atomic>
+#include <condition_variable>
+#include <memory>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "server/cluster/cluster_connection.h"
+#include "server/cluster/cluster_worker.h"
+#include "server/cluster/shared_artifacts.h"
+#include "server/server_config.h"
+
+namespace labelmesh::server {
+
+class ClusterWorkerRole {
+ public:
+  // Connects every slot and starts pulling. Errors: those of connecting.
+  static absl::StatusOr<std::unique_ptr<ClusterWorkerRole>> start(
+      const ServerConfig& config, const cluster::ClusterSettings& settings,
+      const cluster::SharedArtifacts& files);
+  ~ClusterWorkerRole();
+
+  // False while a slot cannot reach NATS.
+  bool healthy() const { return failing_slots_.load() == 0; }
+  // Takes no more jobs; running ones get `grace` to finish, then are stopped
+  // and given back to the queue for another worker. Joins the slots.
+  void drain(absl::Duration grace);
+
+ private:
+  ClusterWorkerRole(const ServerConfig& config, const cluster::SharedArtifacts& files);
+  void run_slot(cluster::ClusterConnection& connection);
+  cluster::JobOutcome run_job(cluster::ClusterConnection& connection, const v1::JobRecord& record,
+                              const cluster::Claim& claim, const std::atomic<bool>& cancelled);
+  // Once the job's end is recorded: the other attempts' files go, and the
+  // input unless kept; a job deleted while it ran goes whole.
+  void job_ended(cluster::ClusterConnection& connection, const v1::JobRecord& record);
+
+  const ServerConfig& config_;
+  const cluster::SharedArtifacts& files_;
+  std::string executable_;
+  cluster::ClusterWorkerConfig loop_;
+  std::vector<std::unique_ptr<cluster::ClusterConnection>> connections_;
+  std::vector<std::thread> slots_;
+
+  std::atomic<bool> stopping_{false};
+  std::atomic<bool> interrupt_{false};
+  std::atomic<int> failing_slots_{0};
+  std::mutex mutex_;
+  std::condition_variable idle_;
+  int busy_ = 0;
+};
+
+}  // namespace labelmesh::server

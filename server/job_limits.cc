@@ -1,0 +1,51 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+#include "server/job_limits.h"
+
+#include <algorithm>
+#include <thread>
+
+#include "absl/strings/str_cat.h"
+
+namespace labelmesh::server {
+
+absl::StatusOr<uint64_t> output_room(const absl::StatusOr<uint64_t>& free_bytes,
+                                     const ServerConfig& config) {
+  if (!free_bytes.ok()) return free_bytes.status();
+  const uint64_t free = *free_bytes;
+  const uint64_t over_reserve =
+      free > config.spool_reserve_bytes ? free - config.spool_reserve_bytes : 0;
+  if (over_reserve < kLeastOutputRoom) {
+    return absl::ResourceExhaustedError(
+        absl::StrCat("spool disk full: ", free, " bytes free, no room over the reserve of ",
+                     config.spool_reserve_bytes, " bytes for the job's results"));
+  }
+  return config.max_job_output_bytes > 0 ? std::min(config.max_job_output_bytes, over_reserve)
+                                         : over_reserve;
+}
+
+absl::StatusOr<std::vector<v1::Artifact>> within_output_limit(std::vector<v1::Artifact> artifacts,
+                                                              const ServerConfig& config) {
+  uint64_t total = 0;
+  for (const auto& artifact : artifacts) total += artifact.size_bytes();
+  if (config.max_job_output_bytes > 0 && total > config.max_job_output_bytes) {
+    return absl::ResourceExhaustedError(
+        absl::StrCat("the results came to ", total, " bytes, over the job's output limit of ",
+                     config.max_job_output_bytes, " bytes; ask for fewer labels or formats"));
+  }
+  return artifacts;
+}
+
+WorkerLimits worker_limits(const ServerConfig& config, uint64_t output_file_bytes) {
+  WorkerLimits limits;
+  limits.memory_bytes = config.worker_memory_bytes;
+  limits.threads = std::max(
+      1u, std::thread::hardware_concurrency() / static_cast<unsigned>(std::max(config.workers, 1)));
+  limits.cpu_seconds =
+      config.worker_cpu_seconds > 0
+          ? config.worker_cpu_seconds
+          : static_cast<uint64_t>(2 * absl::ToDoubleSeconds(config.job_timeout)) + 1;
+  limits.output_file_bytes = output_file_bytes;
+  return limits;
+}
+
+}  // namespace labelmesh::server

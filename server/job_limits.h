@@ -1,0 +1,35 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// The limits a job runs under, from the server's config: the worker
+// process's memory, CPU time, threads and largest file, and the most its
+// results may come to. The same for a local worker pool and a cluster worker.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "labelmesh/v1/service.pb.h"
+#include "server/server_config.h"
+#include "server/worker_process.h"
+
+namespace labelmesh::server {
+
+// Less room than this over the reserve and a job does not start.
+inline constexpr uint64_t kLeastOutputRoom = uint64_t{1} << 20;
+
+// The largest file a job starting now may write, given the free bytes where
+// it writes: its output limit, or the free space over the reserve if that is
+// less. RESOURCE_EXHAUSTED when under kLeastOutputRoom is left.
+absl::StatusOr<uint64_t> output_room(const absl::StatusOr<uint64_t>& free_bytes,
+                                     const ServerConfig& config);
+
+// The results, or RESOURCE_EXHAUSTED if together they are over the output
+// limit.
+absl::StatusOr<std::vector<v1::Artifact>> within_output_limit(std::vector<v1::Artifact> artifacts,
+                                                              const ServerConfig& config);
+
+// A worker process's limits; each of config.workers jobs meshes on its share
+// of the cores.
+WorkerLimits worker_limits(const ServerConfig& config, uint64_t output_file_bytes);
+
+}  // namespace labelmesh::server
