@@ -19,6 +19,7 @@ packages=(
   # tests that prove our files with tools we did not write
   python3 python3-numpy python3-nibabel python3-meshio python3-grpcio python3-protobuf
   python3-pydicom python3-h5py  # h5py: meshio imports it to read any XDMF
+  python3-yaml  # reads deploy/'s Kubernetes and Compose files in their test
   # finite-element tools that must accept our volume meshes
   calculix-ccx gmsh
   # service tests: TLS certificates
