@@ -38,13 +38,16 @@ absl::StatusOr<bool> ClusterWorker::run_one() {
     return true;
   }
   auto ended = jobs_.finish(*claim, outcome.state, outcome.result);
-  if (ended.status().code() == absl::StatusCode::kAborted) return true;
+  if (ended.status().code() == absl::StatusCode::kAborted) {
+    if (ended_) ended_(*claim, ended);
+    return true;
+  }
   if (ended.status().code() == absl::StatusCode::kNotFound) {
     if (auto status = delivery.ack(); !status.ok()) return status;
     return true;
   }
   if (!ended.ok()) return ended.status();
-  if (ended_) ended_(*ended);
+  if (ended_) ended_(*claim, ended);
   if (auto status = delivery.ack(); !status.ok()) return status;
   return true;
 }

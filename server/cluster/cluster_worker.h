@@ -33,8 +33,10 @@ struct JobOutcome {
 // Runs one attempt; `cancelled` turns true when a client cancels the job.
 using RunJob = std::function<JobOutcome(const v1::JobRecord& record, const Claim& claim,
                                         const std::atomic<bool>& cancelled)>;
-// Told of a job this worker ended, as recorded, before the queue hears.
-using JobEnded = std::function<void(const v1::JobRecord& record)>;
+// Told how a run's end went, before the queue hears: the record as ended,
+// or ABORTED when the job states refused it (another attempt holds the job).
+using JobEnded =
+    std::function<void(const Claim& claim, const absl::StatusOr<v1::JobRecord>& ended)>;
 
 class ClusterWorker {
  public:

@@ -86,11 +86,14 @@ void ClusterWorkerRole::run_slot(cluster::ClusterConnection& connection) {
         idle_.notify_all();
         return outcome;
       },
-      loop_, [this, &connection](const v1::JobRecord& record) { job_ended(connection, record); });
+      loop_,
+      [this, &connection](const cluster::Claim& claim, const absl::StatusOr<v1::JobRecord>& ended) {
+        job_ended(connection, claim, ended);
+      });
   bool failing = false;
   while (!stopping_.load()) {
     auto handled = worker.run_one();
-    if (handled.ok() == !failing) {
+    if (handled.ok() == failing) {
       // NATS away (or back): the slot says so once, and health follows.
       failing = !handled.ok();
       failing_slots_ += failing ? 1 : -1;
@@ -167,10 +170,18 @@ cluster::JobOutcome ClusterWorkerRole::run_job(cluster::ClusterConnection& conne
 }
 
 void ClusterWorkerRole::job_ended(cluster::ClusterConnection& connection,
-                                  const v1::JobRecord& record) {
+                                  const cluster::Claim& claim,
+                                  const absl::StatusOr<v1::JobRecord>& ended) {
+  std::error_code error;
+  if (!ended.ok()) {
+    fs::remove_all(files_.attempt_dir(claim.job_id, claim.attempt), error);
+    spdlog::info("job {} attempt {}: another attempt ended the job; this one's result dropped",
+                 claim.job_id, claim.attempt);
+    return;
+  }
+  const v1::JobRecord& record = *ended;
   const std::string& id = record.job().job_id();
   const std::string job_dir = absl::StrCat(files_.root(), "/jobs/", id);
-  std::error_code error;
   if (record.deleted()) {
     fs::remove_all(job_dir, error);
     (void)connection.jobs->erase(id);

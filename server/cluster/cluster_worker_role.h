@@ -40,8 +40,10 @@ class ClusterWorkerRole {
   cluster::JobOutcome run_job(cluster::ClusterConnection& connection, const v1::JobRecord& record,
                               const cluster::Claim& claim, const std::atomic<bool>& cancelled);
   // Once the job's end is recorded: the other attempts' files go, and the
-  // input unless kept; a job deleted while it ran goes whole.
-  void job_ended(cluster::ClusterConnection& connection, const v1::JobRecord& record);
+  // input unless kept; a job deleted while it ran goes whole. A refused end
+  // takes its own attempt's files with it.
+  void job_ended(cluster::ClusterConnection& connection, const cluster::Claim& claim,
+                 const absl::StatusOr<v1::JobRecord>& ended);
 
   const ServerConfig& config_;
   const cluster::SharedArtifacts& files_;
