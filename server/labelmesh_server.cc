@@ -170,8 +170,12 @@ absl::Status LabelmeshServer::open_cluster() {
 }
 
 void LabelmeshServer::update_health() {
+  auto* health = server_->GetHealthCheckService();
+  // "liveness" answers while the process serves at all; the overall status
+  // ("") says whether it should be sent work.
+  health->SetServingStatus(kLivenessService, true);
   if (cluster_workers_) {
-    server_->GetHealthCheckService()->SetServingStatus(cluster_workers_->healthy());
+    health->SetServingStatus("", cluster_workers_->healthy());
     return;
   }
   auto free = store_->free_bytes();
@@ -186,7 +190,9 @@ void LabelmeshServer::update_health() {
     }
     under_reserve_ = under_reserve;
   }
-  server_->GetHealthCheckService()->SetServingStatus(!under_reserve);
+  // A frontend still serves watches and fetches with the shared disk full
+  // (uploads are refused one by one): it is ready while it reaches NATS.
+  health->SetServingStatus("", cluster_store_ ? cluster_store_->connected() : !under_reserve);
 }
 
 void LabelmeshServer::housekeeping_loop() {
@@ -199,6 +205,9 @@ void LabelmeshServer::housekeeping_loop() {
         audit_->record({.event = "expired", .job_id = id, .identity = "labelmeshd"});
       }
     }
+    // No upload outlives the transfer deadline: older ones were cut off.
+    if (cluster_store_)
+      (void)cluster_store_->remove_abandoned_uploads(2 * config_.transfer_deadline);
     update_health();
   }
 }

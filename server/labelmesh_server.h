@@ -35,6 +35,11 @@ class Metrics;
 class Spool;
 class WorkerPool;
 
+// The grpc.health.v1 service name that answers SERVING for as long as the
+// process serves: for liveness probes, which must not restart a process
+// that is only unready.
+inline constexpr char kLivenessService[] = "liveness";
+
 class LabelmeshServer {
  public:
   // Validates the config, recovers the spool and starts serving.
@@ -57,9 +62,9 @@ class LabelmeshServer {
   absl::Status open_cluster();
   // Every few seconds: deletes expired jobs and updates health.
   void housekeeping_loop();
-  // Health NOT_SERVING while a worker cannot reach the cluster, or (other
-  // roles) while the disk of uploads and results is under its reserve, with
-  // the disk-pressure gauge.
+  // Health NOT_SERVING while a worker or frontend cannot reach the cluster,
+  // or (role all) while the spool's disk is under its reserve; the
+  // disk-pressure gauge.
   void update_health();
 
   ServerConfig config_;

@@ -100,7 +100,21 @@ absl::StatusOr<v1::JobRecord> ClusterJobStore::record(const std::string& job_id)
 absl::StatusOr<v1::Job> ClusterJobStore::get(const std::string& job_id) const {
   auto found = record(job_id);
   if (!found.ok()) return found.status();
-  return with_timestamps(found->job());
+  v1::Job job = found->job();
+  if (job.state() == v1::JOB_STATE_RUNNING) {
+    // The record holds no stage: the newest event tells it.
+    auto last = cluster_.events->last(job_id);
+    v1::JobEvent event;
+    if (last.ok() && last->has_value() && event.ParseFromString(**last)) {
+      if (event.has_stage_started()) job.set_stage(event.stage_started().stage());
+      if (event.has_progress()) {
+        job.set_stage(event.progress().stage());
+        job.set_progress(event.progress().fraction());
+      }
+      if (event.has_stage_finished()) job.set_stage(event.stage_finished().stage());
+    }
+  }
+  return with_timestamps(std::move(job));
 }
 
 absl::StatusOr<std::string> ClusterJobStore::owner(const std::string& job_id) const {
@@ -248,6 +262,19 @@ std::vector<std::string> ClusterJobStore::expire(absl::Duration result_ttl, size
     if (!erase(id).ok()) continue;
     spdlog::info("job {} results expired and deleted", id);
     removed.push_back(id);
+  }
+  return removed;
+}
+
+size_t ClusterJobStore::remove_abandoned_uploads(absl::Duration age) const {
+  const auto cutoff = fs::file_time_type::clock::now() - absl::ToChronoSeconds(age);
+  size_t removed = 0;
+  std::error_code error;
+  for (const auto& entry : fs::directory_iterator(files_.root() + "/uploads", error)) {
+    std::error_code ignored;
+    if (entry.is_regular_file(ignored) && entry.last_write_time(ignored) < cutoff &&
+        fs::remove(entry.path(), ignored))
+      ++removed;
   }
   return removed;
 }

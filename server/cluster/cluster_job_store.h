@@ -53,6 +53,12 @@ class ClusterJobStore final : public JobStore {
   // Any frontend may expire a job; doing it twice is harmless.
   std::vector<std::string> expire(absl::Duration result_ttl, size_t max_ended) override;
 
+  // Deletes uploads older than `age` from the shared uploads/ directory:
+  // those of a frontend that died while receiving them. Returns how many.
+  size_t remove_abandoned_uploads(absl::Duration age) const;
+  // False while this frontend cannot reach NATS.
+  bool connected() const { return cluster_.client->connected(); }
+
   // Closes every follow (UNAVAILABLE); listen() refuses from now on.
   void close();
 

@@ -159,18 +159,7 @@ absl::StatusOr<v1::JobRecord> ClusterJobs::cancel(const std::string& job_id) {
 absl::Status ClusterJobs::publish(const Claim& claim, v1::JobEvent event) {
   event.set_job_id(claim.job_id);
   event.set_time(unix_seconds());
-  if (event.has_stage_started()) {
-    auto recorded = change_record(claim.job_id, [&](v1::JobRecord& r) {
-      if (r.job().state() != v1::JOB_STATE_RUNNING || r.job().attempts() != claim.attempt)
-        return absl::AbortedError("another attempt holds the job");
-      r.mutable_job()->set_stage(event.stage_started().stage());
-      r.mutable_job()->set_progress(0);
-      return absl::OkStatus();
-    });
-    // A stale attempt's events are not logged either.
-    if (!recorded.ok()) return recorded.status();
-  }
-  return events_.append(claim.job_id, event.SerializeAsString()).status();
+  return events_.append_async(claim.job_id, event.SerializeAsString());
 }
 
 absl::StatusOr<bool> ClusterJobs::remove(const std::string& job_id) {

@@ -53,8 +53,9 @@ class ClusterJobs {
   absl::StatusOr<v1::JobRecord> finish(const Claim& claim, v1::JobState state,
                                        const v1::JobRecord& result);
 
-  // A running claim's stage or progress event, logged for watchers; a stage
-  // start is also recorded (fenced by the attempt), for GetJob.
+  // A running claim's stage or progress event, logged for watchers without
+  // waiting for NATS to confirm it (GetJob reads a running job's stage from
+  // its newest event).
   absl::Status publish(const Claim& claim, v1::JobEvent event);
   // A running job is marked deleted and asked to stop: its worker removes
   // it once it ends. Any other is removed at once (record and events);

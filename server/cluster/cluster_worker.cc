@@ -28,7 +28,11 @@ absl::StatusOr<bool> ClusterWorker::run_one() {
     // (NATS away for a moment) only risks a second attempt, which the
     // attempt fencing settles.
     (void)delivery.in_progress();
-    if (auto now = jobs_.get(delivery.job_id()); now.ok() && now->cancel_requested())
+    // A client's cancel, or another attempt that took the job over (this
+    // worker was silent past the ack wait): either way the run stops.
+    auto now = jobs_.get(delivery.job_id());
+    if (now.ok() && (now->cancel_requested() || now->job().attempts() != claim->attempt ||
+                     now->job().state() != v1::JOB_STATE_RUNNING))
       cancelled = true;
   }
   const JobOutcome outcome = running.get();

@@ -91,6 +91,23 @@ absl::StatusOr<uint64_t> EventLog::append(const std::string& job_id, const std::
   return sequence;
 }
 
+absl::Status EventLog::append_async(const std::string& job_id, const std::string& data) {
+  return nats_error(js_PublishAsync(client_.jetstream(), subject(job_id).c_str(), data.data(),
+                                    static_cast<int>(data.size()), nullptr),
+                    absl::StrCat("event of ", job_id));
+}
+
+absl::StatusOr<std::optional<std::string>> EventLog::last(const std::string& job_id) {
+  natsMsg* message = nullptr;
+  const natsStatus status = js_GetLastMsg(&message, client_.jetstream(), config_.stream.c_str(),
+                                          subject(job_id).c_str(), nullptr, nullptr);
+  if (status == NATS_NOT_FOUND) return std::nullopt;
+  if (status != NATS_OK) return nats_error(status, absl::StrCat("last event of ", job_id));
+  std::string data(natsMsg_GetData(message), static_cast<size_t>(natsMsg_GetDataLength(message)));
+  natsMsg_Destroy(message);
+  return std::optional<std::string>(std::move(data));
+}
+
 jsSubOptions EventLog::follow_options(uint64_t from) const {
   jsSubOptions options;
   jsSubOptions_Init(&options);

@@ -70,6 +70,12 @@ class EventLog {
 
   // Appends an event to `job_id`'s; its sequence.
   absl::StatusOr<uint64_t> append(const std::string& job_id, const std::string& data);
+  // Appends without waiting for the server's confirmation: for the many
+  // stage and progress events of a run, which the record does not depend
+  // on. Events of one connection keep their order.
+  absl::Status append_async(const std::string& job_id, const std::string& data);
+  // `job_id`'s newest event; nullopt when it has none.
+  absl::StatusOr<std::optional<std::string>> last(const std::string& job_id);
 
   // Follows `job_id`'s events from sequence `from` on (0: from its first).
   absl::StatusOr<std::unique_ptr<EventFollower>> follow(const std::string& job_id, uint64_t from);

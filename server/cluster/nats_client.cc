@@ -62,6 +62,11 @@ absl::Status add_stream(NatsClient& client, jsStreamConfig& config) {
 }
 
 NatsClient::~NatsClient() {
+  // Events published without waiting go out before the context does.
+  jsPubOptions options;
+  jsPubOptions_Init(&options);
+  options.MaxWait = 2000;
+  js_PublishAsyncComplete(jetstream_, &options);
   jsCtx_Destroy(jetstream_);
   natsConnection_Destroy(connection_);
 }

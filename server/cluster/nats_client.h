@@ -29,6 +29,10 @@ class NatsClient {
   NatsClient& operator=(const NatsClient&) = delete;
 
   natsConnection* connection() const { return connection_; }
+  // False while the client is cut off and reconnecting.
+  bool connected() const {
+    return natsConnection_Status(connection_) == NATS_CONN_STATUS_CONNECTED;
+  }
   jsCtx* jetstream() const { return jetstream_; }
 
  private:

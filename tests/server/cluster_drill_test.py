@@ -121,6 +121,11 @@ def drill_duplicate_request(cluster, pb, options_pb, small):
 def drill_kill_worker(cluster, pb, options_pb, big):
     job_id = submit(pb, options_pb, cluster.stub("frontend-1"), big, volume=True).job_id
     pid = wait_for(lambda: worker_running(job_id), "the job to start")
+    # Any frontend tells a running job's stage, from its newest event.
+    stub = cluster.stub("frontend-2")
+    running = wait_for(lambda: (lambda job: job if job.stage else None)(
+        stub.GetJob(pb.GetJobRequest(job_id=job_id))), "a running job's stage")
+    check(running.state == pb.JOB_STATE_RUNNING, f"GetJob of a running job: {running.state}")
     victim = node_of_pid(cluster, pid)
     check(victim in ("worker-1", "worker-2"), f"job runs under {pid}, not a worker")
     cluster.processes.stop(victim, signal.SIGKILL)
