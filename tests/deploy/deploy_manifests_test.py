@@ -33,8 +33,6 @@ NATS_MONITOR_PORT = 8222
 # What labelmeshd keeps for itself besides its jobs' address space.
 MIN_HEADROOM_BYTES = 512 << 20
 DEFAULT_SHUTDOWN_GRACE = "30s"  # labelmeshd --shutdown-grace
-# Flags of the multi-machine mode, accepted until server/main.cc has them.
-PENDING_ENV = {"LABELMESHD_ROLE", "LABELMESHD_NATS_URL", "LABELMESHD_ARTIFACT_DIR"}
 # Volume types the restricted profile allows.
 RESTRICTED_VOLUMES = {"configMap", "csi", "downwardAPI", "emptyDir", "ephemeral",
                       "persistentVolumeClaim", "projected", "secret"}
@@ -67,8 +65,9 @@ def matches(selector, labels):
 class Checks:
     """Problems found in one set of manifests, as readable lines."""
 
-    def __init__(self, known_env, queue_names):
+    def __init__(self, known_env, queue_names, liveness_service):
         self.known_env = known_env
+        self.liveness_service = liveness_service
         self.queue_names = queue_names
         self.problems = []
 
@@ -219,6 +218,12 @@ class Checks:
             grpc = container.get(probe, {}).get("grpc", {})
             self.require(grpc.get("port") == GRPC_PORT,
                          f"{where}: {probe} is not a grpc probe on {GRPC_PORT}")
+        # Liveness must not follow readiness: it asks the service that
+        # answers while the process serves (kLivenessService).
+        liveness = container.get("livenessProbe", {}).get("grpc", {}).get("service")
+        self.require(liveness == self.liveness_service,
+                     f"{where}: livenessProbe asks service {liveness!r}, not "
+                     f"{self.liveness_service!r}")
         grace = duration_seconds(env.get("LABELMESHD_SHUTDOWN_GRACE") or DEFAULT_SHUTDOWN_GRACE)
         period = workload["spec"]["template"]["spec"].get("terminationGracePeriodSeconds", 30)
         self.require(period > grace, f"{where}: terminationGracePeriodSeconds {period} is not "
@@ -505,11 +510,13 @@ def load_kubernetes(directory):
 def known_env(source):
     """LABELMESHD_* names labelmeshd reads, from server/main.cc."""
     text = (source / "server" / "main.cc").read_text()
-    names = set(re.findall(r'"(LABELMESHD_[A-Z0-9_]+)"', text))
-    pending = PENDING_ENV - names
-    if pending:
-        print(f"note: server/main.cc does not read {sorted(pending)} yet; accepted as pending")
-    return names | PENDING_ENV
+    return set(re.findall(r'"(LABELMESHD_[A-Z0-9_]+)"', text))
+
+
+def liveness_service(source):
+    """The health service name that answers while labelmeshd serves."""
+    text = (source / "server" / "labelmesh_server.h").read_text()
+    return re.search(r'kLivenessService\[\] = "([^"]+)"', text).group(1)
 
 
 def queue_names(source):
@@ -561,6 +568,8 @@ def breakages():
                                                            "3"))),
         ("readiness probe on another port", k8s(lambda d: container(d, "frontend")
          ["readinessProbe"].update(grpc={"port": 50052}))),
+        ("liveness on the overall health", k8s(lambda d: container(d, "worker")
+         ["livenessProbe"].update(grpc={"port": 50051}))),
         ("grace shorter than the shutdown grace", k8s(lambda d: find(d, "Deployment", "worker")
          ["spec"]["template"]["spec"].update(terminationGracePeriodSeconds=100))),
         ("unknown labelmeshd variable", k8s(lambda d: set_env(
@@ -604,7 +613,7 @@ def main():
     directory = source / "deploy" / "kubernetes"
     kustomization, docs, unlisted = load_kubernetes(directory)
     compose = yaml.safe_load((source / "deploy" / "compose.yaml").read_text())
-    checks = Checks(known_env(source), queue_names(source))
+    checks = Checks(known_env(source), queue_names(source), liveness_service(source))
     passed, failed, details = 0, 0, []
 
     def report(what, problems):
