@@ -1,4 +1,3 @@
-# syntax=docker/dockerfile:1
 # SPDX-License-Identifier: AGPL-3.0-or-later
 # labelmesh in a container, in two stages on Debian 12:
 #   build    the compilers and -dev packages of scripts/install-deps.sh (the
@@ -27,14 +26,6 @@ RUN --mount=type=cache,target=/root/.cache/labelmesh-ccache \
  && DESTDIR=/staging cmake --install build/release --prefix /usr/local --strip
 
 FROM ${BASE} AS runtime
-ARG VERSION=0.1.0
-ARG REVISION=unknown
-LABEL org.opencontainers.image.title="labelmesh" \
-      org.opencontainers.image.description="Meshing service for segmented medical label volumes: labelmeshd, labelmesh-worker and the labelmesh client" \
-      org.opencontainers.image.version="${VERSION}" \
-      org.opencontainers.image.revision="${REVISION}" \
-      org.opencontainers.image.licenses="AGPL-3.0-or-later"
-
 COPY scripts/runtime-packages.txt /tmp/runtime-packages.txt
 RUN apt-get update \
  && DEBIAN_FRONTEND=noninteractive apt-get install -y --no-install-recommends \
@@ -57,6 +48,16 @@ RUN missing=$(ldd /usr/local/bin/labelmeshd /usr/local/bin/labelmesh-worker \
       echo "scripts/runtime-packages.txt lacks:$missing" >&2; exit 1; \
     fi \
  && labelmeshd --version && labelmesh-worker --version && labelmesh --version
+
+# Labels last: the build arguments change with every commit, and a RUN step
+# after an ARG would be rebuilt with them.
+ARG VERSION=0.1.0
+ARG REVISION=unknown
+LABEL org.opencontainers.image.title="labelmesh" \
+      org.opencontainers.image.description="Meshing service for segmented medical label volumes: labelmeshd, labelmesh-worker and the labelmesh client" \
+      org.opencontainers.image.version="${VERSION}" \
+      org.opencontainers.image.revision="${REVISION}" \
+      org.opencontainers.image.licenses="AGPL-3.0-or-later"
 
 USER 10001:10001
 WORKDIR /data

@@ -99,7 +99,9 @@ EOF
 }
 
 if $rebuild_base || ! podman image exists "$base"; then
+  start=$(date +%s)
   make_base
+  echo "build-image: base made in $(($(date +%s) - start)) s"
 else
   echo "build-image: reusing $base"
 fi
@@ -112,10 +114,11 @@ revision=$(git rev-parse --short HEAD 2>/dev/null || echo unknown)
 build=("${slow[@]}" podman build --isolation=chroot --format docker --pull=never
   --build-arg BASE="$base" --build-arg VERSION="$version" --build-arg REVISION="$revision")
 start=$(date +%s)
+# The build stage first, tagged to compare its size: the full build then
+# reuses its layers (the other order compiles it a second time).
+"${build[@]}" --target build -t labelmesh-build:latest .
 "${build[@]}" -t "labelmesh:$version" -t labelmesh:latest .
 echo "build-image: built in $(($(date +%s) - start)) s"
-# The build stage from the layer cache, only to compare its size.
-"${build[@]}" --target build -t labelmesh-build:latest . >/dev/null
 
 for image in labelmesh:latest labelmesh-build:latest; do
   bytes=$(podman image inspect --format '{{.Size}}' "$image")
