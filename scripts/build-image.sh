@@ -117,7 +117,11 @@ start=$(date +%s)
 # The build stage first, tagged to compare its size: the full build then
 # reuses its layers (the other order compiles it a second time).
 "${build[@]}" --target build -t labelmesh-build:latest .
-"${build[@]}" -t "labelmesh:$version" -t labelmesh:latest .
+# --label again: podman reuses a cached LABEL step even when the build
+# argument in it changed, so the Dockerfile's revision label would go stale.
+"${build[@]}" -t "labelmesh:$version" -t labelmesh:latest \
+  --label org.opencontainers.image.version="$version" \
+  --label org.opencontainers.image.revision="$revision" .
 echo "build-image: built in $(($(date +%s) - start)) s"
 
 for image in labelmesh:latest labelmesh-build:latest; do
