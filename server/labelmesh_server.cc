@@ -164,7 +164,11 @@ absl::Status LabelmeshServer::open_cluster() {
   auto connection = cluster::ClusterConnection::open(settings);
   if (!connection.ok()) return connection.status();
   cluster_ = std::move(*connection);
-  cluster_store_ = std::make_unique<ClusterJobStore>(*cluster_, *files_, c.queue_capacity);
+  // Every run ends within the job timeout; a job RUNNING well past it (and
+  // past the ack waits of its redeliveries) has lost its workers.
+  const absl::Duration abandoned_after = c.job_timeout + 2 * c.cluster_ack_wait + absl::Minutes(1);
+  cluster_store_ =
+      std::make_unique<ClusterJobStore>(*cluster_, *files_, c.queue_capacity, abandoned_after);
   store_ = cluster_store_.get();
   return absl::OkStatus();
 }
@@ -200,15 +204,20 @@ void LabelmeshServer::housekeeping_loop() {
       std::min(absl::ToChronoMilliseconds(config_.result_ttl), std::chrono::milliseconds(2'000));
   std::unique_lock lock(mutex_);
   while (!stopping_.wait_for(lock, period, [this] { return stopped_; })) {
+    // Unlocked: a cluster's calls may wait on NATS, and shutdown must not.
+    lock.unlock();
     if (store_ != nullptr) {
       for (const auto& id : store_->expire(config_.result_ttl, size_t(config_.max_ended_jobs))) {
         audit_->record({.event = "expired", .job_id = id, .identity = "labelmeshd"});
       }
     }
-    // No upload outlives the transfer deadline: older ones were cut off.
-    if (cluster_store_)
+    if (cluster_store_) {
+      cluster_store_->check_follows();
+      // No upload outlives the transfer deadline: older ones were cut off.
       (void)cluster_store_->remove_abandoned_uploads(2 * config_.transfer_deadline);
+    }
     update_health();
+    lock.lock();
   }
 }
 

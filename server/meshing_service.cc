@@ -139,6 +139,9 @@ grpc::Status MeshingService::authorize(const ClientIdentity& identity,
                                        const std::string& job_id) const {
   if (auto status = check_job_id(job_id); !status.ok()) return status;
   auto owner = store_.owner(job_id);
+  // The store unreachable is not "no such job".
+  if (!owner.ok() && owner.status().code() != absl::StatusCode::kNotFound)
+    return to_grpc(owner.status());
   if (!owner.ok() || (!identity.admin && *owner != identity.name)) {
     return grpc::Status(grpc::StatusCode::NOT_FOUND, absl::StrCat("no job ", job_id));
   }

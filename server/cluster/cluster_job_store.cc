@@ -16,6 +16,9 @@ namespace {
 
 // Longest an ended job's replay waits for an event it knows is logged.
 constexpr absl::Duration kReplayWait = absl::Milliseconds(500);
+// How long a follow waits for the last event of a job whose record has
+// ended before the record stands in for it.
+constexpr absl::Duration kLastEventWait = absl::Seconds(5);
 
 bool is_last(const v1::JobEvent& event) {
   return event.has_finished() || event.has_failed() || event.has_cancelled();
@@ -67,11 +70,17 @@ absl::StatusOr<uint32_t> ClusterJobStore::accept(v1::JobRecord record,
                                                  const std::string& upload_path) {
   const std::string id = record.job().job_id();
   std::error_code error;
-  if (cluster_.jobs->get(id).ok()) {
+  auto existing = cluster_.jobs->get(id);
+  if (existing.ok()) {
     // A retry that raced its first try here: the job exists already.
     fs::remove(upload_path, error);
+    if (existing->deleted()) {
+      return absl::AbortedError(
+          "the job of this request_id is being deleted; retry once it is gone");
+    }
     return 0;
   }
+  if (existing.status().code() != absl::StatusCode::kNotFound) return existing.status();
   record.mutable_job()->set_state(v1::JOB_STATE_QUEUED);
   const std::string dir = absl::StrCat("jobs/", id);
   if (auto status = files_.put(dir + "/job.pb", record.SerializeAsString()); !status.ok())
@@ -81,7 +90,9 @@ absl::StatusOr<uint32_t> ClusterJobStore::accept(v1::JobRecord record,
   if (error) return spool_io_error("cannot move the upload into its job", error.value());
   auto submitted = cluster_.jobs->submit(std::move(record));
   if (!submitted.ok()) {
-    (void)erase(id);
+    // Its files go unless another frontend recorded the job meanwhile.
+    if (cluster_.jobs->get(id).status().code() == absl::StatusCode::kNotFound)
+      fs::remove_all(absl::StrCat(files_.root(), "/", dir), error);
     return submitted.status();
   }
   spdlog::info("job {} queued", id);
@@ -129,7 +140,8 @@ absl::StatusOr<JobStore::JobPage> ClusterJobStore::list(const JobQuery& query) c
   std::vector<v1::Job> jobs;
   for (const auto& id : *ids) {
     auto found = record(id);
-    if (!found.ok()) continue;  // deleted meanwhile
+    if (found.status().code() == absl::StatusCode::kNotFound) continue;  // deleted meanwhile
+    if (!found.ok()) return found.status();
     if (!query.owner.empty() && found->job().owner() != query.owner) continue;
     jobs.push_back(with_timestamps(found->job()));
   }
@@ -219,28 +231,90 @@ absl::Status ClusterJobStore::listen(const std::string& job_id, uint64_t from,
   auto found = record(job_id);
   if (!found.ok()) return found.status();
   if (has_ended(found->job().state())) return replay_ended(*found, from, listener);
+  auto heard_last = std::make_shared<std::atomic<bool>>(false);
   auto subscription =
-      cluster_.events->subscribe(job_id, from, [listener](cluster::LoggedEvent logged) {
+      cluster_.events->subscribe(job_id, from, [listener, heard_last](cluster::LoggedEvent logged) {
         const v1::JobEvent event = watched_event(logged);
-        listener->on_event(event, is_last(event));
+        const bool last = is_last(event);
+        listener->on_event(event, last);
+        if (last) *heard_last = true;
       });
   if (!subscription.ok()) return subscription.status();
-  std::lock_guard lock(mutex_);
-  follows_[listener] = std::move(*subscription);
+  std::unique_lock lock(mutex_);
+  if (closed_) {
+    lock.unlock();
+    subscription->reset();
+    return absl::UnavailableError("the server is shutting down");
+  }
+  follows_[listener] = Follow{job_id, std::move(*subscription), heard_last};
   return absl::OkStatus();
 }
 
 void ClusterJobStore::unlisten(const std::string&, EventListener* listener) {
-  std::unique_ptr<cluster::EventSubscription> follow;
+  Follow follow;
   {
-    std::lock_guard lock(mutex_);
+    std::unique_lock lock(mutex_);
+    // A listener being told its end is not gone until it has been told.
+    ended_.wait(lock, [&] { return !ending_.contains(listener); });
     auto it = follows_.find(listener);
     if (it == follows_.end()) return;
     follow = std::move(it->second);
     follows_.erase(it);
   }
   // Destroyed outside the lock: it waits for a callback in progress.
-  follow.reset();
+  follow.subscription.reset();
+}
+
+void ClusterJobStore::end_follows(std::vector<Ending> endings) {
+  for (auto& ending : endings) {
+    ending.follow.subscription.reset();  // no event after this
+    if (ending.last_event && !*ending.follow.heard_last) {
+      ending.listener->on_event(*ending.last_event, true);
+    } else if (!ending.last_event) {
+      ending.listener->on_closed(ending.status);
+    }
+  }
+  std::lock_guard lock(mutex_);
+  for (const auto& ending : endings) ending_.erase(ending.listener);
+  ended_.notify_all();
+}
+
+void ClusterJobStore::check_follows() {
+  // Job ids read under the lock, records without it (NATS calls).
+  std::vector<std::pair<EventListener*, std::string>> watched;
+  {
+    std::lock_guard lock(mutex_);
+    for (const auto& [listener, follow] : follows_) {
+      if (!*follow.heard_last) watched.emplace_back(listener, follow.job_id);
+    }
+  }
+  std::map<EventListener*, absl::StatusOr<v1::JobRecord>> records;
+  for (const auto& [listener, job_id] : watched) records.emplace(listener, record(job_id));
+  const double now = unix_now();
+  std::vector<Ending> endings;
+  {
+    std::lock_guard lock(mutex_);
+    for (auto& [listener, found] : records) {
+      auto it = follows_.find(listener);
+      if (it == follows_.end() || *it->second.heard_last) continue;
+      Follow& follow = it->second;
+      std::optional<v1::JobEvent> last_event;
+      absl::Status status;
+      if (found.status().code() == absl::StatusCode::kNotFound) {
+        status = absl::NotFoundError(absl::StrCat("job ", follow.job_id, " was deleted"));
+      } else if (found.ok() && has_ended(found->job().state())) {
+        if (follow.ended_seen == 0) follow.ended_seen = now;
+        if (now - follow.ended_seen < absl::ToDoubleSeconds(kLastEventWait)) continue;
+        last_event = state_event(found->job(), 0);
+      } else {
+        continue;
+      }
+      ending_.insert(listener);
+      endings.push_back({listener, std::move(follow), status, std::move(last_event)});
+      follows_.erase(it);
+    }
+  }
+  end_follows(std::move(endings));
 }
 
 std::vector<std::string> ClusterJobStore::expire(absl::Duration result_ttl, size_t max_ended) {
@@ -248,11 +322,16 @@ std::vector<std::string> ClusterJobStore::expire(absl::Duration result_ttl, size
   auto ids = cluster_.jobs->job_ids();
   if (!ids.ok()) return removed;
   const double cutoff = unix_now() - absl::ToDoubleSeconds(result_ttl);
+  const double abandoned = unix_now() - absl::ToDoubleSeconds(abandoned_after_);
   std::vector<std::pair<double, std::string>> ended;
   for (const auto& id : *ids) {
     auto found = cluster_.jobs->get(id);
-    if (found.ok() && has_ended(found->job().state()))
-      ended.emplace_back(found->job().finished_at(), id);
+    if (!found.ok()) continue;
+    if (has_ended(found->job().state())) ended.emplace_back(found->job().finished_at(), id);
+    if (found->job().state() == v1::JOB_STATE_RUNNING && found->job().started_at() < abandoned) {
+      if (auto gave_up = cluster_.jobs->give_up(id, abandoned); gave_up.ok() && *gave_up)
+        spdlog::warn("job {} lost its workers past the job timeout: failed", id);
+    }
   }
   std::sort(ended.begin(), ended.end());
   const size_t over_cap = ended.size() > max_ended ? ended.size() - max_ended : 0;
@@ -280,17 +359,18 @@ size_t ClusterJobStore::remove_abandoned_uploads(absl::Duration age) const {
 }
 
 void ClusterJobStore::close() {
-  std::map<EventListener*, std::unique_ptr<cluster::EventSubscription>> follows;
+  std::vector<Ending> endings;
   {
     std::lock_guard lock(mutex_);
     closed_ = true;
-    follows.swap(follows_);
+    const absl::Status closing = absl::UnavailableError("the server is shutting down");
+    for (auto& [listener, follow] : follows_) {
+      ending_.insert(listener);
+      endings.push_back({listener, std::move(follow), closing, std::nullopt});
+    }
+    follows_.clear();
   }
-  const absl::Status closing = absl::UnavailableError("the server is shutting down");
-  for (auto& [listener, follow] : follows) {
-    follow.reset();
-    listener->on_closed(closing);
-  }
+  end_follows(std::move(endings));
 }
 
 }  // namespace labelmesh::server

@@ -5,9 +5,13 @@
 // for any job, and one that dies loses nothing.
 #pragma once
 
+#include <atomic>
+#include <condition_variable>
 #include <map>
 #include <memory>
 #include <mutex>
+#include <optional>
+#include <set>
 #include <string>
 
 #include "server/cluster/cluster_connection.h"
@@ -18,9 +22,14 @@ namespace labelmesh::server {
 
 class ClusterJobStore final : public JobStore {
  public:
+  // A job RUNNING for longer than `abandoned_after` has lost its workers
+  // (every run ends within the job timeout): expire() fails it.
   ClusterJobStore(cluster::ClusterConnection& cluster, const cluster::SharedArtifacts& files,
-                  int queue_capacity)
-      : cluster_(cluster), files_(files), queue_capacity_(static_cast<uint64_t>(queue_capacity)) {}
+                  int queue_capacity, absl::Duration abandoned_after)
+      : cluster_(cluster),
+        files_(files),
+        queue_capacity_(static_cast<uint64_t>(queue_capacity)),
+        abandoned_after_(abandoned_after) {}
   ~ClusterJobStore() override { close(); }
 
   // A retried Submit (same owner and request_id) gets the same id on any
@@ -50,8 +59,14 @@ class ClusterJobStore final : public JobStore {
   // client's thread.
   absl::Status listen(const std::string& job_id, uint64_t from, EventListener* listener) override;
   void unlisten(const std::string& job_id, EventListener* listener) override;
-  // Any frontend may expire a job; doing it twice is harmless.
+  // Any frontend may expire a job; doing it twice is harmless. Also fails
+  // jobs RUNNING past `abandoned_after`.
   std::vector<std::string> expire(absl::Duration result_ttl, size_t max_ended) override;
+  // Ends the follows the event log alone would leave waiting: of a job
+  // deleted meanwhile (NOT_FOUND), and of a job whose record has ended
+  // while its last event has not come for a few seconds (the record tells
+  // it). For the housekeeping loop.
+  void check_follows();
 
   // Deletes uploads older than `age` from the shared uploads/ directory:
   // those of a frontend that died while receiving them. Returns how many.
@@ -71,13 +86,36 @@ class ClusterJobStore final : public JobStore {
   // Removes the job's record, events and files.
   absl::Status erase(const std::string& job_id) const;
 
+  struct Follow {
+    std::string job_id;
+    std::unique_ptr<cluster::EventSubscription> subscription;
+    // Set once the listener was handed the job's last event.
+    std::shared_ptr<std::atomic<bool>> heard_last;
+    // When a check first found the job's record ended, else 0.
+    double ended_seen = 0;
+  };
+  // What to tell a listener whose follow the store ends itself.
+  struct Ending {
+    EventListener* listener;
+    Follow follow;
+    absl::Status status;
+    std::optional<v1::JobEvent> last_event;
+  };
+  // Stops the follows (outside the lock), tells their listeners, and lets
+  // their unlisten calls, which wait meanwhile, go on.
+  void end_follows(std::vector<Ending> endings);
+
   cluster::ClusterConnection& cluster_;
   const cluster::SharedArtifacts& files_;
   const uint64_t queue_capacity_;
+  const absl::Duration abandoned_after_;
 
   std::mutex mutex_;
   bool closed_ = false;
-  std::map<EventListener*, std::unique_ptr<cluster::EventSubscription>> follows_;
+  std::map<EventListener*, Follow> follows_;
+  // Listeners being told their follow ended; unlisten waits for them.
+  std::set<EventListener*> ending_;
+  std::condition_variable ended_;
 };
 
 // The event a logged one is to a watcher: its sequence is its place in the

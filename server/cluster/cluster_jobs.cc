@@ -21,6 +21,19 @@ absl::StatusOr<v1::JobRecord> parse(const Versioned& stored, const std::string& 
 
 double unix_seconds() { return absl::ToDoubleSeconds(absl::Now() - absl::UnixEpoch()); }
 
+// Which making of a job a queue message is for: its creation time in
+// microseconds. A job made again under the same id (a client's request id
+// reused after a delete) is queued again, and the old message is not taken
+// for it.
+std::string made(const v1::JobRecord& record) {
+  return absl::StrCat(static_cast<int64_t>(record.job().created_at() * 1e6));
+}
+
+// What the queue's duplicate window knows a job's message by.
+std::string queue_key(const v1::JobRecord& record) {
+  return absl::StrCat(record.job().job_id(), ":", made(record));
+}
+
 }  // namespace
 
 absl::Status ClusterJobs::log_state(const v1::JobRecord& record) {
@@ -76,11 +89,21 @@ absl::StatusOr<v1::JobRecord> ClusterJobs::submit(v1::JobRecord record) {
     // A retried submit: the job is recorded; queueing it again is harmless
     // (the queue's duplicate window drops it) and covers a submit that died
     // between the two steps.
-    if (auto queued = queue_.enqueue(job_id); !queued.ok()) return queued.status();
-    return get(job_id);
+    auto recorded = get(job_id);
+    if (!recorded.ok()) return recorded.status();
+    if (recorded->job().state() == v1::JOB_STATE_QUEUED) {
+      auto queued = queue_.enqueue(job_id, queue_key(*recorded), made(*recorded));
+      if (!queued.ok()) return queued.status();
+    }
+    return recorded;
   }
   if (!created.ok()) return created.status();
-  if (auto queued = queue_.enqueue(job_id); !queued.ok()) return queued.status();
+  if (auto queued = queue_.enqueue(job_id, queue_key(record), made(record)); !queued.ok()) {
+    // Recorded but not queued: nobody would run it. The client hears the
+    // error and retries.
+    (void)states_.remove(job_id);
+    return queued.status();
+  }
   if (auto status = log_state(record); !status.ok()) return status;
   return record;
 }
@@ -91,11 +114,15 @@ absl::StatusOr<v1::JobRecord> ClusterJobs::get(const std::string& job_id) {
   return parse(*stored, job_id);
 }
 
-absl::StatusOr<Claim> ClusterJobs::claim(const std::string& job_id) {
+absl::StatusOr<Claim> ClusterJobs::claim(const std::string& job_id, const std::string& made_as) {
   Claim claim{job_id, 0, {}};
   auto record = change_record(job_id, [&](v1::JobRecord& r) {
     if (ended(r.job().state())) {
       return absl::FailedPreconditionError(absl::StrCat("job ", job_id, " has ended"));
+    }
+    if (!made_as.empty() && made_as != made(r)) {
+      return absl::FailedPreconditionError(
+          absl::StrCat("the message is for an earlier job ", job_id, ", since deleted"));
     }
     r.mutable_job()->set_state(v1::JOB_STATE_RUNNING);
     r.mutable_job()->set_attempts(r.job().attempts() + 1);
@@ -181,6 +208,35 @@ absl::StatusOr<bool> ClusterJobs::remove(const std::string& job_id) {
 absl::Status ClusterJobs::erase(const std::string& job_id) {
   if (auto status = states_.remove(job_id); !status.ok()) return status;
   return events_.remove(job_id);
+}
+
+absl::Status ClusterJobs::requeue(const Claim& claim) {
+  return queue_
+      .enqueue(claim.job_id, absl::StrCat(queue_key(claim.record), "@", claim.attempt),
+               made(claim.record))
+      .status();
+}
+
+absl::StatusOr<bool> ClusterJobs::give_up(const std::string& job_id, double started_before) {
+  bool gave_up = false;
+  auto record = change_record(job_id, [&](v1::JobRecord& r) {
+    gave_up = r.job().state() == v1::JOB_STATE_RUNNING && r.job().started_at() < started_before;
+    if (!gave_up) return absl::OkStatus();
+    auto* job = r.mutable_job();
+    job->set_state(v1::JOB_STATE_FAILED);
+    job->set_finished_at(unix_seconds());
+    job->clear_stage();
+    job->mutable_error()->set_code(static_cast<int>(absl::StatusCode::kDeadlineExceeded));
+    job->mutable_error()->set_message(absl::StrCat("the job's workers stopped answering (attempt ",
+                                                   job->attempts(),
+                                                   "): given up past the job timeout"));
+    return absl::OkStatus();
+  });
+  if (!record.ok()) return record.status();
+  if (gave_up) {
+    if (auto status = log_state(*record); !status.ok()) return status;
+  }
+  return gave_up;
 }
 
 }  // namespace labelmesh::cluster

@@ -42,9 +42,11 @@ class ClusterJobs {
 
   // Starts the next attempt of a delivered job: QUEUED, or RUNNING under a
   // worker the queue gave up on, becomes RUNNING with one more attempt.
-  // Errors: FAILED_PRECONDITION when the job has ended (the delivery is
-  // done with); NOT_FOUND.
-  absl::StatusOr<Claim> claim(const std::string& job_id);
+  // `made_as` is the delivery's JobDelivery::made (empty: not checked).
+  // Errors: FAILED_PRECONDITION when the job has ended, or when the
+  // delivery was for an earlier job of the same id (the delivery is done
+  // with either way); NOT_FOUND.
+  absl::StatusOr<Claim> claim(const std::string& job_id, const std::string& made_as = "");
 
   // Ends a claimed job in `state` (SUCCEEDED, FAILED or CANCELLED) with
   // `result` filling the record's report, artifacts or error, and logs it.
@@ -63,6 +65,14 @@ class ClusterJobs {
   absl::StatusOr<bool> remove(const std::string& job_id);
   // The record and events of `job_id`, whatever its state.
   absl::Status erase(const std::string& job_id);
+  // Puts a claimed job back in the queue under a key of its own, for a
+  // worker that stops before the job ends (a redelivery would count
+  // towards the queue's most deliveries).
+  absl::Status requeue(const Claim& claim);
+  // A job RUNNING since before `started_before` (seconds since 1970): its
+  // workers died, or the queue stopped delivering it, past any run's
+  // timeout. It ends FAILED (DEADLINE_EXCEEDED); true when it did.
+  absl::StatusOr<bool> give_up(const std::string& job_id, double started_before);
   // Every job id recorded.
   absl::StatusOr<std::vector<std::string>> job_ids() { return states_.keys(); }
 

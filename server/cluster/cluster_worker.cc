@@ -10,7 +10,7 @@ absl::StatusOr<bool> ClusterWorker::run_one() {
   if (!taken.ok()) return taken.status();
   if (!taken->has_value()) return false;
   JobDelivery& delivery = **taken;
-  auto claim = jobs_.claim(delivery.job_id());
+  auto claim = jobs_.claim(delivery.job_id(), delivery.made());
   if (claim.status().code() == absl::StatusCode::kFailedPrecondition ||
       claim.status().code() == absl::StatusCode::kNotFound) {
     // Ended, or deleted: nothing to run, and nothing to deliver again.
@@ -37,8 +37,10 @@ absl::StatusOr<bool> ClusterWorker::run_one() {
   }
   const JobOutcome outcome = running.get();
   if (outcome.state == v1::JOB_STATE_QUEUED) {
-    // This worker is stopping: the next one takes the job at once.
-    if (auto status = delivery.nak(); !status.ok()) return status;
+    // This worker is stopping: the next one takes the job at once, without
+    // it counting as a failed delivery.
+    if (auto status = jobs_.requeue(*claim); !status.ok()) return status;
+    if (auto status = delivery.ack(); !status.ok()) return status;
     return true;
   }
   auto ended = jobs_.finish(*claim, outcome.state, outcome.result);

@@ -200,9 +200,10 @@ void ClusterWorkerRole::drain(absl::Duration grace) {
     if (!idle_.wait_for(lock, absl::ToChronoMilliseconds(grace), [this] { return busy_ == 0; })) {
       spdlog::warn("shutdown: {} jobs still running after the grace period; giving them back",
                    busy_);
-      interrupt_ = true;
     }
   }
+  // Also for a job a slot took just as the grace ended.
+  interrupt_ = true;
   for (auto& slot : slots_) {
     if (slot.joinable()) slot.join();
   }

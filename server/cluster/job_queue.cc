@@ -8,7 +8,10 @@ namespace labelmesh::cluster {
 JobDelivery::~JobDelivery() { natsMsg_Destroy(message_); }
 
 JobDelivery::JobDelivery(JobDelivery&& other) noexcept
-    : message_(other.message_), job_id_(std::move(other.job_id_)), delivered_(other.delivered_) {
+    : message_(other.message_),
+      job_id_(std::move(other.job_id_)),
+      made_(std::move(other.made_)),
+      delivered_(other.delivered_) {
   other.message_ = nullptr;
 }
 
@@ -70,14 +73,17 @@ absl::StatusOr<std::unique_ptr<JobQueue>> JobQueue::open(NatsClient& client,
 
 JobQueue::~JobQueue() { natsSubscription_Destroy(subscription_); }
 
-absl::StatusOr<bool> JobQueue::enqueue(const std::string& job_id) {
+absl::StatusOr<bool> JobQueue::enqueue(const std::string& job_id, const std::string& dedupe_key,
+                                       const std::string& made) {
   jsPubOptions options;
   jsPubOptions_Init(&options);
-  options.MsgId = job_id.c_str();
+  options.MsgId = dedupe_key.empty() ? job_id.c_str() : dedupe_key.c_str();
+  // The message is "<job id>" or "<job id>:<made>".
+  const std::string data = made.empty() ? job_id : absl::StrCat(job_id, ":", made);
   jsPubAck* ack = nullptr;
   const natsStatus status =
-      js_Publish(&ack, client_.jetstream(), config_.subject.c_str(), job_id.data(),
-                 static_cast<int>(job_id.size()), &options, nullptr);
+      js_Publish(&ack, client_.jetstream(), config_.subject.c_str(), data.data(),
+                 static_cast<int>(data.size()), &options, nullptr);
   if (status != NATS_OK) return nats_error(status, absl::StrCat("queueing ", job_id));
   const bool fresh = !ack->Duplicate;
   jsPubAck_Destroy(ack);
@@ -102,8 +108,13 @@ absl::StatusOr<std::optional<JobDelivery>> JobQueue::take(absl::Duration wait) {
     delivered = meta->NumDelivered;
     jsMsgMetaData_Destroy(meta);
   }
-  std::string job_id(natsMsg_GetData(message), static_cast<size_t>(natsMsg_GetDataLength(message)));
-  return std::optional<JobDelivery>(std::in_place, message, std::move(job_id), delivered);
+  const std::string data(natsMsg_GetData(message),
+                         static_cast<size_t>(natsMsg_GetDataLength(message)));
+  const size_t colon = data.find(':');
+  std::string job_id = data.substr(0, colon);
+  std::string made = colon == std::string::npos ? "" : data.substr(colon + 1);
+  return std::optional<JobDelivery>(std::in_place, message, std::move(job_id), std::move(made),
+                                    delivered);
 }
 
 absl::StatusOr<uint64_t> JobQueue::stored() {

@@ -31,14 +31,21 @@ struct JobQueueConfig {
 // One job handed to this worker; exactly one of ack, nak and term ends it.
 class JobDelivery {
  public:
-  JobDelivery(natsMsg* message, std::string job_id, uint64_t delivered)
-      : message_(message), job_id_(std::move(job_id)), delivered_(delivered) {}
+  JobDelivery(natsMsg* message, std::string job_id, std::string made, uint64_t delivered)
+      : message_(message),
+        job_id_(std::move(job_id)),
+        made_(std::move(made)),
+        delivered_(delivered) {}
   ~JobDelivery();
   JobDelivery(JobDelivery&& other) noexcept;
   JobDelivery& operator=(JobDelivery&&) = delete;
   JobDelivery(const JobDelivery&) = delete;
 
   const std::string& job_id() const { return job_id_; }
+  // Which making of the job this message was queued for (as enqueue was
+  // told), so that a message left from a deleted job is not taken for a new
+  // job under the same id; empty when not told.
+  const std::string& made() const { return made_; }
   // 1 the first time this job was handed out, more after redeliveries.
   uint64_t delivered() const { return delivered_; }
 
@@ -55,6 +62,7 @@ class JobDelivery {
  private:
   natsMsg* message_;
   std::string job_id_;
+  std::string made_;
   uint64_t delivered_;
 };
 
@@ -69,9 +77,11 @@ class JobQueue {
   JobQueue(const JobQueue&) = delete;
   JobQueue& operator=(const JobQueue&) = delete;
 
-  // Queues `job_id`; false when it was already queued within the duplicate
-  // window (the queue holds it once).
-  absl::StatusOr<bool> enqueue(const std::string& job_id);
+  // Queues `job_id` (made as `made`, see JobDelivery::made); false when
+  // `dedupe_key` (empty: the job id) was already queued within the
+  // duplicate window (the queue holds it once).
+  absl::StatusOr<bool> enqueue(const std::string& job_id, const std::string& dedupe_key = "",
+                               const std::string& made = "");
 
   // The next job, waiting at most `wait`; nullopt when none came.
   absl::StatusOr<std::optional<JobDelivery>> take(absl::Duration wait);

@@ -38,6 +38,9 @@ absl::StatusOr<std::unique_ptr<NatsClient>> NatsClient::connect(const std::strin
     status = natsOptions_SetTimeout(options, absl::ToInt64Milliseconds(timeout));
   // Reconnect for ever: a restarted NATS server keeps the streams on disk.
   if (status == NATS_OK) status = natsOptions_SetMaxReconnect(options, -1);
+  // Followers of job events share the client's delivery threads rather
+  // than each having one of its own.
+  if (status == NATS_OK) status = natsOptions_UseGlobalMessageDelivery(options, true);
   if (status == NATS_OK) status = natsOptions_SetReconnectWait(options, 200);
   natsConnection* connection = nullptr;
   if (status == NATS_OK) status = natsConnection_Connect(&connection, options);

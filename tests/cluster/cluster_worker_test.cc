@@ -112,5 +112,32 @@ TEST(ClusterWorker, AFailedRunEndsTheJobFailedAndARetriedSubmitDoesNotRunItAgain
   EXPECT_EQ(frontend.queue->stored().value(), 0u);
 }
 
+TEST(ClusterWorker, AJobGivenBackAtShutdownIsNotCountedAsAFailedDelivery) {
+  testing::NatsServer server(testing::scratch_dir("give-back"));
+  Node frontend(server), worker_node(server);
+  ASSERT_TRUE(frontend.jobs->submit(new_job("interrupted")).ok());
+  // The queue stops a job after max_deliver (3) deliveries: four stops in a
+  // row must not lose it.
+  auto stop = [](const v1::JobRecord&, const Claim&, const std::atomic<bool>&) {
+    return JobOutcome{v1::JOB_STATE_QUEUED, {}};
+  };
+  for (int i = 0; i < 4; ++i) {
+    ClusterWorker stopping(*worker_node.queue, *worker_node.jobs, stop, kQuick);
+    ASSERT_EQ(stopping.run_one().value(), true) << "stop " << i;
+  }
+  uint64_t delivered = 0;
+  ClusterWorker worker(
+      *worker_node.queue, *worker_node.jobs,
+      [&](const v1::JobRecord&, const Claim& claim, const std::atomic<bool>&) {
+        delivered = claim.attempt;
+        return JobOutcome{v1::JOB_STATE_SUCCEEDED, {}};
+      },
+      kQuick);
+  ASSERT_EQ(worker.run_one().value(), true);
+  EXPECT_EQ(delivered, 5u);  // the fifth attempt, on a fresh message
+  EXPECT_EQ(frontend.jobs->get("interrupted").value().job().state(), v1::JOB_STATE_SUCCEEDED);
+  EXPECT_EQ(frontend.queue->stored().value(), 0u);
+}
+
 }  // namespace
 }  // namespace labelmesh::cluster

@@ -63,7 +63,7 @@ class ClusterRolesTest : public ::testing::Test {
     connection_ = std::move(cluster::ClusterConnection::open(settings).value());
     files_ = std::make_unique<cluster::SharedArtifacts>(
         cluster::SharedArtifacts::open((dir_ / "artifacts").string()).value());
-    store_ = std::make_unique<ClusterJobStore>(*connection_, *files_, 8);
+    store_ = std::make_unique<ClusterJobStore>(*connection_, *files_, 8, absl::Hours(1));
   }
 
   // A job accepted by the store from an upload of `bytes`.
@@ -114,7 +114,7 @@ TEST_F(ClusterRolesTest, ARetriedRequestIsOneJobOnAnyFrontend) {
   EXPECT_FALSE(store_->find_request("bob", "r1").has_value());
   // A second frontend that received the same request at once: its upload
   // goes, the job stays as the first one made it.
-  ClusterJobStore other(*connection_, *files_, 8);
+  ClusterJobStore other(*connection_, *files_, 8, absl::Hours(1));
   const std::string upload = other.upload_path(id, ".nii.gz");
   std::ofstream(upload) << "volume bytes";
   v1::JobRecord again;
@@ -209,6 +209,79 @@ TEST_F(ClusterRolesTest, ExpiryRemovesEndedJobsWithTheirFilesAndKeepsTheRest) {
   fs::last_write_time(abandoned, fs::file_time_type::clock::now() - std::chrono::hours(2));
   EXPECT_EQ(store_->remove_abandoned_uploads(absl::Hours(1)), 1u);
   EXPECT_FALSE(fs::exists(abandoned));
+}
+
+TEST_F(ClusterRolesTest, ARequestIdReusedAfterADeleteIsANewJobAndTheOldMessageIsDropped) {
+  const std::string first = accept("ann", "r1");
+  ASSERT_TRUE(store_->remove(first).ok());
+  std::this_thread::sleep_for(std::chrono::milliseconds(2));  // another creation time
+  const std::string second = accept("ann", "r1");
+  ASSERT_EQ(second, first);  // the same id, made again
+  EXPECT_EQ(connection_->queue->stored().value(), 2u);
+  // The deleted job's message comes first and must not start the new job.
+  auto old_message = connection_->queue->take(absl::Seconds(2)).value();
+  ASSERT_TRUE(old_message.has_value());
+  EXPECT_EQ(connection_->jobs->claim(first, old_message->made()).status().code(),
+            absl::StatusCode::kFailedPrecondition);
+  ASSERT_TRUE(old_message->ack().ok());
+  auto new_message = connection_->queue->take(absl::Seconds(2)).value();
+  ASSERT_TRUE(new_message.has_value());
+  auto claim = connection_->jobs->claim(second, new_message->made());
+  ASSERT_TRUE(claim.ok()) << claim.status();
+  EXPECT_EQ(claim->attempt, 1u);
+}
+
+TEST_F(ClusterRolesTest, ShutdownEndsEveryFollowAndListenRefusesAfter) {
+  const std::string id = accept("ann", "");
+  RecordingListener listener;
+  ASSERT_TRUE(store_->listen(id, 0, &listener).ok());
+  store_->close();
+  EXPECT_TRUE(listener.ended());
+  store_->unlisten(id, &listener);  // gone already: returns at once
+  RecordingListener late;
+  EXPECT_EQ(store_->listen(id, 0, &late).code(), absl::StatusCode::kUnavailable);
+}
+
+TEST_F(ClusterRolesTest, FollowsOfDeletedOrSilentlyEndedJobsAreEnded) {
+  const std::string deleted = accept("ann", "");
+  RecordingListener of_deleted;
+  ASSERT_TRUE(store_->listen(deleted, 0, &of_deleted).ok());
+  ASSERT_TRUE(store_->remove(deleted).ok());
+  store_->check_follows();
+  EXPECT_TRUE(of_deleted.ended());
+
+  // A job whose record ended with no end event (its worker died between
+  // the two): the record stands in once the event is overdue.
+  const std::string silent = accept("ann", "");
+  RecordingListener of_silent;
+  ASSERT_TRUE(store_->listen(silent, 0, &of_silent).ok());
+  auto stored = connection_->states->get(silent).value();
+  v1::JobRecord record;
+  ASSERT_TRUE(record.ParseFromString(stored.value));
+  record.mutable_job()->set_state(v1::JOB_STATE_FAILED);
+  ASSERT_TRUE(
+      connection_->states->update(silent, record.SerializeAsString(), stored.revision).ok());
+  store_->check_follows();
+  EXPECT_FALSE(of_silent.ended());  // the event may still come
+  std::this_thread::sleep_for(std::chrono::milliseconds(5200));
+  store_->check_follows();
+  ASSERT_TRUE(of_silent.ended());
+  EXPECT_TRUE(of_silent.events().back().has_failed());
+  store_->unlisten(deleted, &of_deleted);
+  store_->unlisten(silent, &of_silent);
+}
+
+TEST_F(ClusterRolesTest, AJobRunningPastTheTimeoutIsFailed) {
+  const std::string id = accept("ann", "");
+  (void)connection_->jobs->claim(id).value();  // its worker then dies for good
+  EXPECT_TRUE(store_->expire(absl::Hours(1), 100).empty());
+  EXPECT_EQ(store_->get(id).value().state(), v1::JOB_STATE_RUNNING);
+  std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  ClusterJobStore impatient(*connection_, *files_, 8, absl::ZeroDuration());
+  (void)impatient.expire(absl::Hours(1), 100);
+  const v1::Job job = store_->get(id).value();
+  EXPECT_EQ(job.state(), v1::JOB_STATE_FAILED);
+  EXPECT_EQ(job.error().code(), static_cast<int>(absl::StatusCode::kDeadlineExceeded));
 }
 
 // grpc.health.v1 on a server: `service` "" is the overall health.
