@@ -37,7 +37,7 @@ RUN apt-get update \
 RUN groupadd --gid 10001 labelmesh \
  && useradd --uid 10001 --gid 10001 --home-dir /data --no-create-home \
       --shell /usr/sbin/nologin labelmesh \
- && mkdir -p /data/spool \
+ && mkdir -p /data/spool /data/artifacts \
  && chown -R 10001:10001 /data
 
 COPY --from=build /staging/usr/local/bin/ /usr/local/bin/
