@@ -150,7 +150,7 @@ absl::Status LabelmeshServer::open_cluster() {
   settings.connection_name = absl::StrCat("labelmeshd ", c.role);
   settings.queue.ack_wait = c.cluster_ack_wait;
   if (c.role == "worker") {
-    auto workers = ClusterWorkerRole::start(c, settings, *files_);
+    auto workers = ClusterWorkerRole::start(c, settings, *files_, *metrics_);
     if (!workers.ok()) return workers.status();
     cluster_workers_ = std::move(*workers);
     return absl::OkStatus();
@@ -213,6 +213,7 @@ void LabelmeshServer::housekeeping_loop() {
     }
     if (cluster_store_) {
       cluster_store_->check_follows();
+      if (auto stored = cluster_->queue->stored(); stored.ok()) metrics_->set_queue_depth(*stored);
       // No upload outlives the transfer deadline: older ones were cut off.
       (void)cluster_store_->remove_abandoned_uploads(2 * config_.transfer_deadline);
     }

@@ -46,8 +46,8 @@ absl::StatusOr<uint64_t> free_bytes(const std::string& dir) {
 }  // namespace
 
 ClusterWorkerRole::ClusterWorkerRole(const ServerConfig& config,
-                                     const cluster::SharedArtifacts& files)
-    : config_(config), files_(files), executable_(worker_executable(config)) {
+                                     const cluster::SharedArtifacts& files, Metrics& metrics)
+    : config_(config), files_(files), metrics_(metrics), executable_(worker_executable(config)) {
   // Heartbeats well inside the ack wait, so that a live worker never loses
   // its job; cancels are seen within a heartbeat.
   loop_.heartbeat = std::min(absl::Seconds(5), config.cluster_ack_wait / 4);
@@ -56,8 +56,8 @@ ClusterWorkerRole::ClusterWorkerRole(const ServerConfig& config,
 
 absl::StatusOr<std::unique_ptr<ClusterWorkerRole>> ClusterWorkerRole::start(
     const ServerConfig& config, const cluster::ClusterSettings& settings,
-    const cluster::SharedArtifacts& files) {
-  std::unique_ptr<ClusterWorkerRole> role(new ClusterWorkerRole(config, files));
+    const cluster::SharedArtifacts& files, Metrics& metrics) {
+  std::unique_ptr<ClusterWorkerRole> role(new ClusterWorkerRole(config, files, metrics));
   for (int i = 0; i < config.workers; ++i) {
     auto connection = cluster::ClusterConnection::open(settings);
     if (!connection.ok()) return connection.status();
@@ -78,11 +78,14 @@ void ClusterWorkerRole::run_slot(cluster::ClusterConnection& connection) {
                           const std::atomic<bool>& cancelled) {
         {
           std::lock_guard lock(mutex_);
-          ++busy_;
+          metrics_.set_running(++busy_);
         }
         cluster::JobOutcome outcome = run_job(connection, record, claim, cancelled);
+        // A job given back at shutdown has not ended.
+        static const char* const kOutcome[] = {"", "", "", "succeeded", "failed", "cancelled"};
+        if (outcome.state != v1::JOB_STATE_QUEUED) metrics_.job_ended(kOutcome[outcome.state]);
         std::lock_guard lock(mutex_);
-        --busy_;
+        metrics_.set_running(--busy_);
         idle_.notify_all();
         return outcome;
       },
@@ -128,6 +131,8 @@ cluster::JobOutcome ClusterWorkerRole::run_job(cluster::ClusterConnection& conne
   run.limits = worker_limits(config_, *room);
   run.deadline = absl::Now() + config_.job_timeout;
   run.on_event = [&](v1::JobEvent event) {
+    if (event.has_stage_finished())
+      metrics_.stage_finished(event.stage_finished().stage(), event.stage_finished().seconds());
     (void)connection.jobs->publish(claim, std::move(event));
   };
   run.stop_request = [&] {

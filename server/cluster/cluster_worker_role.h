@@ -16,6 +16,7 @@
 #include "server/cluster/cluster_connection.h"
 #include "server/cluster/cluster_worker.h"
 #include "server/cluster/shared_artifacts.h"
+#include "server/metrics.h"
 #include "server/server_config.h"
 
 namespace labelmesh::server {
@@ -23,9 +24,10 @@ namespace labelmesh::server {
 class ClusterWorkerRole {
  public:
   // Connects every slot and starts pulling. Errors: those of connecting.
+  // Counts jobs, their stages and how many run in `metrics`.
   static absl::StatusOr<std::unique_ptr<ClusterWorkerRole>> start(
       const ServerConfig& config, const cluster::ClusterSettings& settings,
-      const cluster::SharedArtifacts& files);
+      const cluster::SharedArtifacts& files, Metrics& metrics);
   ~ClusterWorkerRole();
 
   // False while a slot cannot reach NATS.
@@ -35,7 +37,8 @@ class ClusterWorkerRole {
   void drain(absl::Duration grace);
 
  private:
-  ClusterWorkerRole(const ServerConfig& config, const cluster::SharedArtifacts& files);
+  ClusterWorkerRole(const ServerConfig& config, const cluster::SharedArtifacts& files,
+                    Metrics& metrics);
   void run_slot(cluster::ClusterConnection& connection);
   cluster::JobOutcome run_job(cluster::ClusterConnection& connection, const v1::JobRecord& record,
                               const cluster::Claim& claim, const std::atomic<bool>& cancelled);
@@ -47,6 +50,7 @@ class ClusterWorkerRole {
 
   const ServerConfig& config_;
   const cluster::SharedArtifacts& files_;
+  Metrics& metrics_;
   std::string executable_;
   cluster::ClusterWorkerConfig loop_;
   std::vector<std::unique_ptr<cluster::ClusterConnection>> connections_;

@@ -10,10 +10,12 @@
 #include <thread>
 
 #include "cluster/nats_server.h"
+#include "core/volume/phantom.h"
 #include "grpc/health/v1/health.grpc.pb.h"
 #include "labelmesh/v1/service.grpc.pb.h"
 #include "server/cluster/cluster_job_store.h"
 #include "server/labelmesh_server.h"
+#include "server/metrics.h"
 #include "server/spool.h"
 #include "support/service_harness.h"
 
@@ -333,16 +335,48 @@ TEST_F(ClusterRolesTest, AFrontendIsReadyWhileItReachesNatsAndLiveThroughout) {
   (*frontend)->shutdown();
 }
 
-TEST_F(ClusterRolesTest, AWorkerServesHealthButNoJobs) {
+TEST_F(ClusterRolesTest, AWorkerRunsAJobFromTheSharedDirectoryAndServesOnlyHealth) {
+  // A sphere phantom accepted as a frontend would, run by a real worker.
+  const fs::path volume = testing::write_phantom(dir_, volume::PhantomShape::kSphere);
+  const std::string id = store_->new_job_id_for("ann", "");
+  const std::string upload = store_->upload_path(id, ".nii.gz");
+  fs::copy_file(volume, upload);
+  v1::JobRecord record;
+  record.mutable_job()->set_job_id(id);
+  record.mutable_job()->set_owner("ann");
+  record.mutable_job()->set_created_at(server::unix_now());
+  record.set_input_extension(".nii.gz");
+  ASSERT_TRUE(store_->accept(record, upload).ok());
+
   auto worker = server::LabelmeshServer::start(role_config(dir_, "worker", nats_->url()));
   ASSERT_TRUE(worker.ok()) << worker.status();
+  v1::Job job;
+  for (int i = 0; i < 1200; ++i) {
+    job = store_->get(id).value();
+    if (server::has_ended(job.state())) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  ASSERT_EQ(job.state(), v1::JOB_STATE_SUCCEEDED) << job.error().message();
+  EXPECT_EQ(job.attempts(), 1u);
+  const auto artifacts = store_->artifacts(id).value();
+  ASSERT_FALSE(artifacts.empty());
+  for (const auto& artifact : artifacts) {
+    EXPECT_EQ(fs::file_size(store_->artifact_path(job, artifact.name())), artifact.size_bytes())
+        << artifact.name();
+  }
+  // The job counted where the worker's metrics are served; its input gone.
+  const std::string metrics = (*worker)->metrics().text();
+  EXPECT_NE(metrics.find("labelmesh_jobs_total{outcome=\"succeeded\"} 1"), std::string::npos);
+  EXPECT_NE(metrics.find("labelmesh_stage_duration_seconds_count"), std::string::npos);
+  EXPECT_FALSE(fs::exists(job_dir(id) / "input.nii.gz"));
+
   EXPECT_EQ(health((*worker)->port(), ""), grpc::health::v1::HealthCheckResponse::SERVING);
   auto channel = grpc::CreateChannel("127.0.0.1:" + std::to_string((*worker)->port()),
                                      grpc::InsecureChannelCredentials());
   grpc::ClientContext context;
   v1::Job reply;
   v1::GetJobRequest request;
-  request.set_job_id(std::string(32, 'a'));
+  request.set_job_id(id);
   EXPECT_EQ(v1::MeshingService::NewStub(channel)->GetJob(&context, request, &reply).error_code(),
             grpc::StatusCode::UNIMPLEMENTED);
   (*worker)->shutdown();
