@@ -46,8 +46,7 @@ TEST(SharedArtifacts, OnlyTheFinalAttemptsFilesRemain) {
   ASSERT_TRUE(store.ok());
   EXPECT_EQ(store->attempt_dir("j1", 2), (root / "jobs/j1/out-2").string());
   for (int attempt : {1, 2, 3}) {
-    ASSERT_TRUE(
-        store->put("jobs/j1/out-" + std::to_string(attempt) + "/report.json", "{}").ok());
+    ASSERT_TRUE(store->put("jobs/j1/out-" + std::to_string(attempt) + "/report.json", "{}").ok());
   }
   EXPECT_EQ(store->remove_other_attempts("j1", 2).value(), 2u);
   EXPECT_FALSE(fs::exists(root / "jobs/j1/out-1"));
