@@ -17,6 +17,10 @@ WatchReactor* WatchReactor::start(JobStore& store, StreamWatchdog& watchdog,
   std::lock_guard lock(reactor->mutex_);
   reactor->listening_ = listening.ok();
   if (!listening.ok()) reactor->finish(to_grpc(listening));
+  // An end that came while listen() ran (events may come on another
+  // thread) finishes the stream only now, so that OnDone knows to unlisten.
+  reactor->starting_ = false;
+  if (reactor->finish_deferred_) reactor->Finish(reactor->deferred_status_);
   return reactor;
 }
 
@@ -26,7 +30,7 @@ WatchReactor::WatchReactor(JobStore& store, std::string job_id,
 
 void WatchReactor::on_event(const v1::JobEvent& event, bool last) {
   std::lock_guard lock(mutex_);
-  if (finished_) return;
+  if (finished_ || end_queued_) return;  // nothing follows a job's end
   pending_.push_back(event);
   if (last) {
     end_queued_ = true;
@@ -81,6 +85,11 @@ grpc::Status WatchReactor::left_or_stalled() const {
 void WatchReactor::finish(const grpc::Status& status) {
   if (finished_) return;
   finished_ = true;
+  if (starting_) {
+    finish_deferred_ = true;
+    deferred_status_ = status;
+    return;
+  }
   Finish(status);
 }
 

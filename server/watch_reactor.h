@@ -54,6 +54,10 @@ class WatchReactor final : public grpc::ServerWriteReactor<v1::JobEvent>,
 
   std::mutex mutex_;
   bool listening_ = false;
+  // Until start() has recorded whether it listens: a finish waits for it.
+  bool starting_ = true;
+  bool finish_deferred_ = false;
+  grpc::Status deferred_status_;
   std::deque<v1::JobEvent> pending_;
   v1::JobEvent writing_;
   bool write_outstanding_ = false;

@@ -268,15 +268,18 @@ void ClusterJobStore::unlisten(const std::string&, EventListener* listener) {
 void ClusterJobStore::end_follows(std::vector<Ending> endings) {
   for (auto& ending : endings) {
     ending.follow.subscription.reset();  // no event after this
-    if (ending.last_event && !*ending.follow.heard_last) {
-      ending.listener->on_event(*ending.last_event, true);
-    } else if (!ending.last_event) {
-      ending.listener->on_closed(ending.status);
+    // A listener handed its last event meanwhile has heard the end.
+    if (!*ending.follow.heard_last) {
+      if (ending.last_event) {
+        ending.listener->on_event(*ending.last_event, true);
+      } else {
+        ending.listener->on_closed(ending.status);
+      }
     }
+    std::lock_guard lock(mutex_);
+    ending_.erase(ending.listener);
+    ended_.notify_all();
   }
-  std::lock_guard lock(mutex_);
-  for (const auto& ending : endings) ending_.erase(ending.listener);
-  ended_.notify_all();
 }
 
 void ClusterJobStore::check_follows() {
@@ -288,15 +291,18 @@ void ClusterJobStore::check_follows() {
       if (!*follow.heard_last) watched.emplace_back(listener, follow.job_id);
     }
   }
-  std::map<EventListener*, absl::StatusOr<v1::JobRecord>> records;
-  for (const auto& [listener, job_id] : watched) records.emplace(listener, record(job_id));
+  std::map<EventListener*, std::pair<std::string, absl::StatusOr<v1::JobRecord>>> records;
+  for (const auto& [listener, job_id] : watched)
+    records.emplace(listener, std::make_pair(job_id, record(job_id)));
   const double now = unix_now();
   std::vector<Ending> endings;
   {
     std::lock_guard lock(mutex_);
-    for (auto& [listener, found] : records) {
+    for (auto& [listener, checked] : records) {
+      auto& [job_id, found] = checked;
       auto it = follows_.find(listener);
-      if (it == follows_.end() || *it->second.heard_last) continue;
+      // Gone, or a new listener at the same address following another job.
+      if (it == follows_.end() || it->second.job_id != job_id || *it->second.heard_last) continue;
       Follow& follow = it->second;
       std::optional<v1::JobEvent> last_event;
       absl::Status status;
@@ -329,8 +335,11 @@ std::vector<std::string> ClusterJobStore::expire(absl::Duration result_ttl, size
     if (!found.ok()) continue;
     if (has_ended(found->job().state())) ended.emplace_back(found->job().finished_at(), id);
     if (found->job().state() == v1::JOB_STATE_RUNNING && found->job().started_at() < abandoned) {
-      if (auto gave_up = cluster_.jobs->give_up(id, abandoned); gave_up.ok() && *gave_up)
+      if (auto gave_up = cluster_.jobs->give_up(id, abandoned); gave_up.ok() && *gave_up) {
         spdlog::warn("job {} lost its workers past the job timeout: failed", id);
+        // Deleted by a client while it ran: nobody else will remove it.
+        if (found->deleted()) (void)erase(id);
+      }
     }
   }
   std::sort(ended.begin(), ended.end());

@@ -114,16 +114,24 @@ absl::StatusOr<v1::JobRecord> ClusterJobs::get(const std::string& job_id) {
   return parse(*stored, job_id);
 }
 
-absl::StatusOr<Claim> ClusterJobs::claim(const std::string& job_id, const std::string& made_as) {
+absl::StatusOr<Claim> ClusterJobs::claim(const std::string& job_id, const Delivered& from) {
   Claim claim{job_id, 0, {}};
   auto record = change_record(job_id, [&](v1::JobRecord& r) {
     if (ended(r.job().state())) {
       return absl::FailedPreconditionError(absl::StrCat("job ", job_id, " has ended"));
     }
-    if (!made_as.empty() && made_as != made(r)) {
+    if (!from.made.empty() && from.made != made(r)) {
       return absl::FailedPreconditionError(
           absl::StrCat("the message is for an earlier job ", job_id, ", since deleted"));
     }
+    // A redelivery of the running message takes over from a silent worker;
+    // any other message (a give-back whose old message came back) does not.
+    if (r.job().state() == v1::JOB_STATE_RUNNING && from.message != 0 && r.queue_message() != 0 &&
+        r.queue_message() != from.message) {
+      return absl::FailedPreconditionError(absl::StrCat("another queue message runs job ", job_id));
+    }
+    r.set_queue_message(from.message);
+    r.set_final_delivery(from.final_delivery);
     r.mutable_job()->set_state(v1::JOB_STATE_RUNNING);
     r.mutable_job()->set_attempts(r.job().attempts() + 1);
     r.mutable_job()->set_started_at(unix_seconds());
@@ -211,6 +219,17 @@ absl::Status ClusterJobs::erase(const std::string& job_id) {
 }
 
 absl::Status ClusterJobs::requeue(const Claim& claim) {
+  auto record = change_record(claim.job_id, [&](v1::JobRecord& r) {
+    if (r.job().state() != v1::JOB_STATE_RUNNING || r.job().attempts() != claim.attempt)
+      return absl::AbortedError("another attempt holds the job");
+    r.mutable_job()->set_state(v1::JOB_STATE_QUEUED);
+    r.mutable_job()->set_started_at(0);
+    r.mutable_job()->clear_stage();
+    r.set_queue_message(0);
+    return absl::OkStatus();
+  });
+  if (!record.ok()) return record.status();
+  if (auto status = log_state(*record); !status.ok()) return status;
   return queue_
       .enqueue(claim.job_id, absl::StrCat(queue_key(claim.record), "@", claim.attempt),
                made(claim.record))
@@ -220,7 +239,8 @@ absl::Status ClusterJobs::requeue(const Claim& claim) {
 absl::StatusOr<bool> ClusterJobs::give_up(const std::string& job_id, double started_before) {
   bool gave_up = false;
   auto record = change_record(job_id, [&](v1::JobRecord& r) {
-    gave_up = r.job().state() == v1::JOB_STATE_RUNNING && r.job().started_at() < started_before;
+    gave_up = r.job().state() == v1::JOB_STATE_RUNNING && r.final_delivery() &&
+              r.job().started_at() < started_before;
     if (!gave_up) return absl::OkStatus();
     auto* job = r.mutable_job();
     job->set_state(v1::JOB_STATE_FAILED);

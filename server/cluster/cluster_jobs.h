@@ -28,6 +28,13 @@ struct Claim {
   v1::JobRecord record;
 };
 
+// Which queue message delivered a job to a worker (all empty: unknown).
+struct Delivered {
+  std::string made;             // JobDelivery::made
+  uint64_t message = 0;         // JobDelivery::sequence
+  bool final_delivery = false;  // the queue delivers this message no more
+};
+
 class ClusterJobs {
  public:
   ClusterJobs(JobStates& states, JobQueue& queue, EventLog& events)
@@ -42,11 +49,12 @@ class ClusterJobs {
 
   // Starts the next attempt of a delivered job: QUEUED, or RUNNING under a
   // worker the queue gave up on, becomes RUNNING with one more attempt.
-  // `made_as` is the delivery's JobDelivery::made (empty: not checked).
-  // Errors: FAILED_PRECONDITION when the job has ended, or when the
-  // delivery was for an earlier job of the same id (the delivery is done
-  // with either way); NOT_FOUND.
-  absl::StatusOr<Claim> claim(const std::string& job_id, const std::string& made_as = "");
+  // `from` tells which queue message delivered it (all empty: not checked).
+  // Errors: FAILED_PRECONDITION when the job has ended, when the delivery
+  // was for an earlier job of the same id, or when another message's
+  // delivery runs the job (the delivery is done with in every case);
+  // NOT_FOUND.
+  absl::StatusOr<Claim> claim(const std::string& job_id, const Delivered& from = Delivered());
 
   // Ends a claimed job in `state` (SUCCEEDED, FAILED or CANCELLED) with
   // `result` filling the record's report, artifacts or error, and logs it.
@@ -65,13 +73,15 @@ class ClusterJobs {
   absl::StatusOr<bool> remove(const std::string& job_id);
   // The record and events of `job_id`, whatever its state.
   absl::Status erase(const std::string& job_id);
-  // Puts a claimed job back in the queue under a key of its own, for a
-  // worker that stops before the job ends (a redelivery would count
-  // towards the queue's most deliveries).
+  // Puts a claimed job back in the queue under a message of its own, QUEUED
+  // again, for a worker that stops before the job ends (a redelivery would
+  // count towards the queue's most deliveries). Errors: ABORTED when the
+  // claim is no longer the job's current attempt.
   absl::Status requeue(const Claim& claim);
-  // A job RUNNING since before `started_before` (seconds since 1970): its
-  // workers died, or the queue stopped delivering it, past any run's
-  // timeout. It ends FAILED (DEADLINE_EXCEEDED); true when it did.
+  // A job RUNNING on the queue's final delivery since before
+  // `started_before` (seconds since 1970): its last worker died, past any
+  // run's timeout, and no delivery will come. It ends FAILED
+  // (DEADLINE_EXCEEDED); true when it did.
   absl::StatusOr<bool> give_up(const std::string& job_id, double started_before);
   // Every job id recorded.
   absl::StatusOr<std::vector<std::string>> job_ids() { return states_.keys(); }

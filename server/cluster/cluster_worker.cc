@@ -10,7 +10,9 @@ absl::StatusOr<bool> ClusterWorker::run_one() {
   if (!taken.ok()) return taken.status();
   if (!taken->has_value()) return false;
   JobDelivery& delivery = **taken;
-  auto claim = jobs_.claim(delivery.job_id(), delivery.made());
+  const bool final_delivery = delivery.delivered() >= static_cast<uint64_t>(queue_.max_deliver());
+  auto claim =
+      jobs_.claim(delivery.job_id(), {delivery.made(), delivery.sequence(), final_delivery});
   if (claim.status().code() == absl::StatusCode::kFailedPrecondition ||
       claim.status().code() == absl::StatusCode::kNotFound) {
     // Ended, or deleted: nothing to run, and nothing to deliver again.
@@ -39,7 +41,9 @@ absl::StatusOr<bool> ClusterWorker::run_one() {
   if (outcome.state == v1::JOB_STATE_QUEUED) {
     // This worker is stopping: the next one takes the job at once, without
     // it counting as a failed delivery.
-    if (auto status = jobs_.requeue(*claim); !status.ok()) return status;
+    auto requeued = jobs_.requeue(*claim);
+    // Taken over meanwhile: the other attempt has it.
+    if (!requeued.ok() && requeued.code() != absl::StatusCode::kAborted) return requeued;
     if (auto status = delivery.ack(); !status.ok()) return status;
     return true;
   }

@@ -11,7 +11,8 @@ JobDelivery::JobDelivery(JobDelivery&& other) noexcept
     : message_(other.message_),
       job_id_(std::move(other.job_id_)),
       made_(std::move(other.made_)),
-      delivered_(other.delivered_) {
+      delivered_(other.delivered_),
+      sequence_(other.sequence_) {
   other.message_ = nullptr;
 }
 
@@ -103,9 +104,10 @@ absl::StatusOr<std::optional<JobDelivery>> JobQueue::take(absl::Duration wait) {
   list.Msgs[0] = nullptr;
   natsMsgList_Destroy(&list);
   jsMsgMetaData* meta = nullptr;
-  uint64_t delivered = 1;
+  uint64_t delivered = 1, sequence = 0;
   if (natsMsg_GetMetaData(&meta, message) == NATS_OK) {
     delivered = meta->NumDelivered;
+    sequence = meta->Sequence.Stream;
     jsMsgMetaData_Destroy(meta);
   }
   const std::string data(natsMsg_GetData(message),
@@ -114,7 +116,7 @@ absl::StatusOr<std::optional<JobDelivery>> JobQueue::take(absl::Duration wait) {
   std::string job_id = data.substr(0, colon);
   std::string made = colon == std::string::npos ? "" : data.substr(colon + 1);
   return std::optional<JobDelivery>(std::in_place, message, std::move(job_id), std::move(made),
-                                    delivered);
+                                    delivered, sequence);
 }
 
 absl::StatusOr<uint64_t> JobQueue::stored() {

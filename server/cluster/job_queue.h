@@ -31,11 +31,13 @@ struct JobQueueConfig {
 // One job handed to this worker; exactly one of ack, nak and term ends it.
 class JobDelivery {
  public:
-  JobDelivery(natsMsg* message, std::string job_id, std::string made, uint64_t delivered)
+  JobDelivery(natsMsg* message, std::string job_id, std::string made, uint64_t delivered,
+              uint64_t sequence = 0)
       : message_(message),
         job_id_(std::move(job_id)),
         made_(std::move(made)),
-        delivered_(delivered) {}
+        delivered_(delivered),
+        sequence_(sequence) {}
   ~JobDelivery();
   JobDelivery(JobDelivery&& other) noexcept;
   JobDelivery& operator=(JobDelivery&&) = delete;
@@ -47,6 +49,9 @@ class JobDelivery {
   // job under the same id; empty when not told.
   const std::string& made() const { return made_; }
   // 1 the first time this job was handed out, more after redeliveries.
+  // The message's place in the queue stream: the same for every delivery
+  // of one message.
+  uint64_t sequence() const { return sequence_; }
   uint64_t delivered() const { return delivered_; }
 
   // Done (finished, failed or cancelled): the queue drops the job. Waits
@@ -64,10 +69,13 @@ class JobDelivery {
   std::string job_id_;
   std::string made_;
   uint64_t delivered_;
+  uint64_t sequence_;
 };
 
 class JobQueue {
  public:
+  // The most deliveries of one message (JobQueueConfig::max_deliver).
+  int max_deliver() const { return config_.max_deliver; }
   // Creates the stream and the consumer unless they exist (then they are
   // used as they are) and subscribes to the consumer.
   // Errors: those of nats_error, naming the stream or the consumer.

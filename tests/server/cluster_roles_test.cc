@@ -223,12 +223,12 @@ TEST_F(ClusterRolesTest, ARequestIdReusedAfterADeleteIsANewJobAndTheOldMessageIs
   // The deleted job's message comes first and must not start the new job.
   auto old_message = connection_->queue->take(absl::Seconds(2)).value();
   ASSERT_TRUE(old_message.has_value());
-  EXPECT_EQ(connection_->jobs->claim(first, old_message->made()).status().code(),
+  EXPECT_EQ(connection_->jobs->claim(first, {old_message->made()}).status().code(),
             absl::StatusCode::kFailedPrecondition);
   ASSERT_TRUE(old_message->ack().ok());
   auto new_message = connection_->queue->take(absl::Seconds(2)).value();
   ASSERT_TRUE(new_message.has_value());
-  auto claim = connection_->jobs->claim(second, new_message->made());
+  auto claim = connection_->jobs->claim(second, {new_message->made()});
   ASSERT_TRUE(claim.ok()) << claim.status();
   EXPECT_EQ(claim->attempt, 1u);
 }
@@ -273,17 +273,42 @@ TEST_F(ClusterRolesTest, FollowsOfDeletedOrSilentlyEndedJobsAreEnded) {
   store_->unlisten(silent, &of_silent);
 }
 
-TEST_F(ClusterRolesTest, AJobRunningPastTheTimeoutIsFailed) {
-  const std::string id = accept("ann", "");
-  (void)connection_->jobs->claim(id).value();  // its worker then dies for good
-  EXPECT_TRUE(store_->expire(absl::Hours(1), 100).empty());
-  EXPECT_EQ(store_->get(id).value().state(), v1::JOB_STATE_RUNNING);
-  std::this_thread::sleep_for(std::chrono::milliseconds(5));
+TEST_F(ClusterRolesTest, AJobWhoseLastDeliveryDiedIsFailedPastTheTimeout) {
   ClusterJobStore impatient(*connection_, *files_, 8, absl::ZeroDuration());
+  // Not on the final delivery: another comes, however long it waits.
+  const std::string waiting = accept("ann", "");
+  (void)connection_->jobs->claim(waiting, {"", 1, false}).value();
+  // On the final delivery: its worker then dies for good.
+  const std::string lost = accept("ann", "");
+  (void)connection_->jobs->claim(lost, {"", 2, true}).value();
+  EXPECT_TRUE(store_->expire(absl::Hours(1), 100).empty());
+  EXPECT_EQ(store_->get(lost).value().state(), v1::JOB_STATE_RUNNING);
+  std::this_thread::sleep_for(std::chrono::milliseconds(5));
   (void)impatient.expire(absl::Hours(1), 100);
-  const v1::Job job = store_->get(id).value();
+  const v1::Job job = store_->get(lost).value();
   EXPECT_EQ(job.state(), v1::JOB_STATE_FAILED);
   EXPECT_EQ(job.error().code(), static_cast<int>(absl::StatusCode::kDeadlineExceeded));
+  EXPECT_EQ(store_->get(waiting).value().state(), v1::JOB_STATE_RUNNING);
+}
+
+TEST_F(ClusterRolesTest, AnotherMessageNeverTakesARunningJobOver) {
+  const std::string id = accept("ann", "");
+  auto first = connection_->jobs->claim(id, {"", 10, false});
+  ASSERT_TRUE(first.ok());
+  // The same message again (its worker went silent) takes over...
+  auto again = connection_->jobs->claim(id, {"", 10, false});
+  ASSERT_TRUE(again.ok());
+  EXPECT_EQ(again->attempt, 2u);
+  // ...a second message of the job (a give-back whose ack was lost) does not.
+  EXPECT_EQ(connection_->jobs->claim(id, {"", 11, false}).status().code(),
+            absl::StatusCode::kFailedPrecondition);
+  // A give-back makes the job QUEUED, and the new message takes it.
+  ASSERT_TRUE(connection_->jobs->requeue(*again).ok());
+  EXPECT_EQ(store_->get(id).value().state(), v1::JOB_STATE_QUEUED);
+  EXPECT_EQ(connection_->jobs->requeue(*again).code(), absl::StatusCode::kAborted);
+  auto third = connection_->jobs->claim(id, {"", 12, false});
+  ASSERT_TRUE(third.ok());
+  EXPECT_EQ(third->attempt, 3u);
 }
 
 // grpc.health.v1 on a server: `service` "" is the overall health.
@@ -368,6 +393,9 @@ TEST_F(ClusterRolesTest, AWorkerRunsAJobFromTheSharedDirectoryAndServesOnlyHealt
   const std::string metrics = (*worker)->metrics().text();
   EXPECT_NE(metrics.find("labelmesh_jobs_total{outcome=\"succeeded\"} 1"), std::string::npos);
   EXPECT_NE(metrics.find("labelmesh_stage_duration_seconds_count"), std::string::npos);
+  // The worker cleans up just after it records the end.
+  for (int i = 0; i < 100 && fs::exists(job_dir(id) / "input.nii.gz"); ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
   EXPECT_FALSE(fs::exists(job_dir(id) / "input.nii.gz"));
 
   EXPECT_EQ(health((*worker)->port(), ""), grpc::health::v1::HealthCheckResponse::SERVING);
