@@ -2,7 +2,6 @@
 #include "server/job_store.h"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 
 #include "absl/strings/numbers.h"
@@ -35,42 +34,6 @@ std::optional<ListPosition> parse_page_token(std::string_view token) {
 }
 
 }  // namespace
-
-google::protobuf::Timestamp to_timestamp(double unix_seconds) {
-  google::protobuf::Timestamp stamp;
-  const double whole = std::floor(unix_seconds);
-  stamp.set_seconds(static_cast<int64_t>(whole));
-  stamp.set_nanos(std::min(999'999'999, static_cast<int>((unix_seconds - whole) * 1e9)));
-  return stamp;
-}
-
-double unix_now() {
-  return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
-}
-
-bool has_ended(v1::JobState state) {
-  return state == v1::JOB_STATE_SUCCEEDED || state == v1::JOB_STATE_FAILED ||
-         state == v1::JOB_STATE_CANCELLED;
-}
-
-v1::JobEvent state_event(const v1::Job& job, uint32_t position) {
-  v1::JobEvent event;
-  event.set_job_id(job.job_id());
-  switch (job.state()) {
-    case v1::JOB_STATE_SUCCEEDED:
-      *event.mutable_finished()->mutable_report() = job.report();
-      break;
-    case v1::JOB_STATE_FAILED:
-      *event.mutable_failed() = job.error();
-      break;
-    case v1::JOB_STATE_CANCELLED:
-      event.mutable_cancelled();
-      break;
-    default:
-      event.mutable_queued()->set_position(position);
-  }
-  return event;
-}
 
 v1::Job with_timestamps(v1::Job job) {
   if (job.created_at() > 0) *job.mutable_created_time() = to_timestamp(job.created_at());

@@ -14,6 +14,7 @@
 #include "absl/status/statusor.h"
 #include "absl/time/time.h"
 #include "labelmesh/v1/service.pb.h"
+#include "server/job_events.h"
 
 namespace labelmesh::server {
 
@@ -97,18 +98,6 @@ class JobStore {
   // jobs beyond `max_ended`; returns their ids.
   virtual std::vector<std::string> expire(absl::Duration result_ttl, size_t max_ended) = 0;
 };
-
-// Seconds since 1970, UTC.
-double unix_now();
-
-bool has_ended(v1::JobState state);
-
-google::protobuf::Timestamp to_timestamp(double unix_seconds);
-
-// The event that tells a watcher where a job stands when its history is not
-// at hand: its end, or queued at `position` (a running job too: it runs again
-// or is followed from here).
-v1::JobEvent state_event(const v1::Job& job, uint32_t position);
 
 // The job as clients see it: timestamps as Timestamp messages too.
 v1::Job with_timestamps(v1::Job job);

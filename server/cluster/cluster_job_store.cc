@@ -52,14 +52,7 @@ std::string ClusterJobStore::upload_path(const std::string& job_id, const std::s
                       extension);
 }
 
-absl::StatusOr<uint64_t> ClusterJobStore::free_bytes() const {
-  std::error_code error;
-  const fs::space_info space = fs::space(files_.root(), error);
-  if (error)
-    return spool_io_error(absl::StrCat("cannot read the free space of ", files_.root()),
-                          error.value());
-  return space.available;
-}
+absl::StatusOr<uint64_t> ClusterJobStore::free_bytes() const { return files_.free_bytes(); }
 
 bool ClusterJobStore::queue_full() const {
   auto stored = cluster_.queue->stored();
@@ -82,17 +75,17 @@ absl::StatusOr<uint32_t> ClusterJobStore::accept(v1::JobRecord record,
   }
   if (existing.status().code() != absl::StatusCode::kNotFound) return existing.status();
   record.mutable_job()->set_state(v1::JOB_STATE_QUEUED);
-  const std::string dir = absl::StrCat("jobs/", id);
-  if (auto status = files_.put(dir + "/job.pb", record.SerializeAsString()); !status.ok())
+  if (auto status = files_.put(absl::StrCat("jobs/", id, "/job.pb"), record.SerializeAsString());
+      !status.ok())
     return status;
-  fs::rename(upload_path, absl::StrCat(files_.root(), "/", dir, "/input", record.input_extension()),
+  fs::rename(upload_path, absl::StrCat(files_.job_dir(id), "/input", record.input_extension()),
              error);
   if (error) return spool_io_error("cannot move the upload into its job", error.value());
   auto submitted = cluster_.jobs->submit(std::move(record));
   if (!submitted.ok()) {
     // Its files go unless another frontend recorded the job meanwhile.
     if (cluster_.jobs->get(id).status().code() == absl::StatusCode::kNotFound)
-      fs::remove_all(absl::StrCat(files_.root(), "/", dir), error);
+      files_.remove_job(id);
     return submitted.status();
   }
   spdlog::info("job {} queued", id);
@@ -157,8 +150,7 @@ std::optional<JobStore::PriorRequest> ClusterJobStore::find_request(
 }
 
 absl::Status ClusterJobStore::erase(const std::string& job_id) const {
-  std::error_code error;
-  fs::remove_all(absl::StrCat(files_.root(), "/jobs/", job_id), error);
+  files_.remove_job(job_id);
   return cluster_.jobs->erase(job_id);
 }
 
@@ -168,10 +160,7 @@ absl::StatusOr<v1::JobState> ClusterJobStore::remove(const std::string& job_id) 
   auto removed = cluster_.jobs->remove(job_id);
   if (!removed.ok()) return removed.status();
   // A running job's worker removes its files once it stops.
-  if (*removed) {
-    std::error_code error;
-    fs::remove_all(absl::StrCat(files_.root(), "/jobs/", job_id), error);
-  }
+  if (*removed) files_.remove_job(job_id);
   spdlog::info("job {} deleted by a client", job_id);
   return found->job().state();
 }

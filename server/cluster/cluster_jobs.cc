@@ -2,15 +2,13 @@
 #include "server/cluster/cluster_jobs.h"
 
 #include "absl/strings/str_cat.h"
-#include "absl/time/clock.h"
+#include "server/job_events.h"
 
 namespace labelmesh::cluster {
 namespace {
 
-bool ended(v1::JobState state) {
-  return state == v1::JOB_STATE_SUCCEEDED || state == v1::JOB_STATE_FAILED ||
-         state == v1::JOB_STATE_CANCELLED;
-}
+using server::has_ended;
+using server::unix_now;
 
 absl::StatusOr<v1::JobRecord> parse(const Versioned& stored, const std::string& job_id) {
   v1::JobRecord record;
@@ -18,8 +16,6 @@ absl::StatusOr<v1::JobRecord> parse(const Versioned& stored, const std::string& 
     return absl::DataLossError(absl::StrCat("job state ", job_id, " is unreadable"));
   return record;
 }
-
-double unix_seconds() { return absl::ToDoubleSeconds(absl::Now() - absl::UnixEpoch()); }
 
 // Which making of a job a queue message is for: its creation time in
 // microseconds. A job made again under the same id (a client's request id
@@ -37,30 +33,10 @@ std::string queue_key(const v1::JobRecord& record) {
 }  // namespace
 
 absl::Status ClusterJobs::log_state(const v1::JobRecord& record) {
-  const v1::Job& job = record.job();
-  v1::JobEvent event;
-  event.set_job_id(job.job_id());
-  event.set_time(unix_seconds());
-  switch (job.state()) {
-    case v1::JOB_STATE_QUEUED:
-      event.mutable_queued();
-      break;
-    case v1::JOB_STATE_RUNNING:
-      event.mutable_started()->set_attempt(job.attempts());
-      break;
-    case v1::JOB_STATE_SUCCEEDED:
-      *event.mutable_finished()->mutable_report() = job.report();
-      break;
-    case v1::JOB_STATE_FAILED:
-      *event.mutable_failed() = job.error();
-      break;
-    case v1::JOB_STATE_CANCELLED:
-      event.mutable_cancelled();
-      break;
-    default:
-      return absl::OkStatus();
-  }
-  return events_.append(job.job_id(), event.SerializeAsString()).status();
+  if (record.job().state() == v1::JOB_STATE_UNSPECIFIED) return absl::OkStatus();
+  v1::JobEvent event = server::state_event(record.job(), 0);
+  event.set_time(unix_now());
+  return events_.append(record.job().job_id(), event.SerializeAsString()).status();
 }
 
 template <typename Change>
@@ -117,7 +93,7 @@ absl::StatusOr<v1::JobRecord> ClusterJobs::get(const std::string& job_id) {
 absl::StatusOr<Claim> ClusterJobs::claim(const std::string& job_id, const Delivered& from) {
   Claim claim{job_id, 0, {}};
   auto record = change_record(job_id, [&](v1::JobRecord& r) {
-    if (ended(r.job().state())) {
+    if (has_ended(r.job().state())) {
       return absl::FailedPreconditionError(absl::StrCat("job ", job_id, " has ended"));
     }
     if (!from.made.empty() && from.made != made(r)) {
@@ -134,7 +110,7 @@ absl::StatusOr<Claim> ClusterJobs::claim(const std::string& job_id, const Delive
     r.set_final_delivery(from.final_delivery);
     r.mutable_job()->set_state(v1::JOB_STATE_RUNNING);
     r.mutable_job()->set_attempts(r.job().attempts() + 1);
-    r.mutable_job()->set_started_at(unix_seconds());
+    r.mutable_job()->set_started_at(unix_now());
     r.mutable_job()->clear_stage();
     r.mutable_job()->set_progress(0);
     claim.attempt = r.job().attempts();
@@ -148,7 +124,7 @@ absl::StatusOr<Claim> ClusterJobs::claim(const std::string& job_id, const Delive
 
 absl::StatusOr<v1::JobRecord> ClusterJobs::finish(const Claim& claim, v1::JobState state,
                                                   const v1::JobRecord& result) {
-  if (!ended(state)) return absl::InvalidArgumentError("a job can only end as it ends");
+  if (!has_ended(state)) return absl::InvalidArgumentError("a job can only end as it ends");
   auto record = change_record(claim.job_id, [&](v1::JobRecord& r) {
     if (r.job().state() != v1::JOB_STATE_RUNNING || r.job().attempts() != claim.attempt) {
       return absl::AbortedError(absl::StrCat("job ", claim.job_id, " attempt ", claim.attempt,
@@ -156,7 +132,7 @@ absl::StatusOr<v1::JobRecord> ClusterJobs::finish(const Claim& claim, v1::JobSta
     }
     auto* job = r.mutable_job();
     job->set_state(state);
-    job->set_finished_at(unix_seconds());
+    job->set_finished_at(unix_now());
     job->clear_stage();
     if (state == v1::JOB_STATE_SUCCEEDED) job->set_progress(1);
     if (result.job().has_report()) *job->mutable_report() = result.job().report();
@@ -171,12 +147,12 @@ absl::StatusOr<v1::JobRecord> ClusterJobs::finish(const Claim& claim, v1::JobSta
 
 absl::StatusOr<v1::JobRecord> ClusterJobs::cancel(const std::string& job_id) {
   auto record = change_record(job_id, [&](v1::JobRecord& r) {
-    if (ended(r.job().state())) {
+    if (has_ended(r.job().state())) {
       return absl::FailedPreconditionError(absl::StrCat("job ", job_id, " has ended"));
     }
     if (r.job().state() == v1::JOB_STATE_QUEUED) {
       r.mutable_job()->set_state(v1::JOB_STATE_CANCELLED);
-      r.mutable_job()->set_finished_at(unix_seconds());
+      r.mutable_job()->set_finished_at(unix_now());
       r.mutable_job()->mutable_error()->set_code(static_cast<int>(absl::StatusCode::kCancelled));
       r.mutable_job()->mutable_error()->set_message("cancelled by a client");
     } else {
@@ -193,7 +169,7 @@ absl::StatusOr<v1::JobRecord> ClusterJobs::cancel(const std::string& job_id) {
 
 absl::Status ClusterJobs::publish(const Claim& claim, v1::JobEvent event) {
   event.set_job_id(claim.job_id);
-  event.set_time(unix_seconds());
+  event.set_time(unix_now());
   return events_.append_async(claim.job_id, event.SerializeAsString());
 }
 
@@ -244,7 +220,7 @@ absl::StatusOr<bool> ClusterJobs::give_up(const std::string& job_id, double star
     if (!gave_up) return absl::OkStatus();
     auto* job = r.mutable_job();
     job->set_state(v1::JOB_STATE_FAILED);
-    job->set_finished_at(unix_seconds());
+    job->set_finished_at(unix_now());
     job->clear_stage();
     job->mutable_error()->set_code(static_cast<int>(absl::StatusCode::kDeadlineExceeded));
     job->mutable_error()->set_message(absl::StrCat("the job's workers stopped answering (attempt ",

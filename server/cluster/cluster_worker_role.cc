@@ -35,14 +35,6 @@ absl::Status fresh_directory(const std::string& dir) {
   return absl::OkStatus();
 }
 
-absl::StatusOr<uint64_t> free_bytes(const std::string& dir) {
-  std::error_code error;
-  const fs::space_info space = fs::space(dir, error);
-  if (error)
-    return spool_io_error(absl::StrCat("cannot read the free space of ", dir), error.value());
-  return space.available;
-}
-
 }  // namespace
 
 ClusterWorkerRole::ClusterWorkerRole(const ServerConfig& config,
@@ -119,10 +111,9 @@ cluster::JobOutcome ClusterWorkerRole::run_job(cluster::ClusterConnection& conne
   spdlog::info("job {} started (attempt {})", id, claim.attempt);
   const std::string out = files_.attempt_dir(id, claim.attempt);
   if (auto status = fresh_directory(out); !status.ok()) return failed(status);
-  auto room = output_room(free_bytes(files_.root()), config_);
+  auto room = output_room(files_.free_bytes(), config_);
   if (!room.ok()) return failed(room.status());
-  // The worker program wants its output directory right under the job's.
-  const std::string job_dir = fs::path(out).parent_path().string();
+  const std::string job_dir = files_.job_dir(id);
   WorkerRun run;
   run.executable = executable_;
   run.job_dir = job_dir;
@@ -186,9 +177,9 @@ void ClusterWorkerRole::job_ended(cluster::ClusterConnection& connection,
   }
   const v1::JobRecord& record = *ended;
   const std::string& id = record.job().job_id();
-  const std::string job_dir = absl::StrCat(files_.root(), "/jobs/", id);
+  const std::string job_dir = files_.job_dir(id);
   if (record.deleted()) {
-    fs::remove_all(job_dir, error);
+    files_.remove_job(id);
     (void)connection.jobs->erase(id);
     spdlog::info("job {} deleted by a client once it stopped", id);
     return;

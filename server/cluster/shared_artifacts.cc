@@ -27,8 +27,26 @@ absl::StatusOr<SharedArtifacts> SharedArtifacts::open(const std::string& root) {
   return SharedArtifacts(fs::weakly_canonical(root).string());
 }
 
+std::string SharedArtifacts::job_dir(const std::string& job_id) const {
+  return (fs::path(root_) / "jobs" / job_id).string();
+}
+
 std::string SharedArtifacts::attempt_dir(const std::string& job_id, uint32_t attempt) const {
-  return (fs::path(root_) / "jobs" / job_id / absl::StrCat("out-", attempt)).string();
+  return (fs::path(job_dir(job_id)) / absl::StrCat("out-", attempt)).string();
+}
+
+absl::StatusOr<uint64_t> SharedArtifacts::free_bytes() const {
+  std::error_code error;
+  const fs::space_info space = fs::space(root_, error);
+  if (error)
+    return server::spool_io_error(absl::StrCat("cannot read the free space of ", root_),
+                                  error.value());
+  return space.available;
+}
+
+void SharedArtifacts::remove_job(const std::string& job_id) const {
+  std::error_code ignored;
+  fs::remove_all(job_dir(job_id), ignored);
 }
 
 absl::StatusOr<std::string> SharedArtifacts::resolve(std::string_view relative) const {

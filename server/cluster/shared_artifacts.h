@@ -22,8 +22,12 @@ class SharedArtifacts {
   static absl::StatusOr<SharedArtifacts> open(const std::string& root);
 
   const std::string& root() const { return root_; }
+  // jobs/<job id>, under the root: the job's record, input and attempts.
+  std::string job_dir(const std::string& job_id) const;
   // jobs/<job id>/out-<n> (the layout the worker program expects), under the root.
   std::string attempt_dir(const std::string& job_id, uint32_t attempt) const;
+  // Bytes an unprivileged writer may still use under the root.
+  absl::StatusOr<uint64_t> free_bytes() const;
 
   // Writes `bytes` to `relative` (a path under the root) so that readers
   // see the whole file or none. Errors: INVALID_ARGUMENT for a path that is
@@ -38,6 +42,8 @@ class SharedArtifacts {
   // Removes every attempt directory of `job_id` except `kept`'s; how many
   // went.
   absl::StatusOr<size_t> remove_other_attempts(const std::string& job_id, uint32_t kept) const;
+  // Removes the job's directory and everything in it.
+  void remove_job(const std::string& job_id) const;
 
  private:
   explicit SharedArtifacts(std::string root) : root_(std::move(root)) {}

@@ -23,6 +23,7 @@ class CheckFailed(Exception):
 
 
 def check(condition, message):
+    # Not `assert`: these checks must also hold under `python3 -O`.
     if not condition:
         raise CheckFailed(message)
 

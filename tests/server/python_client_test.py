@@ -10,7 +10,6 @@ import json
 import os
 import re
 import signal
-import socket
 import subprocess
 import sys
 import tempfile
@@ -22,31 +21,14 @@ JOB_SECONDS = 240  # far above a small phantom's few seconds; bounds a hang
 CALL_SECONDS = 30
 STOP_SECONDS = 40
 
-
-class CheckFailed(Exception):
-    pass
-
-
-def check(condition, message):
-    # Not `assert`: these checks must also hold under `python3 -O`.
-    if not condition:
-        raise CheckFailed(message)
-
-
-def free_port():
-    with socket.socket() as sock:
-        sock.bind(("127.0.0.1", 0))
-        return sock.getsockname()[1]
+# The harness the cluster drills share: checks that hold under `python3 -O`,
+# free ports, the Submit stream.
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from cluster_harness import CheckFailed, check, free_port, requests  # noqa: E402
 
 
 def sha256_hex(data):
     return hashlib.sha256(data).hexdigest()
-
-
-def submit_requests(pb, spec, data):
-    yield pb.SubmitRequest(spec=spec)
-    for start in range(0, len(data), CHUNK_BYTES):
-        yield pb.SubmitRequest(chunk=data[start:start + CHUNK_BYTES])
 
 
 def fetch_artifact(stub, pb, job_id, name):
@@ -92,7 +74,7 @@ def run_whole_job(pb, options_pb, stub, volume_path):
     options = options_pb.MeshOptions(surface=options_pb.SURFACE_METHOD_REPAIRED)
     spec = pb.JobSpec(options=options, file_name=os.path.basename(volume_path),
                       size_bytes=len(data), sha256=sha256_hex(data))
-    reply = stub.Submit(submit_requests(pb, spec, data), timeout=CALL_SECONDS)
+    reply = stub.Submit(requests(pb, spec, data), timeout=CALL_SECONDS)
     job_id = reply.job_id
     check(re.fullmatch(r"[0-9a-f]{32}", job_id), f"job id {job_id!r} is not 32 hex digits")
 
@@ -146,7 +128,7 @@ def run_whole_job(pb, options_pb, stub, volume_path):
 def check_errors(grpc, pb, stub, data):
     spec = pb.JobSpec(file_name="sphere.nii.gz", size_bytes=len(data), sha256="0" * 64)
     expect_status(grpc, grpc.StatusCode.INVALID_ARGUMENT,
-                  lambda: stub.Submit(submit_requests(pb, spec, data), timeout=CALL_SECONDS),
+                  lambda: stub.Submit(requests(pb, spec, data), timeout=CALL_SECONDS),
                   "Submit with a wrong sha256")
     expect_status(grpc, grpc.StatusCode.NOT_FOUND,
                   lambda: stub.GetJob(pb.GetJobRequest(job_id="0" * 32), timeout=CALL_SECONDS),
