@@ -16,10 +16,11 @@ void add_pipeline_flags(CLI::App& command, PipelineFlags& flags) {
       ->delimiter(',');
   command
       .add_option("--surface", flags.surface,
-                  "Surface method: mc (Marching Cubes), repaired (MC repaired with CGAL), "
-                  "poisson (repaired MC, then CGAL Poisson reconstruction)")
-      ->check(CLI::IsMember({"mc", "repaired", "poisson"}))
-      ->capture_default_str();
+                  "Surface method: net (the labels' shared surface net smoothed within each "
+                  "voxel, judged against the voxels; the default), mc (Marching Cubes), repaired "
+                  "(MC repaired with CGAL), poisson (repaired MC, then CGAL Poisson "
+                  "reconstruction; the default under --volume tet, mixed or hex)")
+      ->check(CLI::IsMember({"net", "mc", "repaired", "poisson"}));
   auto& poisson = flags.poisson;
   command
       .add_option("--min-angle", poisson.min_angle_deg,
@@ -242,7 +243,9 @@ absl::StatusOr<v1::MeshOptions> to_mesh_options(const PipelineFlags& flags) {
   for (int32_t label : flags.labels) proto.add_labels(label);
   proto.set_surface(flags.surface == "mc"         ? v1::SURFACE_METHOD_MARCHING_CUBES
                     : flags.surface == "repaired" ? v1::SURFACE_METHOD_REPAIRED
-                                                  : v1::SURFACE_METHOD_POISSON);
+                    : flags.surface == "poisson"  ? v1::SURFACE_METHOD_POISSON
+                    : flags.surface == "net"      ? v1::SURFACE_METHOD_NET
+                                                  : v1::SURFACE_METHOD_UNSPECIFIED);
   const auto& poisson = flags.poisson;
   proto.set_min_angle_deg(poisson.min_angle_deg);
   proto.set_max_edge_voxels(poisson.max_edge_voxels);

@@ -18,7 +18,8 @@ namespace labelmesh::client {
 
 struct PipelineFlags {
   std::vector<int32_t> labels;
-  std::string surface = "poisson";
+  // Empty: the job options' default (net, or poisson under a volume mesh).
+  std::string surface;
   PoissonOptions poisson;
   std::string normals = "uniform";
   std::string point_reduction = "grid";

@@ -21,6 +21,13 @@ struct InterfaceSurface {
   // Per triangle: {label behind, label in front}. The triangle's right-hand
   // normal points from sides[0] into sides[1]; the two always differ.
   std::vector<std::array<int32_t, 2>> sides;
+  // Per triangle: the voxels behind and in front, as linear indices into the
+  // padded box (x fastest): which voxel of a label each triangle bounds.
+  std::vector<std::array<uint64_t, 2>> side_voxels;
+  // The padded box's dimensions, and the volume index of its first voxel:
+  // the box holds the selected labels and one voxel more all round.
+  std::array<int64_t, 3> padded_dims{0, 0, 0};
+  std::array<int64_t, 3> padded_first{-1, -1, -1};
 };
 
 }  // namespace labelmesh::conforming

@@ -17,10 +17,12 @@ using geometry::Vec3;
 
 constexpr uint32_t kNoPoint = UINT32_MAX;
 
-// The volume's labels with a ring of outside voxels around them, so every
-// surface closes.
+// The selected labels' box of the volume with a ring of outside voxels
+// around it, so every surface closes.
 struct PaddedLabels {
   std::array<int64_t, 3> dims{0, 0, 0};
+  // Volume index of padded voxel (0, 0, 0).
+  std::array<int64_t, 3> first{-1, -1, -1};
   std::vector<int32_t> labels;
 
   int32_t at(int64_t x, int64_t y, int64_t z) const {
@@ -31,21 +33,45 @@ struct PaddedLabels {
 PaddedLabels padded_labels(const volume::LabelVolume& volume, std::vector<int32_t> selected) {
   std::sort(selected.begin(), selected.end());
   const auto& dims = volume.geometry.dims;
-  PaddedLabels padded;
-  padded.dims = {dims[0] + 2, dims[1] + 2, dims[2] + 2};
-  padded.labels.assign(static_cast<size_t>(padded.dims[0] * padded.dims[1] * padded.dims[2]),
-                       kOutside);
+  const auto chosen = [&](int32_t label) {
+    return label != kOutside &&
+           (selected.empty() || std::binary_search(selected.begin(), selected.end(), label));
+  };
+  // The selected voxels' box, in volume indices.
+  std::array<int64_t, 3> lo{dims[0], dims[1], dims[2]}, hi{-1, -1, -1};
   volume::visit_voxels(volume.voxels, [&](const auto* voxels, size_t count) {
     if (count != static_cast<size_t>(dims[0] * dims[1] * dims[2])) return;
     size_t i = 0;
-    for (int64_t z = 0; z < dims[2]; ++z) {
-      for (int64_t y = 0; y < dims[1]; ++y) {
-        size_t out = static_cast<size_t>(((z + 1) * padded.dims[1] + y + 1) * padded.dims[0] + 1);
-        for (int64_t x = 0; x < dims[0]; ++x, ++i, ++out) {
-          const auto label = static_cast<int32_t>(voxels[i]);
-          if (label == kOutside) continue;
-          if (selected.empty() || std::binary_search(selected.begin(), selected.end(), label))
-            padded.labels[out] = label;
+    for (int64_t z = 0; z < dims[2]; ++z)
+      for (int64_t y = 0; y < dims[1]; ++y)
+        for (int64_t x = 0; x < dims[0]; ++x, ++i) {
+          if (!chosen(static_cast<int32_t>(voxels[i]))) continue;
+          const std::array<int64_t, 3> p{x, y, z};
+          for (int a = 0; a < 3; ++a) {
+            lo[a] = std::min(lo[a], p[a]);
+            hi[a] = std::max(hi[a], p[a]);
+          }
+        }
+  });
+  PaddedLabels padded;
+  if (hi[0] < 0) lo = hi = {0, 0, 0};
+  for (int a = 0; a < 3; ++a) {
+    padded.first[a] = lo[a] - 1;
+    padded.dims[a] = hi[a] - lo[a] + 3;
+  }
+  padded.labels.assign(static_cast<size_t>(padded.dims[0] * padded.dims[1] * padded.dims[2]),
+                       kOutside);
+  if (hi[0] < 0) return padded;
+  volume::visit_voxels(volume.voxels, [&](const auto* voxels, size_t count) {
+    if (count != static_cast<size_t>(dims[0] * dims[1] * dims[2])) return;
+    for (int64_t z = lo[2]; z <= hi[2]; ++z) {
+      for (int64_t y = lo[1]; y <= hi[1]; ++y) {
+        size_t in = static_cast<size_t>((z * dims[1] + y) * dims[0] + lo[0]);
+        size_t out = static_cast<size_t>(
+            ((z - padded.first[2]) * padded.dims[1] + y - padded.first[1]) * padded.dims[0] + 1);
+        for (int64_t x = lo[0]; x <= hi[0]; ++x, ++in, ++out) {
+          const auto label = static_cast<int32_t>(voxels[in]);
+          if (chosen(label)) padded.labels[out] = label;
         }
       }
     }
@@ -70,7 +96,8 @@ struct Net {
   std::vector<uint8_t> label_count;  // distinct labels among the cube's corners
   std::vector<std::array<uint32_t, 4>> quads;
   std::vector<std::array<int32_t, 2>> quad_sides;
-  std::vector<uint8_t> quad_axis;  // the axis between the quad's two voxels
+  std::vector<uint8_t> quad_axis;                    // the axis between the quad's two voxels
+  std::vector<std::array<uint64_t, 2>> quad_voxels;  // padded linear indices
 };
 
 uint8_t distinct_labels(const PaddedLabels& labels, int64_t a, int64_t b, int64_t c) {
@@ -94,9 +121,12 @@ Net build_net(const PaddedLabels& labels, const std::array<double, 3>& spacing, 
         const uint8_t count = distinct_labels(labels, a, b, c);
         if (count < 2) continue;
         cubes.point[cubes.index(a, b, c)] = static_cast<uint32_t>(net.centre.size());
-        // Padded voxel a is voxel a - 1; the cube's centre is half a voxel on.
-        net.centre.push_back(
-            {(a - 0.5) * spacing[0], (b - 0.5) * spacing[1], (c - 0.5) * spacing[2]});
+        // Padded voxel a is voxel a + first; the cube's centre is half a
+        // voxel on.
+        const auto& f = labels.first;
+        net.centre.push_back({(double(a + f[0]) + 0.5) * spacing[0],
+                              (double(b + f[1]) + 0.5) * spacing[1],
+                              (double(c + f[2]) + 0.5) * spacing[2]});
         net.label_count.push_back(count);
       }
     }
@@ -128,6 +158,10 @@ Net build_net(const PaddedLabels& labels, const std::array<double, 3>& spacing, 
           net.quads.push_back(quad);
           net.quad_sides.push_back({behind, front});
           net.quad_axis.push_back(static_cast<uint8_t>(axis));
+          const auto linear = [&](const std::array<int64_t, 3>& v) {
+            return static_cast<uint64_t>((v[2] * labels.dims[1] + v[1]) * labels.dims[0] + v[0]);
+          };
+          net.quad_voxels.push_back({linear(p), linear(q)});
         }
       }
     }
@@ -262,6 +296,7 @@ void subdivide_quads(const std::array<double, 3>& spacing, Net& net, std::vector
 
   std::vector<std::array<uint32_t, 4>> quads;
   std::vector<std::array<int32_t, 2>> sides;
+  std::vector<std::array<uint64_t, 2>> voxels;
   for (size_t q = 0; q < net.quads.size(); ++q) {
     const auto& c = net.quads[q];
     const int ku = parts[(net.quad_axis[q] + 1) % 3];
@@ -285,11 +320,13 @@ void subdivide_quads(const std::array<double, 3>& spacing, Net& net, std::vector
       for (int i = 0; i < ku; ++i) {
         quads.push_back({grid[j][i], grid[j][i + 1], grid[j + 1][i + 1], grid[j + 1][i]});
         sides.push_back(net.quad_sides[q]);
+        voxels.push_back(net.quad_voxels[q]);
       }
     }
   }
   net.quads = std::move(quads);
   net.quad_sides = std::move(sides);
+  net.quad_voxels = std::move(voxels);
   net.quad_axis.clear();
 }
 
@@ -309,11 +346,12 @@ InterfaceSurface label_interfaces(const volume::LabelVolume& volume,
 
   const Stencil stencil = smoothing_stencil(net, figures);
   const double half = 0.5 * params.cube_fraction;
-  const Vec3 half_box{half * geometry.spacing[0], half * geometry.spacing[1],
-                      half * geometry.spacing[2]};
+  const Vec3 half_box{half * geometry.spacing[0] * params.box_scale[0],
+                      half * geometry.spacing[1] * params.box_scale[1],
+                      half * geometry.spacing[2] * params.box_scale[2]};
   std::vector<Vec3> points = net.centre;
   smooth(stencil, net.centre, half_box, params, points);
-  subdivide_quads(geometry.spacing, net, points, net.centre);
+  if (params.subdivide_thick_quads) subdivide_quads(geometry.spacing, net, points, net.centre);
 
   InterfaceSurface surface;
   const auto to_patient = [&](const Vec3& scaled) {
@@ -338,6 +376,9 @@ InterfaceSurface label_interfaces(const volume::LabelVolume& volume,
   const bool mirrored = det < 0;
   surface.triangles.reserve(2 * net.quads.size());
   surface.sides.reserve(2 * net.quads.size());
+  surface.side_voxels.reserve(2 * net.quads.size());
+  surface.padded_dims = padded.dims;
+  surface.padded_first = padded.first;
   for (size_t q = 0; q < net.quads.size(); ++q) {
     const auto& quad = net.quads[q];
     const auto& x = surface.points;
@@ -354,6 +395,7 @@ InterfaceSurface label_interfaces(const volume::LabelVolume& volume,
       if (mirrored) std::swap(triangle[1], triangle[2]);
       surface.triangles.push_back(triangle);
       surface.sides.push_back(net.quad_sides[q]);
+      surface.side_voxels.push_back(net.quad_voxels[q]);
     }
   }
   figures.points = surface.points.size();

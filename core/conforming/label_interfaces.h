@@ -12,6 +12,7 @@
 // Preservation of Sharp Boundaries", J. Computer Graphics Techniques 11(1), 2022.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -24,6 +25,7 @@ namespace labelmesh::conforming {
 struct InterfaceParams {
   // Taubin rounds (a shrinking step and an inflating one each): smooth the
   // staircase without shrinking convex organs the way plain averaging does.
+  // Each step holds every point in its box (cube_fraction).
   int smoothing_rounds = 12;
   double shrink_step = 0.5;
   double inflate_step = -0.53;
@@ -31,6 +33,12 @@ struct InterfaceParams {
   // fraction of half the voxel: below 1, so points of neighbouring cubes
   // never meet.
   double cube_fraction = 0.9;
+  // The box along each axis is this many times cube_fraction's (a grid cut
+  // into thinner slices may let its points move as far as the thick ones').
+  std::array<double, 3> box_scale{1, 1, 1};
+  // Cut each quad on a grid with thicker slices into near-square ones (for
+  // tetrahedra); surfaces keep one quad per voxel face.
+  bool subdivide_thick_quads = true;
 };
 
 struct InterfaceFigures {

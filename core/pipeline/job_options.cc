@@ -17,6 +17,8 @@ v1::SurfaceMethod to_proto(SurfaceMethod method) {
       return v1::SURFACE_METHOD_REPAIRED;
     case SurfaceMethod::kPoisson:
       return v1::SURFACE_METHOD_POISSON;
+    case SurfaceMethod::kNet:
+      return v1::SURFACE_METHOD_NET;
   }
   return v1::SURFACE_METHOD_UNSPECIFIED;
 }
@@ -415,9 +417,12 @@ absl::StatusOr<MeshParams> params_from_options(const v1::MeshOptions& options) {
     case v1::SURFACE_METHOD_REPAIRED:
       params.surface = SurfaceMethod::kRepaired;
       break;
-    case v1::SURFACE_METHOD_UNSPECIFIED:
     case v1::SURFACE_METHOD_POISSON:
       params.surface = SurfaceMethod::kPoisson;
+      break;
+    case v1::SURFACE_METHOD_UNSPECIFIED:
+    case v1::SURFACE_METHOD_NET:
+      params.surface = SurfaceMethod::kNet;
       break;
     default:
       return absl::InvalidArgumentError("surface: unknown surface method");
@@ -425,6 +430,13 @@ absl::StatusOr<MeshParams> params_from_options(const v1::MeshOptions& options) {
   if (auto s = read_poisson_options(options, params.poisson); !s.ok()) return s;
   if (auto s = read_guard_options(options, params.guard); !s.ok()) return s;
   if (auto s = read_volume_options(options, params); !s.ok()) return s;
+  // Per-label tetrahedra and hexahedra want surfaces sized for elements, not
+  // one node per voxel face: unless asked otherwise they mesh Poisson's.
+  const bool element_sized = params.volume == VolumeMethod::kTetgen ||
+                             params.volume == VolumeMethod::kMixed ||
+                             params.volume == VolumeMethod::kHex;
+  if (options.surface() == v1::SURFACE_METHOD_UNSPECIFIED && element_sized)
+    params.surface = SurfaceMethod::kPoisson;
   if (options.formats_size() > kMaxFormatEntries)
     return absl::InvalidArgumentError(
         cat("formats: ", options.formats_size(), " entries; at most ", kMaxFormatEntries));

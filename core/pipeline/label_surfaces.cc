@@ -359,11 +359,11 @@ absl::Status add_label_surfaces(const volume::LabelVolume& volume,
   std::vector<Candidate> candidates;
   // Builds and measures one attempt; `build(i, sizing)` makes piece i.
   auto try_surface =
-      [&](std::string method, double refine,
+      [&](SurfaceAttemptMethod method, double refine,
           const std::function<absl::StatusOr<TriangleMesh>(size_t, const Sizing&)>& build)
       -> absl::Status {
     SurfaceAttempt attempt;
-    attempt.method = std::move(method);
+    attempt.method = method;
     TriangleMesh mesh;
     for (size_t i = 0; i < pieces->meshes.size() && attempt.error.empty(); ++i) {
       const Sizing sizing = sizing_for(params.poisson, label.label, voxel, thickness[i], refine);
@@ -406,7 +406,7 @@ absl::Status add_label_surfaces(const volume::LabelVolume& volume,
   if (to_poisson) {
     const bool fall_back = params.guard.fall_back;
     // The smoothed pieces stay for the finer Poisson attempt.
-    auto poisson_attempt = [&](const char* method, double refine) {
+    auto poisson_attempt = [&](SurfaceAttemptMethod method, double refine) {
       surface::PoissonFigures sum;
       PieceProgress progress(context, "poisson", pieces->meshes);
       auto status = try_surface(
@@ -427,19 +427,19 @@ absl::Status add_label_surfaces(const volume::LabelVolume& volume,
     };
     if (try_poisson) {
       output.poisson.emplace();
-      if (auto s = poisson_attempt("poisson", 1); !s.ok()) return s;
+      if (auto s = poisson_attempt(SurfaceAttemptMethod::kPoisson, 1); !s.ok()) return s;
       // A finer Poisson surface only helps one that was nearly within: on
       // the 61-label TotalSegmentator volume it rescued two labels, both
       // within 1.5 times the tolerance, and never one further out.
       if (fall_back && !delivered() &&
           excess_over(fidelity.attempts.back(), tolerance) <= kRefineWithin) {
-        if (auto s = poisson_attempt("poisson_refined", 0.5); !s.ok()) return s;
+        if (auto s = poisson_attempt(SurfaceAttemptMethod::kPoissonRefined, 0.5); !s.ok()) return s;
       }
     }
     smoothed = {};
     // The label's voxel mask, smoothed, meshed just under one half.
     bool mask_did_not_settle = false;
-    auto mask_attempt = [&](const char* method, double refine) {
+    auto mask_attempt = [&](SurfaceAttemptMethod method, double refine) {
       StageTimer timer(stages, "level_set");
       context.report("level_set", 0);
       return try_surface(
@@ -466,17 +466,18 @@ absl::Status add_label_surfaces(const volume::LabelVolume& volume,
       if (n < 2) return false;
       const SurfaceAttempt& coarse = fidelity.attempts[n - 2];
       const SurfaceAttempt& fine = fidelity.attempts[n - 1];
-      return coarse.method == "mask" && fine.method == "mask_refined" && coarse.error.empty() &&
+      return coarse.method == SurfaceAttemptMethod::kMask &&
+             fine.method == SurfaceAttemptMethod::kMaskRefined && coarse.error.empty() &&
              fine.error.empty() && fine.hausdorff_mm < coarse.hausdorff_mm;
     };
     if (fall_back && !delivered()) {
-      if (auto s = mask_attempt("mask", 1); !s.ok()) return s;
+      if (auto s = mask_attempt(SurfaceAttemptMethod::kMask, 1); !s.ok()) return s;
     }
     // A mask the mesher could not settle on at the label's sizing has a
     // feature no finer sizing resolves, and the finer attempt would spend four
     // times the budget on it.
     if (fall_back && !delivered() && !mask_did_not_settle) {
-      if (auto s = mask_attempt("mask_refined", 0.5); !s.ok()) return s;
+      if (auto s = mask_attempt(SurfaceAttemptMethod::kMaskRefined, 0.5); !s.ok()) return s;
     }
     // Halving again helps a mask surface that the first halving brought
     // closer: a narrow groove that the coarser sizings bridged (brain label 8:
@@ -484,17 +485,18 @@ absl::Status add_label_surfaces(const volume::LabelVolume& volume,
     // so only a surface that stays small gets it.
     if (fall_back && !delivered() && mask_closes_in() &&
         uint64_t(candidates.back().statistics.nodes) * 4 <= kFinestMaskMaxNodes) {
-      if (auto s = mask_attempt("mask_finest", 0.25); !s.ok()) return s;
+      if (auto s = mask_attempt(SurfaceAttemptMethod::kMaskFinest, 0.25); !s.ok()) return s;
     }
     // Last: the repaired surface itself, when nothing smoother was built.
     const bool none_built = std::none_of(fidelity.attempts.begin(), fidelity.attempts.end(),
                                          [](const SurfaceAttempt& a) { return a.error.empty(); });
     if (fall_back && none_built) {
-      if (auto s = try_surface("repaired", 1, repaired_piece); !s.ok()) return s;
+      if (auto s = try_surface(SurfaceAttemptMethod::kRepaired, 1, repaired_piece); !s.ok())
+        return s;
     }
   } else {
     // The repaired surface is the output: measured, not rebuilt.
-    if (auto s = try_surface("repaired", 1, repaired_piece); !s.ok()) return s;
+    if (auto s = try_surface(SurfaceAttemptMethod::kRepaired, 1, repaired_piece); !s.ok()) return s;
   }
   // The first attempt within the tolerance, else the one least outside it.
   fidelity.delivered = fidelity.attempts.size() - 1;
@@ -518,7 +520,7 @@ absl::Status add_label_surfaces(const volume::LabelVolume& volume,
     surfaces.push_back(std::move(output));
     return absl::OkStatus();
   }
-  output.stage = chosen.method;
+  output.stage = method_name(chosen.method);
   output.mesh = std::move(candidates[fidelity.delivered].mesh);
   output.statistics = candidates[fidelity.delivered].statistics;
   output.distance_to_marching_cubes =

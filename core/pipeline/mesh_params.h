@@ -25,6 +25,35 @@ enum class SurfaceMethod {
   kMarchingCubes,  // VTK discrete flying edges; staircase surface (paper §2.2).
   kRepaired,       // Marching Cubes repaired with CGAL ("MC improved", Table 2).
   kPoisson,        // Repaired MC per component, then CGAL Poisson (paper §2.3).
+  // The labels' shared surface net, smoothed within each voxel cube, judged
+  // against the voxels; Poisson for thick labels that touch no other.
+  kNet,
+};
+
+// The shared surface net (SurfaceMethod::kNet): Taubin rounds of a shrinking
+// and an inflating step, each step holding every point within cube_fraction
+// of half a voxel of its staircase position along each axis (Frisken's
+// constrained smoothing). The pass band, 1 / shrink + 1 / inflate, sets the
+// longest ripple removed: the terraces of thick slices are many voxels long.
+struct NetOptions {
+  int smoothing_rounds = 150;
+  double shrink_step = 0.5;
+  double inflate_step = -0.505;
+  // How far a point may leave its staircase position along each axis, as a
+  // fraction of half the voxel: below 1, so no voxel centre changes sides.
+  double cube_fraction = 0.95;
+  // An axis whose spacing is at least thick_ratio times the others' is cut
+  // into slices about thin_ratio times theirs by shape-based interpolation
+  // before the net is made: the net then slopes between the slices instead
+  // of stepping a whole slice at once. 0 turns it off.
+  double thick_ratio = 2.5;
+  double thin_ratio = 1;
+  // At most this many voxels on the thinner grid (fewer parts otherwise).
+  int64_t max_thin_voxels = 48'000'000;
+  // Poisson is tried first on labels touching no other selected label, at
+  // least PoissonOptions::min_thickness_voxels thick, on grids whose largest
+  // spacing is at most this many times the smallest.
+  double poisson_max_anisotropy = 1.5;
 };
 
 // Poisson surface settings. Lengths are in voxels (multiples of the cube root
@@ -128,7 +157,8 @@ struct GuardOptions {
 struct MeshParams {
   // Labels to mesh; empty means every non-zero label in the volume.
   std::vector<int32_t> labels;
-  SurfaceMethod surface = SurfaceMethod::kPoisson;
+  SurfaceMethod surface = SurfaceMethod::kNet;
+  NetOptions net;
   PoissonOptions poisson;
   GuardOptions guard;
   // Surface files to write per label.

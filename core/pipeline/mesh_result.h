@@ -58,8 +58,7 @@ struct ComponentCounts {
 struct SurfaceResult {
   int32_t label = 0;
   // Stage that produced the surface: "marching_cubes", "repaired", or the
-  // delivery guard's method ("poisson", "poisson_refined", "mask",
-  // "mask_refined", "mask_finest").
+  // delivery guard's method (method_name: "net", "poisson", ...).
   std::string stage;
   // True for the stage whose surface is the run's output.
   bool is_output = false;
@@ -76,6 +75,8 @@ struct SurfaceResult {
   // Output stage of the quality surfaces: what the delivery guard tried and
   // measured, and which attempt was delivered.
   std::optional<SurfaceFidelity> fidelity;
+  // Share of the area facing along a voxel axis (surface::axis_aligned_share).
+  std::optional<double> axis_aligned_share;
   // Why the label has no surface when its stages failed (the run goes on).
   std::optional<std::string> error;
   // Files written for it, relative to the output directory.

@@ -12,10 +12,12 @@
 #include <thread>
 
 #include "core/pipeline/label_conforming_mesh.h"
+#include "core/pipeline/label_net_surfaces.h"
 #include "core/pipeline/label_queue.h"
 #include "core/pipeline/label_surfaces.h"
 #include "core/pipeline/volume_layers.h"
 #include "core/surface/extract_surfaces.h"
+#include "core/surface/voxel_fidelity.h"
 #include "core/util/exception_status.h"
 #include "core/util/side_by_side.h"
 #include "core/util/text.h"
@@ -86,9 +88,23 @@ std::vector<LabelWarning> collect_warnings(const std::vector<SurfaceResult>& sur
     if (!s.is_output || !s.fidelity) continue;
     const auto& f = *s.fidelity;
     const auto& a = f.attempts[f.delivered];
-    if (!f.within_tolerance()) {
+    if (!f.within_tolerance() && a.voxels) {
+      const auto& v = *a.voxels;
       warnings.push_back(
-          {s.label, cat("outside tolerance: ", a.method, " surface, volume ",
+          {s.label, cat("outside tolerance: ", method_name(a.method), " surface, volume ",
+                        format_fixed(100 * v.volume_change, 1), " % of the voxels' (tolerance ",
+                        format_fixed(100 * f.tolerance.volume_fraction, 1), " %), ",
+                        v.misclassified, " voxel centres on the wrong side (",
+                        format_fixed(100 * v.misclassified_fraction(), 2), " % of ",
+                        v.boundary_voxels, " boundary voxels; tolerance ",
+                        format_fixed(100 * f.tolerance.misclassified_fraction, 1), " %), farthest ",
+                        format_fixed(v.farthest_misclassified_voxels, 2), " voxel (tolerance ",
+                        format_fixed(f.tolerance.misclassified_reach_voxels, 2), "), Hausdorff ",
+                        format_fixed(v.hausdorff_voxels, 2), " voxel (tolerance ",
+                        format_fixed(f.tolerance.hausdorff_voxels, 2), ")")});
+    } else if (!f.within_tolerance()) {
+      warnings.push_back(
+          {s.label, cat("outside tolerance: ", method_name(a.method), " surface, volume ",
                         format_fixed(100 * a.volume_change, 1), " % (tolerance ",
                         format_fixed(100 * f.tolerance.volume_fraction, 1), " %), Hausdorff ",
                         format_fixed(a.hausdorff_mm, 2), " mm (tolerance ",
@@ -123,15 +139,35 @@ unsigned label_threads(const MeshParams& params, size_t labels) {
 // joined in label order, so the result does not depend on the thread count.
 // A label whose stages fail gets that error and the others go on; a stop, a
 // bad option, or a failure of a label asked for by name ends the run.
+// Each label's delivery tolerance, in the order of `labels`.
+std::vector<SurfaceTolerance> label_tolerances(const volume::ImageGeometry& geometry,
+                                               const VolumeSummary& input,
+                                               const std::vector<int32_t>& labels,
+                                               const GuardOptions& guard) {
+  std::array<double, 3> drawn_spacing;
+  for (int axis = 0; axis < 3; ++axis)
+    drawn_spacing[axis] = geometry.spacing[axis] * input.repeated_planes[axis];
+  std::vector<SurfaceTolerance> tolerances;
+  for (int32_t label : labels) {
+    tolerances.push_back(tolerance_for(input.statistics.find(label)->voxels, drawn_spacing,
+                                       guard.volume_percent, guard.small_volume_percent,
+                                       guard.hausdorff_mm));
+  }
+  return tolerances;
+}
+
 absl::Status add_every_label_surface(const std::vector<volume::LabelVolume>& layers,
                                      const std::vector<size_t>& layer_of,
                                      const VolumeSummary& input, const std::vector<int32_t>& labels,
                                      const MeshParams& params, const RunContext& context,
                                      std::vector<SurfaceResult>& surfaces,
                                      std::vector<StageTiming>& stages) {
-  std::array<double, 3> drawn_spacing;
-  for (int axis = 0; axis < 3; ++axis)
-    drawn_spacing[axis] = layers.front().geometry.spacing[axis] * input.repeated_planes[axis];
+  if (params.surface == SurfaceMethod::kNet) {
+    return add_net_surfaces(layers, layer_of, input.statistics, labels,
+                            label_tolerances(layers.front().geometry, input, labels, params.guard),
+                            params, context, surfaces, stages);
+  }
+  const auto tolerances = label_tolerances(layers.front().geometry, input, labels, params.guard);
   const size_t count = labels.size();
   std::vector<std::vector<SurfaceResult>> label_surfaces(count);
   std::vector<std::vector<StageTiming>> label_stages(count);
@@ -167,10 +203,7 @@ absl::Status add_every_label_surface(const std::vector<volume::LabelVolume>& lay
     while (const auto taken = queue.take()) {
       const size_t i = *taken;
       const auto* statistics = input.statistics.find(labels[i]);
-      const auto& guard = params.guard;
-      const SurfaceTolerance tolerance =
-          tolerance_for(statistics->voxels, drawn_spacing, guard.volume_percent,
-                        guard.small_volume_percent, guard.hausdorff_mm);
+      const SurfaceTolerance& tolerance = tolerances[i];
       RunContext label_context = shared;
       label_context.label = &in_progress[i];
       absl::Status status;
@@ -328,6 +361,11 @@ volume_mesh::ImproveParams improve_params_for(const MeshParams& params,
 
 namespace {
 
+absl::StatusOr<MeshResult> run_on_volume(const std::string& path,
+                                         absl::StatusOr<volume::LabelVolume> volume,
+                                         const MeshParams& params, const RunContext& context,
+                                         MeshResult result);
+
 absl::StatusOr<MeshResult> run_stages(const std::string& path, const MeshParams& params,
                                       const RunContext& context) {
   MeshResult result;
@@ -338,6 +376,14 @@ absl::StatusOr<MeshResult> run_stages(const std::string& path, const MeshParams&
     volume = volume::read_label_volume(path, params.limits, context);
   }
   if (!volume.ok()) return volume.status();
+  return run_on_volume(path, std::move(volume), params, context, std::move(result));
+}
+
+// The stages after reading; `path` names the input in messages.
+absl::StatusOr<MeshResult> run_on_volume(const std::string& path,
+                                         absl::StatusOr<volume::LabelVolume> volume,
+                                         const MeshParams& params, const RunContext& context,
+                                         MeshResult result) {
   if (auto s = check_sizing_for_grid(params.poisson, volume->geometry); !s.ok())
     return absl::InvalidArgumentError(cat(path, ": ", std::string(s.message())));
   const std::vector<volume::LabelVolume> layers = volume_layers(*volume);
@@ -394,6 +440,8 @@ absl::StatusOr<MeshResult> run_stages(const std::string& path, const MeshParams&
       surface.stage = "marching_cubes";
       surface.is_output = !quality;
       surface.statistics = surface::compute_surface_statistics(extracted.mesh);
+      surface.axis_aligned_share =
+          surface::axis_aligned_share(extracted.mesh, layers.front().geometry);
       if (!quality) surface.mesh = std::move(extracted.mesh);
       extracted.mesh = {};
       result.surfaces.push_back(std::move(surface));
@@ -448,6 +496,16 @@ absl::StatusOr<MeshResult> run_pipeline(const std::string& path, const MeshParam
                                         const RunContext& context) {
   try {
     return run_stages(path, params, context);
+  } catch (...) {
+    return current_exception_status("pipeline");
+  }
+}
+
+absl::StatusOr<MeshResult> run_pipeline_on_volume(volume::LabelVolume volume,
+                                                  const MeshParams& params,
+                                                  const RunContext& context) {
+  try {
+    return run_on_volume("the volume", std::move(volume), params, context, MeshResult{});
   } catch (...) {
     return current_exception_status("pipeline");
   }

@@ -31,4 +31,9 @@ volume_mesh::ImproveParams improve_params_for(const MeshParams& params,
 absl::StatusOr<MeshResult> run_pipeline(const std::string& path, const MeshParams& params,
                                         const RunContext& context);
 
+// The same on a volume already in memory (phantoms, tests).
+absl::StatusOr<MeshResult> run_pipeline_on_volume(volume::LabelVolume volume,
+                                                  const MeshParams& params,
+                                                  const RunContext& context);
+
 }  // namespace labelmesh

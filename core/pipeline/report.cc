@@ -192,6 +192,7 @@ void add_quality_figures(const SurfaceResult& surface, v1::SurfaceSummary& entry
     repair->set_holes_filled(r.holes_filled);
   }
   if (surface.error) entry.set_error(*surface.error);
+  if (surface.axis_aligned_share) entry.set_axis_aligned_percent(100 * *surface.axis_aligned_share);
   if (surface.fidelity) {
     const auto& f = *surface.fidelity;
     auto* fidelity = entry.mutable_fidelity();
@@ -199,11 +200,15 @@ void add_quality_figures(const SurfaceResult& surface, v1::SurfaceSummary& entry
     fidelity->set_hausdorff_tolerance_mm(f.tolerance.hausdorff_mm);
     fidelity->set_marching_cubes_volume_mm3(f.marching_cubes_volume_mm3);
     fidelity->set_thickness_voxels(f.thickness_voxels);
+    fidelity->set_misclassified_tolerance_percent(100 * f.tolerance.misclassified_fraction);
+    fidelity->set_misclassified_reach_voxels(f.tolerance.misclassified_reach_voxels);
+    fidelity->set_hausdorff_tolerance_voxels(f.tolerance.hausdorff_voxels);
     fidelity->set_within_tolerance(f.within_tolerance());
-    if (f.delivered < f.attempts.size()) fidelity->set_delivered(f.attempts[f.delivered].method);
+    if (f.delivered < f.attempts.size())
+      fidelity->set_delivered(method_name(f.attempts[f.delivered].method));
     for (const auto& a : f.attempts) {
       auto* attempt = fidelity->add_attempts();
-      attempt->set_method(a.method);
+      attempt->set_method(method_name(a.method));
       attempt->set_max_edge_mm(a.max_edge_mm);
       attempt->set_max_distance_mm(a.max_distance_mm);
       attempt->set_error(a.error);
@@ -213,6 +218,17 @@ void add_quality_figures(const SurfaceResult& surface, v1::SurfaceSummary& entry
       attempt->set_min_angle_deg(a.min_angle_deg);
       attempt->set_max_angle_deg(a.max_angle_deg);
       attempt->set_within_tolerance(a.within_tolerance);
+      if (a.voxels) {
+        const auto& v = *a.voxels;
+        auto* voxels = attempt->mutable_voxels();
+        voxels->set_volume_change_percent(100 * v.volume_change);
+        voxels->set_boundary_voxels(v.boundary_voxels);
+        voxels->set_misclassified(v.misclassified);
+        voxels->set_misclassified_percent(100 * v.misclassified_fraction());
+        voxels->set_farthest_misclassified_voxels(v.farthest_misclassified_voxels);
+        voxels->set_hausdorff_voxels(v.hausdorff_voxels);
+        voxels->set_axis_aligned_percent(100 * v.axis_aligned_share);
+      }
     }
   }
   if (surface.poisson) {

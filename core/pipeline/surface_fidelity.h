@@ -5,24 +5,49 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "core/surface/voxel_fidelity.h"
+
 namespace labelmesh {
 
-// What a surface may differ from its label's Marching Cubes surface (of the
-// kept components) and still be delivered.
+// What a surface may differ from its label and still be delivered. Surfaces
+// measured against the label's voxels (SurfaceAttempt::voxels) are judged by
+// those figures; the others against the label's Marching Cubes surface (of
+// the kept components).
 struct SurfaceTolerance {
-  // |volume change| as a fraction of the Marching Cubes volume.
+  // |volume change| as a fraction of the voxels' volume (or the Marching
+  // Cubes volume).
   double volume_fraction = 0.03;
-  // Symmetric Hausdorff distance, mm.
+  // Symmetric Hausdorff distance to the Marching Cubes surface, mm.
   double hausdorff_mm = 0;
+  // Voxel centres on the wrong side, as a fraction of the label's boundary
+  // voxels, and the farthest any may lie from the surface, voxels.
+  double misclassified_fraction = 0.01;
+  double misclassified_reach_voxels = 0.5;
+  // Hausdorff distance to the voxels' boundary, voxels along each axis.
+  double hausdorff_voxels = 1;
 };
+
+// The surfaces the delivery guard can build, in the order it tries them.
+enum class SurfaceAttemptMethod {
+  kNet,             // the labels' shared surface net, smoothed within each voxel
+  kPoisson,         // repaired Marching Cubes, CGAL Poisson reconstruction
+  kPoissonRefined,  // the same at half the edge and distance bounds
+  kMask,            // the smoothed voxel mask meshed by CGAL just under one half
+  kMaskRefined,     // the same at half the bounds
+  kMaskFinest,      // at a quarter
+  kRepaired,        // the repaired Marching Cubes surface itself
+};
+
+// The method's name in reports and stages ("net", "poisson_refined", ...).
+const char* method_name(SurfaceAttemptMethod method);
 
 // One surface the guard built and measured for a label.
 struct SurfaceAttempt {
-  // poisson, poisson_refined, mask, mask_refined, mask_finest or repaired.
-  std::string method;
+  SurfaceAttemptMethod method = SurfaceAttemptMethod::kNet;
   // Sizing it was built with, mm (the largest over the label's components).
   double max_edge_mm = 0;
   double max_distance_mm = 0;
@@ -35,6 +60,8 @@ struct SurfaceAttempt {
   std::array<double, 3> hausdorff_at{0, 0, 0};
   double min_angle_deg = 0;
   double max_angle_deg = 0;
+  // Against the label's voxels; when set, the verdict rests on these.
+  std::optional<surface::VoxelFidelity> voxels;
   bool within_tolerance = false;
 };
 
@@ -62,11 +89,12 @@ SurfaceTolerance tolerance_for(uint64_t voxels, const std::array<double, 3>& dra
                                double volume_percent, double small_volume_percent,
                                double hausdorff_mm);
 
-// Whether `attempt`'s figures are within `tolerance` (and it was built).
+// Whether `attempt`'s figures are within `tolerance` (and it was built): its
+// voxel figures when it has them, else those against Marching Cubes.
 bool is_within(const SurfaceAttempt& attempt, const SurfaceTolerance& tolerance);
 
-// How far outside the tolerance an attempt is: the larger of its volume change
-// and Hausdorff distance, each over its bound; infinite when it failed. The
+// How far outside the tolerance an attempt is: the largest of its figures,
+// each over its bound (as is_within chooses them); infinite when it failed. The
 // guard delivers the attempt with the least when none is within.
 double excess_over(const SurfaceAttempt& attempt, const SurfaceTolerance& tolerance);
 

@@ -1,0 +1,139 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+#include "core/conforming/net_label_surface.h"
+
+#include <algorithm>
+#include <vector>
+
+#include "core/util/disjoint_sets.h"
+#include "core/util/vec3.h"
+
+namespace labelmesh::conforming {
+namespace {
+
+using geometry::Vec3;
+
+// One triangle's use of one of its edges.
+struct EdgeUse {
+  uint64_t key = 0;    // the edge's two points, lower id first
+  uint64_t voxel = 0;  // the label's voxel the triangle bounds
+  uint32_t triangle = 0;
+};
+
+// The label's voxel centre of a padded linear index, LPS mm.
+Vec3 voxel_centre(uint64_t padded, const InterfaceSurface& net,
+                  const volume::ImageGeometry& geometry) {
+  const auto v = static_cast<int64_t>(padded);
+  const auto& dims = net.padded_dims;
+  const auto& first = net.padded_first;
+  const double x = double(v % dims[0] + first[0]);
+  const double y = double((v / dims[0]) % dims[1] + first[1]);
+  const double z = double(v / (dims[0] * dims[1]) + first[2]);
+  return geometry.to_physical({x, y, z});
+}
+
+}  // namespace
+
+NetLabelSurface net_label_surface(const InterfaceSurface& net, int32_t label,
+                                  const volume::ImageGeometry& geometry) {
+  // The label's triangles, wound outward, and the voxel each bounds.
+  std::vector<std::array<uint32_t, 3>> triangles;
+  std::vector<uint64_t> voxel;
+  for (size_t t = 0; t < net.triangles.size(); ++t) {
+    const auto& sides = net.sides[t];
+    if (sides[0] != label && sides[1] != label) continue;
+    auto triangle = net.triangles[t];
+    // Normals point from sides[0] into sides[1]: outward when the label is
+    // behind.
+    const bool behind = sides[0] == label;
+    if (!behind) std::swap(triangle[1], triangle[2]);
+    triangles.push_back(triangle);
+    voxel.push_back(net.side_voxels[t][behind ? 0 : 1]);
+  }
+  NetLabelSurface result;
+  if (triangles.empty()) return result;
+
+  std::vector<EdgeUse> uses;
+  uses.reserve(3 * triangles.size());
+  for (uint32_t t = 0; t < triangles.size(); ++t) {
+    for (int k = 0; k < 3; ++k) {
+      const uint32_t a = triangles[t][k], b = triangles[t][(k + 1) % 3];
+      const uint64_t key = a < b ? (uint64_t{a} << 32) | b : (uint64_t{b} << 32) | a;
+      uses.push_back({key, voxel[t], t});
+    }
+  }
+  std::sort(uses.begin(), uses.end(), [](const EdgeUse& x, const EdgeUse& y) {
+    return x.key != y.key ? x.key < y.key
+                          : (x.voxel != y.voxel ? x.voxel < y.voxel : x.triangle < y.triangle);
+  });
+  // Corners (3 per triangle) joined across the edges the surface crosses
+  // smoothly: each class is one fan of triangles around a point.
+  geometry::DisjointSets corners(3 * triangles.size());
+  const auto corner = [&](uint32_t t, uint32_t point) {
+    const auto& tri = triangles[t];
+    const int k = tri[0] == point ? 0 : (tri[1] == point ? 1 : 2);
+    return 3 * t + static_cast<uint32_t>(k);
+  };
+  const auto join = [&](uint64_t key, uint32_t t1, uint32_t t2) {
+    const auto a = static_cast<uint32_t>(key >> 32), b = static_cast<uint32_t>(key);
+    corners.unite(corner(t1, a), corner(t2, a));
+    corners.unite(corner(t1, b), corner(t2, b));
+  };
+  for (size_t first = 0; first < uses.size();) {
+    size_t last = first;
+    while (last < uses.size() && uses[last].key == uses[first].key) ++last;
+    if (last - first == 2) {
+      join(uses[first].key, uses[first].triangle, uses[first + 1].triangle);
+    } else {
+      // More than two triangles on one edge: the label's voxels meet only
+      // along it. The two triangles around each voxel stay together.
+      for (size_t i = first + 1; i < last; ++i) {
+        if (uses[i].voxel == uses[i - 1].voxel)
+          join(uses[i].key, uses[i - 1].triangle, uses[i].triangle);
+      }
+    }
+    first = last;
+  }
+
+  // One output point per class; where a net point has several, each copy
+  // moves a little towards the voxels of its own fan.
+  std::vector<uint32_t> class_point(3 * triangles.size(), UINT32_MAX);
+  std::vector<uint32_t> copies(net.points.size(), 0);
+  std::vector<uint32_t> source;  // net point of each output point
+  std::vector<Vec3> voxel_sum;
+  std::vector<uint32_t> voxel_count;
+  auto& mesh = result.mesh;
+  auto& staircase = result.staircase;
+  mesh.triangles.resize(triangles.size());
+  for (uint32_t t = 0; t < triangles.size(); ++t) {
+    const Vec3 centre = voxel_centre(voxel[t], net, geometry);
+    for (int k = 0; k < 3; ++k) {
+      const uint32_t root = corners.find(3 * t + static_cast<uint32_t>(k));
+      if (class_point[root] == UINT32_MAX) {
+        class_point[root] = static_cast<uint32_t>(source.size());
+        source.push_back(triangles[t][k]);
+        ++copies[triangles[t][k]];
+        voxel_sum.push_back({0, 0, 0});
+        voxel_count.push_back(0);
+      }
+      const uint32_t p = class_point[root];
+      mesh.triangles[t][k] = p;
+      voxel_sum[p] = geometry::add(voxel_sum[p], centre);
+      ++voxel_count[p];
+    }
+  }
+  mesh.points.resize(source.size());
+  staircase.points.resize(source.size());
+  for (size_t p = 0; p < source.size(); ++p) {
+    mesh.points[p] = net.points[source[p]];
+    staircase.points[p] = net.staircase[source[p]];
+    if (copies[source[p]] < 2) continue;
+    ++result.split_points;
+    const Vec3 towards = geometry::scale(voxel_sum[p], 1.0 / voxel_count[p]);
+    mesh.points[p] = geometry::add(
+        mesh.points[p], geometry::scale(geometry::sub(towards, mesh.points[p]), kSplitNudge));
+  }
+  staircase.triangles = mesh.triangles;
+  return result;
+}
+
+}  // namespace labelmesh::conforming

@@ -1,0 +1,38 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// One label's closed surface cut out of the labels' shared interface surface
+// (label_interfaces.h): every triangle with the label on one side, wound
+// outward. Touching labels therefore get the same triangles where they meet.
+// Where the label's voxels touch each other only along an edge or at a
+// corner, the point there is split into one copy per voxel and each copy is
+// nudged towards its own voxel, so the surface stays 2-manifold.
+#pragma once
+
+#include <cstdint>
+
+#include "core/conforming/interface_surface.h"
+#include "core/surface/triangle_mesh.h"
+#include "core/volume/image_geometry.h"
+
+namespace labelmesh::conforming {
+
+struct NetLabelSurface {
+  // LPS, mm; outward.
+  surface::TriangleMesh mesh;
+  // The same triangles with every point at its staircase position: the
+  // exact boundary of the label's voxels.
+  surface::TriangleMesh staircase;
+  // Copies made where the label's voxels touch only along an edge or at a
+  // corner.
+  uint32_t split_points = 0;
+};
+
+// How far a split copy moves from the shared point towards the centre of its
+// own voxels, as a fraction of the way.
+inline constexpr double kSplitNudge = 0.1;
+
+// The surface of `label` in `net` (empty when no triangle bounds it).
+// `geometry` is the volume the net was built from.
+NetLabelSurface net_label_surface(const InterfaceSurface& net, int32_t label,
+                                  const volume::ImageGeometry& geometry);
+
+}  // namespace labelmesh::conforming

@@ -1,0 +1,388 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+#include "core/pipeline/label_net_surfaces.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <mutex>
+#include <optional>
+#include <thread>
+
+#include "core/conforming/label_interfaces.h"
+#include "core/conforming/net_label_surface.h"
+#include "core/conforming/thick_slices.h"
+#include "core/pipeline/label_surfaces.h"
+#include "core/surface/surface_checks.h"
+#include "core/surface/surface_statistics.h"
+#include "core/surface/voxel_fidelity.h"
+#include "core/util/text.h"
+
+namespace labelmesh {
+namespace {
+
+conforming::InterfaceParams interface_params(const NetOptions& options) {
+  conforming::InterfaceParams params;
+  params.smoothing_rounds = options.smoothing_rounds;
+  params.shrink_step = options.shrink_step;
+  params.inflate_step = options.inflate_step;
+  params.cube_fraction = options.cube_fraction;
+  params.subdivide_thick_quads = false;
+  return params;
+}
+
+absl::Status check_net_options(const NetOptions& options) {
+  if (options.smoothing_rounds < 0 || options.smoothing_rounds > 2000)
+    return absl::InvalidArgumentError(
+        cat("net smoothing rounds: ", options.smoothing_rounds, " is outside 0..2000"));
+  if (!(options.shrink_step > 0 && options.shrink_step < 1 && options.inflate_step < 0 &&
+        -options.inflate_step < 1))
+    return absl::InvalidArgumentError("net smoothing steps: shrink in (0, 1), inflate in (-1, 0)");
+  if (!(options.thick_ratio >= 0 && options.thin_ratio > 0))
+    return absl::InvalidArgumentError("net thick slices: ratios must be positive");
+  if (!(options.cube_fraction > 0 && options.cube_fraction < 1))
+    return absl::InvalidArgumentError(
+        cat("net cube fraction: ", options.cube_fraction, " is outside (0, 1)"));
+  return absl::OkStatus();
+}
+
+// The labels of `net` that share a triangle with another selected label.
+std::vector<int32_t> touching_labels(const conforming::InterfaceSurface& net) {
+  std::vector<int32_t> touching;
+  for (const auto& sides : net.sides) {
+    if (sides[0] == conforming::kOutside || sides[1] == conforming::kOutside) continue;
+    touching.push_back(sides[0]);
+    touching.push_back(sides[1]);
+  }
+  std::sort(touching.begin(), touching.end());
+  touching.erase(std::unique(touching.begin(), touching.end()), touching.end());
+  return touching;
+}
+
+// Which axis of `geometry` is cut into thinner slices for the net, if any.
+conforming::ThickSlices thick_slices(const volume::ImageGeometry& geometry,
+                                     const NetOptions& options) {
+  if (options.thick_ratio <= 0) return {};
+  conforming::ThickSliceParams params;
+  params.min_ratio = options.thick_ratio;
+  params.thin_ratio = options.thin_ratio;
+  params.max_voxels = options.max_thin_voxels;
+  return conforming::find_thick_slices(geometry, params);
+}
+
+double anisotropy(const volume::ImageGeometry& geometry) {
+  const auto& s = geometry.spacing;
+  return std::max({s[0], s[1], s[2]}) / std::min({s[0], s[1], s[2]});
+}
+
+// What one label's guard made: the delivered surface and the attempts.
+struct LabelOutcome {
+  std::vector<SurfaceResult> surfaces;
+  std::vector<StageTiming> stages;
+  absl::Status status;
+};
+
+class LabelGuard {
+ public:
+  // `net` was made on a grid of `net_geometry` (the layer's, or thinner
+  // slices of it); `staircase`, when set, is the layer's own unsmoothed net.
+  LabelGuard(const volume::LabelVolume& layer, const conforming::InterfaceSurface& net,
+             const volume::ImageGeometry& net_geometry,
+             const conforming::InterfaceSurface* staircase, const volume::LabelStatistics& label,
+             const SurfaceTolerance& tolerance, const MeshParams& params, const RunContext& context,
+             LabelOutcome& outcome)
+      : layer_(layer),
+        net_(net),
+        net_geometry_(net_geometry),
+        staircase_net_(staircase),
+        label_(label),
+        tolerance_(tolerance),
+        params_(params),
+        context_(context),
+        outcome_(outcome) {
+    fidelity_.tolerance = tolerance;
+  }
+
+  absl::Status run(bool poisson_first) {
+    {
+      StageTimer timer(outcome_.stages, "net_label_surface");
+      cut_ = conforming::net_label_surface(net_, label_.label, net_geometry_);
+      if (staircase_net_ != nullptr)
+        voxel_boundary_ =
+            conforming::net_label_surface(*staircase_net_, label_.label, layer_.geometry).staircase;
+    }
+    if (cut_.mesh.triangles.empty())
+      return absl::InternalError(cat("label ", label_.label, ": the surface net has no triangle"));
+    const double voxel = voxel_size_mm(layer_.geometry);
+    const double area = surface::surface_area(cut_.mesh);
+    fidelity_.thickness_voxels =
+        area > 0 ? 3 * std::abs(surface::signed_volume(cut_.mesh)) / area / voxel : 0;
+    const bool fall_back = params_.guard.fall_back;
+    poisson_first =
+        poisson_first && fidelity_.thickness_voxels >= params_.poisson.min_thickness_voxels;
+    if (poisson_first) {
+      if (auto s = try_poisson(); !s.ok()) return s;
+    }
+    if (!delivered()) {
+      Candidate net{cut_.mesh, {}};
+      const auto* corresponding = staircase_net_ == nullptr ? &cut_.staircase : nullptr;
+      if (auto s = measure(SurfaceAttemptMethod::kNet, net, corresponding); !s.ok()) return s;
+    }
+    if (fall_back && !delivered() && !poisson_first) {
+      if (auto s = try_poisson(); !s.ok()) return s;
+    }
+    return deliver();
+  }
+
+ private:
+  struct Candidate {
+    surface::TriangleMesh mesh;
+    surface::SurfaceStatistics statistics;
+  };
+
+  // The exact boundary of the label's voxels.
+  const surface::TriangleMesh& voxel_boundary() const {
+    return staircase_net_ != nullptr ? voxel_boundary_ : cut_.staircase;
+  }
+
+  bool delivered() const {
+    return !fidelity_.attempts.empty() && fidelity_.attempts.back().within_tolerance;
+  }
+
+  // Measures `candidate` against the voxels and keeps it as an attempt.
+  // `corresponding`: the same triangles on the staircase, when it has them.
+  absl::Status measure(SurfaceAttemptMethod method, Candidate& candidate,
+                       const surface::TriangleMesh* corresponding) {
+    StageTimer timer(outcome_.stages, "voxel_fidelity");
+    context_.report("voxel_fidelity", 0);
+    candidate.statistics = surface::compute_surface_statistics(candidate.mesh);
+    auto voxels = surface::measure_voxel_fidelity(candidate.mesh, layer_, label_, context_);
+    if (!voxels.ok()) return voxels.status();
+    voxels->hausdorff_voxels =
+        corresponding != nullptr ? surface::corresponding_hausdorff_voxels(
+                                       candidate.mesh, *corresponding, layer_.geometry)
+                                 : surface::sampled_hausdorff_voxels(
+                                       candidate.mesh, voxel_boundary(), layer_.geometry, context_);
+    if (auto s = context_.check_stop(); !s.ok()) return s;
+    SurfaceAttempt attempt;
+    attempt.method = method;
+    attempt.volume_change = voxels->volume_change;
+    attempt.min_angle_deg = candidate.statistics.min_angle_deg;
+    attempt.max_angle_deg = candidate.statistics.max_angle_deg;
+    attempt.voxels = *voxels;
+    // A surface must also be closed and manifold to be delivered.
+    if (!candidate.statistics.closed || !candidate.statistics.manifold)
+      attempt.error = "the surface is not a closed 2-manifold";
+    attempt.within_tolerance = is_within(attempt, tolerance_);
+    fidelity_.attempts.push_back(std::move(attempt));
+    candidates_.push_back(std::move(candidate));
+    return absl::OkStatus();
+  }
+
+  // The Poisson path (with its own guard against Marching Cubes); its output
+  // is then measured against the voxels like any other attempt.
+  absl::Status try_poisson() {
+    MeshParams poisson = params_;
+    poisson.surface = SurfaceMethod::kPoisson;
+    std::vector<SurfaceResult> made;
+    auto status =
+        add_label_surfaces(layer_, label_, poisson, tolerance_, context_, made, outcome_.stages);
+    if (status.code() == absl::StatusCode::kCancelled) return status;
+    SurfaceResult* output = nullptr;
+    for (auto& s : made)
+      if (s.is_output) output = &s;
+    if (!status.ok() || output == nullptr) {
+      SurfaceAttempt failed;
+      failed.method = SurfaceAttemptMethod::kPoisson;
+      failed.error = status.ok() ? "no surface was left once small components were dropped"
+                                 : std::string(status.message());
+      fidelity_.attempts.push_back(std::move(failed));
+      candidates_.push_back({});
+      return absl::OkStatus();
+    }
+    // The repaired stage before it stays in the report (Table 2's columns).
+    for (auto& s : made)
+      if (!s.is_output) poisson_stages_.push_back(std::move(s));
+    const auto& inner = *output->fidelity;
+    const SurfaceAttemptMethod method = inner.attempts[inner.delivered].method;
+    poisson_figures_ = output->poisson;
+    Candidate candidate{std::move(output->mesh), {}};
+    return measure(method, candidate, nullptr);
+  }
+
+  absl::Status deliver() {
+    size_t best = fidelity_.attempts.size() - 1;
+    if (!fidelity_.attempts.back().within_tolerance) {
+      for (size_t i = 0; i < fidelity_.attempts.size(); ++i) {
+        if (excess_over(fidelity_.attempts[i], tolerance_) <
+            excess_over(fidelity_.attempts[best], tolerance_))
+          best = i;
+      }
+    }
+    fidelity_.delivered = best;
+    const SurfaceAttempt& chosen = fidelity_.attempts[best];
+    SurfaceResult output;
+    output.label = label_.label;
+    output.stage = method_name(chosen.method);
+    output.components = ComponentCounts{};
+    if (!chosen.error.empty() && candidates_[best].mesh.triangles.empty()) {
+      output.error = chosen.error;
+      output.fidelity = std::move(fidelity_);
+      outcome_.surfaces.push_back(std::move(output));
+      return absl::OkStatus();
+    }
+    if (chosen.method != SurfaceAttemptMethod::kNet)
+      for (auto& stage : poisson_stages_) outcome_.surfaces.push_back(std::move(stage));
+    output.mesh = std::move(candidates_[best].mesh);
+    output.statistics = candidates_[best].statistics;
+    output.components->kept = output.statistics.components;
+    output.axis_aligned_share = chosen.voxels->axis_aligned_share;
+    if (chosen.method != SurfaceAttemptMethod::kNet) output.poisson = poisson_figures_;
+    output.fidelity = std::move(fidelity_);
+    output.is_output = true;
+    {
+      StageTimer timer(outcome_.stages, "self_intersections");
+      context_.report("self_intersections", 0);
+      output.self_intersections = surface::count_self_intersections(output.mesh);
+    }
+    outcome_.surfaces.push_back(std::move(output));
+    return absl::OkStatus();
+  }
+
+  const volume::LabelVolume& layer_;
+  const conforming::InterfaceSurface& net_;
+  const volume::ImageGeometry& net_geometry_;
+  const conforming::InterfaceSurface* staircase_net_;
+  const volume::LabelStatistics& label_;
+  const SurfaceTolerance& tolerance_;
+  const MeshParams& params_;
+  const RunContext& context_;
+  LabelOutcome& outcome_;
+  conforming::NetLabelSurface cut_;
+  surface::TriangleMesh voxel_boundary_;
+  SurfaceFidelity fidelity_;
+  std::vector<Candidate> candidates_;
+  std::optional<surface::PoissonFigures> poisson_figures_;
+  // What the Poisson path reported before its output (the repaired stage).
+  std::vector<SurfaceResult> poisson_stages_;
+};
+
+}  // namespace
+
+absl::Status add_net_surfaces(const std::vector<volume::LabelVolume>& layers,
+                              const std::vector<size_t>& layer_of,
+                              const volume::VolumeStatistics& statistics,
+                              const std::vector<int32_t>& labels,
+                              const std::vector<SurfaceTolerance>& tolerance_of,
+                              const MeshParams& params, const RunContext& context,
+                              std::vector<SurfaceResult>& surfaces,
+                              std::vector<StageTiming>& stages) {
+  if (auto s = check_net_options(params.net); !s.ok()) return s;
+  const size_t count = labels.size();
+  // One net per layer, of that layer's selected labels.
+  std::vector<conforming::InterfaceSurface> nets(layers.size());
+  std::vector<volume::ImageGeometry> net_geometry(layers.size());
+  // The layers' own unsmoothed nets, where the net was made on thinner slices.
+  std::vector<std::optional<conforming::InterfaceSurface>> staircases(layers.size());
+  std::vector<bool> poisson_first(count, false);
+  {
+    StageTimer timer(stages, "surface_net");
+    context.report("surface_net", 0);
+    for (size_t layer = 0; layer < layers.size(); ++layer) {
+      std::vector<int32_t> here;
+      for (size_t i = 0; i < count; ++i)
+        if (layer_of[i] == layer) here.push_back(labels[i]);
+      if (here.empty()) continue;
+      conforming::InterfaceFigures figures;
+      const auto cut = thick_slices(layers[layer].geometry, params.net);
+      if (cut.axis < 0) {
+        net_geometry[layer] = layers[layer].geometry;
+        nets[layer] = conforming::label_interfaces(layers[layer], here,
+                                                   interface_params(params.net), figures);
+      } else {
+        absl::StatusOr<volume::LabelVolume> thin;
+        {
+          StageTimer thick_timer(stages, "thick_slices");
+          thin = conforming::interpolate_thick_slices(layers[layer], here, cut, context);
+        }
+        if (!thin.ok()) return thin.status();
+        net_geometry[layer] = thin->geometry;
+        // Points of the thinner grid may move as far as the thick slices'.
+        auto thin_params = interface_params(params.net);
+        thin_params.box_scale[cut.axis] = cut.parts;
+        nets[layer] = conforming::label_interfaces(*thin, here, thin_params, figures);
+        conforming::InterfaceParams flat = interface_params(params.net);
+        flat.smoothing_rounds = 0;
+        staircases[layer] = conforming::label_interfaces(layers[layer], here, flat, figures);
+      }
+      if (auto s = context.check_stop(); !s.ok()) return s;
+      const auto touching = touching_labels(nets[layer]);
+      const bool fine_grid =
+          anisotropy(layers[layer].geometry) <= params.net.poisson_max_anisotropy;
+      for (size_t i = 0; i < count; ++i) {
+        if (layer_of[i] != layer) continue;
+        poisson_first[i] =
+            fine_grid && !std::binary_search(touching.begin(), touching.end(), labels[i]);
+      }
+    }
+    context.report("surface_net", 1);
+  }
+
+  // Progress callbacks expect one caller at a time.
+  std::mutex progress_mutex;
+  RunContext shared = context;
+  if (context.progress) {
+    shared.progress = [&](const ProgressUpdate& update) {
+      std::lock_guard<std::mutex> lock(progress_mutex);
+      context.progress(update);
+    };
+  }
+  std::vector<LabelOutcome> outcomes(count);
+  std::atomic<size_t> next{0};
+  auto work = [&] {
+    for (size_t i = next++; i < count; i = next++) {
+      const auto* label = statistics.find(labels[i]);
+      auto& outcome = outcomes[i];
+      if (label == nullptr) {
+        outcome.status =
+            absl::InvalidArgumentError(cat("label ", labels[i], " is not in the volume"));
+        continue;
+      }
+      try {
+        const size_t layer = layer_of[i];
+        LabelGuard guard(layers[layer], nets[layer], net_geometry[layer],
+                         staircases[layer] ? &*staircases[layer] : nullptr, *label, tolerance_of[i],
+                         params, shared, outcome);
+        outcome.status = guard.run(poisson_first[i]);
+      } catch (const std::bad_alloc&) {
+        outcome.status = absl::ResourceExhaustedError(cat("label ", labels[i], ": out of memory"));
+      }
+    }
+  };
+  unsigned threads = params.threads > 0 ? params.threads : std::thread::hardware_concurrency();
+  threads = static_cast<unsigned>(std::clamp<size_t>(threads, 1, std::max<size_t>(count, 1)));
+  std::vector<std::thread> helpers;
+  for (unsigned t = 1; t < threads; ++t) helpers.emplace_back(work);
+  work();
+  for (auto& helper : helpers) helper.join();
+
+  for (size_t i = 0; i < count; ++i) {
+    auto& outcome = outcomes[i];
+    if (outcome.status.code() == absl::StatusCode::kCancelled ||
+        outcome.status.code() == absl::StatusCode::kInvalidArgument)
+      return outcome.status;
+    if (!outcome.status.ok()) {
+      if (!params.labels.empty()) return outcome.status;
+      SurfaceResult failed;
+      failed.label = labels[i];
+      failed.stage = "net";
+      failed.error = std::string(outcome.status.message());
+      outcome.surfaces = {};
+      outcome.surfaces.push_back(std::move(failed));
+    }
+    for (auto& surface : outcome.surfaces) surfaces.push_back(std::move(surface));
+    for (const auto& stage : outcome.stages) add_stage_time(stages, stage.name, stage.seconds);
+  }
+  return absl::OkStatus();
+}
+
+}  // namespace labelmesh
