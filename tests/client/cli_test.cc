@@ -146,7 +146,7 @@ TEST(Cli, JsonReportOnStdout) {
   ASSERT_EQ(run_cli("phantom torus --out " + (dir / "t.mha").string()).exit_code, 0);
   // Poisson on every label, however thin.
   const CliRun run = run_cli("mesh " + (dir / "t.mha").string() + " --out " + (dir / "o").string() +
-                             " --poisson-min-thickness 0 --json 2>/dev/null");
+                             " --surface poisson --poisson-min-thickness 0 --json 2>/dev/null");
   ASSERT_EQ(run.exit_code, 0);
   v1::Report report;
   ASSERT_TRUE(google::protobuf::util::JsonStringToMessage(run.output, &report).ok()) << run.output;
@@ -210,7 +210,8 @@ TEST(Cli, TetrahedralMeshFilesForSolvers) {
 TEST(Cli, BadPoissonOptionsAreUsageErrors) {
   const auto dir = testing::scratch_dir("cli-poisson-options");
   ASSERT_EQ(run_cli("phantom sphere --out " + (dir / "s.nii").string()).exit_code, 0);
-  const std::string mesh = "mesh " + (dir / "s.nii").string() + " --out " + (dir / "o").string();
+  const std::string mesh =
+      "mesh " + (dir / "s.nii").string() + " --out " + (dir / "o").string() + " --surface poisson";
   const CliRun angle = run_cli(mesh + " --min-angle 35");
   EXPECT_EQ(angle.exit_code, 2);
   EXPECT_NE(angle.output.find("min_angle_deg"), std::string::npos) << angle.output;

@@ -31,9 +31,10 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// The delivered surface of `label` (default Poisson pipeline).
+// The delivered surface of `label` (the Poisson pipeline).
 surface::TriangleMesh delivered_surface(const std::string& path, int32_t label) {
   MeshParams params;
+  params.surface = SurfaceMethod::kPoisson;
   params.labels = {label};
   auto result = run_pipeline(path, params, {});
   EXPECT_TRUE(result.ok()) << result.status();
@@ -260,6 +261,7 @@ TEST(MixedVolumeStage, NestedSpheresConformAndKeepTheirVolume) {
                   volume::make_phantom(volume::PhantomShape::kNestedSpheres).volume, path)
                   .ok());
   MeshParams params;
+  params.surface = SurfaceMethod::kPoisson;
   params.volume = VolumeMethod::kMixed;
   params.hex_size_mm = 2;
   params.volume_formats = {volume_mesh::VolumeFormat::kVtu, volume_mesh::VolumeFormat::kMsh,

@@ -26,6 +26,13 @@
 namespace labelmesh {
 namespace {
 
+// The Poisson path and its guard against Marching Cubes (--surface poisson).
+MeshParams poisson_params() {
+  MeshParams params;
+  params.surface = SurfaceMethod::kPoisson;
+  return params;
+}
+
 using volume::make_phantom;
 using volume::PhantomShape;
 
@@ -55,7 +62,7 @@ const LabelWarning* warning_for(const MeshResult& result, int32_t label) {
 // labels are too small to mesh.
 void expect_every_label_accounted_for(PhantomShape shape, const std::string& name) {
   const auto path = phantom_file(shape, name);
-  auto result = run_pipeline(path, MeshParams{}, RunContext{});
+  auto result = run_pipeline(path, poisson_params(), RunContext{});
   ASSERT_TRUE(result.ok()) << result.status();
   int delivered = 0;
   for (const auto& thin : volume::thin_shapes()) {
@@ -77,7 +84,7 @@ void expect_every_label_accounted_for(PhantomShape shape, const std::string& nam
     EXPECT_TRUE(s->statistics.manifold);
     // The repaired surface is the last resort, with the repair's angles.
     EXPECT_GE(s->statistics.min_angle_deg, s->stage == "repaired" ? 10 : 29.9);
-    EXPECT_EQ(s->stage, chosen.method);
+    EXPECT_EQ(s->stage, method_name(chosen.method));
     ASSERT_TRUE(s->self_intersections.has_value());
     EXPECT_EQ(*s->self_intersections, 0u);
   }
@@ -102,7 +109,7 @@ TEST(DeliveryGuard, ThinShapesOnAnAnisotropicGrid) {
 
 TEST(DeliveryGuard, StrictFailsWhenALabelIsNotDelivered) {
   const auto path = phantom_file(PhantomShape::kThinShapes, "thin-strict.nii.gz");
-  MeshParams params;
+  MeshParams params = poisson_params();
   params.guard.strict = true;
   auto result = run_pipeline(path, params, RunContext{});
   ASSERT_FALSE(result.ok());
@@ -112,7 +119,7 @@ TEST(DeliveryGuard, StrictFailsWhenALabelIsNotDelivered) {
 
 TEST(DeliveryGuard, OneAndTwoVoxelsKeptAreMeshedOrWarned) {
   const auto path = phantom_file(PhantomShape::kThinShapesAnisotropic, "voxels.nii.gz");
-  MeshParams params;
+  MeshParams params = poisson_params();
   params.labels = {9, 10};
   params.poisson.min_component_voxels = 1;
   params.poisson.prune_strands = false;
@@ -132,7 +139,7 @@ TEST(DeliveryGuard, OneAndTwoVoxelsKeptAreMeshedOrWarned) {
 
 TEST(DeliveryGuard, WithoutFallBackASurfaceOutsideToleranceIsWarnedNotHidden) {
   const auto path = phantom_file(PhantomShape::kSphere, "sphere-tight.nii.gz");
-  MeshParams params;
+  MeshParams params = poisson_params();
   params.guard.fall_back = false;
   params.guard.hausdorff_mm = 0.05;  // no smooth surface is that near the staircase
   auto result = run_pipeline(path, params, RunContext{});
@@ -149,7 +156,7 @@ TEST(DeliveryGuard, WithoutFallBackASurfaceOutsideToleranceIsWarnedNotHidden) {
 
 TEST(DeliveryGuard, LabelsInParallelGiveTheSameSurfacesAsOneAtATime) {
   const auto path = phantom_file(PhantomShape::kThinShapes, "thin-threads.nii.gz");
-  MeshParams one, four;
+  MeshParams one = poisson_params(), four = poisson_params();
   one.threads = 1;
   four.threads = 4;
   auto serial = run_pipeline(path, one, RunContext{});
@@ -181,26 +188,26 @@ TEST(DeliveryGuard, ThinLabelsStartWithTheMaskUnlessPoissonIsAskedFor) {
     EXPECT_TRUE(s != nullptr && s->fidelity && !s->fidelity->attempts.empty());
     return s != nullptr && s->fidelity && !s->fidelity->attempts.empty() ? *s : SurfaceResult{};
   };
-  const SurfaceResult by_default = first_attempt(MeshParams{});
+  const SurfaceResult by_default = first_attempt(poisson_params());
   ASSERT_TRUE(by_default.fidelity);
   EXPECT_NEAR(by_default.fidelity->thickness_voxels, 9, 1);
-  EXPECT_EQ(by_default.fidelity->attempts.front().method, "mask");
+  EXPECT_EQ(by_default.fidelity->attempts.front().method, SurfaceAttemptMethod::kMask);
   EXPECT_FALSE(by_default.poisson.has_value());
   EXPECT_TRUE(by_default.fidelity->within_tolerance());
   EXPECT_GE(by_default.statistics.min_angle_deg, 29.99);
 
-  MeshParams everywhere;
+  MeshParams everywhere = poisson_params();
   everywhere.poisson.min_thickness_voxels = 0;
   const SurfaceResult asked = first_attempt(everywhere);
   ASSERT_TRUE(asked.fidelity);
-  EXPECT_EQ(asked.fidelity->attempts.front().method, "poisson");
+  EXPECT_EQ(asked.fidelity->attempts.front().method, SurfaceAttemptMethod::kPoisson);
   EXPECT_TRUE(asked.poisson.has_value());
 
-  MeshParams no_fall_back;
+  MeshParams no_fall_back = poisson_params();
   no_fall_back.guard.fall_back = false;
   const SurfaceResult measured = first_attempt(no_fall_back);
   ASSERT_TRUE(measured.fidelity);
-  EXPECT_EQ(measured.fidelity->attempts.front().method, "poisson");
+  EXPECT_EQ(measured.fidelity->attempts.front().method, SurfaceAttemptMethod::kPoisson);
 }
 
 TEST(DeliveryGuard, TolerancesFollowLabelSizeAndDrawnSpacing) {

@@ -21,6 +21,7 @@ using volume::PhantomShape;
 
 MeshResult mesh_with_tets(const std::string& path, std::vector<int32_t> labels = {}) {
   MeshParams params;
+  params.surface = SurfaceMethod::kPoisson;
   params.labels = std::move(labels);
   params.volume = VolumeMethod::kTetgen;
   auto result = run_pipeline(path, params, RunContext{});

@@ -17,10 +17,17 @@
 namespace labelmesh {
 namespace {
 
+// The Poisson path and its guard against Marching Cubes (--surface poisson).
+MeshParams poisson_params() {
+  MeshParams params;
+  params.surface = SurfaceMethod::kPoisson;
+  return params;
+}
+
 class SharedVolumes : public ::testing::TestWithParam<const char*> {};
 
 TEST_P(SharedVolumes, EveryLabelIsWithinToleranceOrTooSmall) {
-  auto result = run_pipeline(testing::shared_data(GetParam()), MeshParams{}, RunContext{});
+  auto result = run_pipeline(testing::shared_data(GetParam()), poisson_params(), RunContext{});
   ASSERT_TRUE(result.ok()) << result.status();
   std::set<int32_t> too_small;
   for (const auto& warning : result->warnings) {
@@ -60,7 +67,7 @@ INSTANTIATE_TEST_SUITE_P(Files, SharedVolumes,
 // Brain label 8 has a groove that the mask surface bridges at its label's
 // sizing and at half of it; a quarter resolves it.
 TEST(SharedVolumesBrain, ANarrowGrooveGetsTheFinestMaskSurface) {
-  MeshParams params;
+  MeshParams params = poisson_params();
   params.labels = {8};
   auto result =
       run_pipeline(testing::shared_data("iso2mesh_brain_seg_converted.nii.gz"), params, {});

@@ -45,9 +45,9 @@ plain_flags=(--listen "127.0.0.1:$port" --metrics-listen "127.0.0.1:$metrics_por
 start_server "${plain_flags[@]}"
 
 # The liver through the server and in-process: the same report figures.
-"$labelmesh" submit "$data/liver.inr.gz" --labels 255 --out "$work/remote" --json \
+"$labelmesh" submit "$data/liver.inr.gz" --labels 255 --surface poisson --out "$work/remote" --json \
   >"$work/remote.json" || fail "submit of the liver exited $?"
-"$labelmesh" mesh "$data/liver.inr.gz" --labels 255 --out "$work/local" --json \
+"$labelmesh" mesh "$data/liver.inr.gz" --labels 255 --surface poisson --out "$work/local" --json \
   >"$work/local.json" || fail "local mesh of the liver exited $?"
 /usr/bin/python3 - "$work" <<'PY' || fail "remote and local reports differ"
 import json, os, sys

@@ -100,9 +100,15 @@ TEST_F(MeshingServiceTest, WholeJobFromUploadToFetchedArtifacts) {
   for (const auto& surface : report.surfaces()) {
     if (!surface.output()) continue;
     found_output = true;
-    EXPECT_EQ(surface.stage(), "poisson");
+    // By default the shared net, judged against the voxels.
+    EXPECT_EQ(surface.stage(), "net");
     EXPECT_TRUE(surface.closed());
-    EXPECT_GE(surface.min_angle_deg(), 29.9);
+    EXPECT_TRUE(surface.fidelity().within_tolerance());
+    EXPECT_EQ(surface.fidelity()
+                  .attempts(surface.fidelity().attempts_size() - 1)
+                  .voxels()
+                  .misclassified(),
+              0u);
   }
   EXPECT_TRUE(found_output);
 

@@ -48,6 +48,7 @@ const SurfaceResult* find_stage(const MeshResult& result, int32_t label, const s
 // Poisson on every label, however thin: these tests are about Poisson itself.
 MeshParams poisson_everywhere() {
   MeshParams params;
+  params.surface = SurfaceMethod::kPoisson;
   params.poisson.min_thickness_voxels = 0;
   return params;
 }

@@ -1,0 +1,236 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// The default surfaces: labels cut from one shared surface net, closed and
+// manifold each, sharing their interfaces, judged against the voxels; and
+// the voxel figures the guard judges them by.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+#include "core/conforming/label_interfaces.h"
+#include "core/conforming/net_label_surface.h"
+#include "core/pipeline/pipeline.h"
+#include "core/surface/surface_checks.h"
+#include "core/surface/surface_statistics.h"
+#include "core/surface/voxel_fidelity.h"
+#include "core/volume/label_statistics.h"
+#include "core/volume/phantom.h"
+#include "support/analytic_shapes.h"
+#include "support/label_grid.h"
+#include "support/slicer_like.h"
+
+namespace labelmesh {
+namespace {
+
+using surface::TriangleMesh;
+
+conforming::InterfaceSurface staircase_net(const volume::LabelVolume& volume) {
+  conforming::InterfaceParams flat;
+  flat.smoothing_rounds = 0;
+  flat.subdivide_thick_quads = false;
+  conforming::InterfaceFigures figures;
+  return conforming::label_interfaces(volume, {}, flat, figures);
+}
+
+conforming::InterfaceSurface smoothed_net(const volume::LabelVolume& volume) {
+  const NetOptions options;
+  conforming::InterfaceParams params;
+  params.smoothing_rounds = options.smoothing_rounds;
+  params.shrink_step = options.shrink_step;
+  params.inflate_step = options.inflate_step;
+  params.cube_fraction = options.cube_fraction;
+  params.subdivide_thick_quads = false;
+  conforming::InterfaceFigures figures;
+  return conforming::label_interfaces(volume, {}, params, figures);
+}
+
+// Triangles of `a` whose three points are also a triangle of `b` (the same
+// positions, any order).
+size_t shared_triangles(const TriangleMesh& a, const TriangleMesh& b) {
+  using Key = std::array<std::array<double, 3>, 3>;
+  const auto key = [](const TriangleMesh& m, const std::array<uint32_t, 3>& t) {
+    Key k{m.points[t[0]], m.points[t[1]], m.points[t[2]]};
+    std::sort(k.begin(), k.end());
+    return k;
+  };
+  std::map<Key, int> in_b;
+  for (const auto& t : b.triangles) ++in_b[key(b, t)];
+  size_t shared = 0;
+  for (const auto& t : a.triangles) shared += in_b.count(key(a, t));
+  return shared;
+}
+
+// Winding number of `mesh` around p (about 1 inside, 0 outside).
+double winding_number(const TriangleMesh& mesh, const std::array<double, 3>& p) {
+  double total = 0;
+  for (const auto& t : mesh.triangles) {
+    std::array<geometry::Vec3, 3> r;
+    for (int k = 0; k < 3; ++k) r[k] = geometry::sub(mesh.points[t[k]], p);
+    const double la = geometry::norm(r[0]), lb = geometry::norm(r[1]), lc = geometry::norm(r[2]);
+    const double det = geometry::dot(r[0], geometry::cross(r[1], r[2]));
+    const double div = la * lb * lc + geometry::dot(r[0], r[1]) * lc +
+                       geometry::dot(r[1], r[2]) * la + geometry::dot(r[2], r[0]) * lb;
+    total += 2 * std::atan2(det, div);
+  }
+  return total / (4 * M_PI);
+}
+
+TEST(NetLabelSurface, TouchingBoxesShareTheirInterfaceAndStayClosed) {
+  // Box 1 is x 2..5, box 2 is x 6..8; both y and z 2..5: 16 voxel faces meet.
+  const auto volume = testing::label_grid({11, 8, 8}, [](int i, int j, int k) -> uint8_t {
+    if (j < 2 || j > 5 || k < 2 || k > 5) return 0;
+    return i >= 2 && i <= 5 ? 1 : (i >= 6 && i <= 8 ? 2 : 0);
+  });
+  const auto net = smoothed_net(volume);
+  const auto one = conforming::net_label_surface(net, 1, volume.geometry);
+  const auto two = conforming::net_label_surface(net, 2, volume.geometry);
+  for (const auto* s : {&one, &two}) {
+    const auto statistics = surface::compute_surface_statistics(s->mesh);
+    EXPECT_TRUE(statistics.closed);
+    EXPECT_TRUE(statistics.manifold);
+    EXPECT_GT(statistics.volume_mm3, 0);  // outward
+    EXPECT_EQ(s->split_points, 0u);
+    EXPECT_EQ(surface::count_self_intersections(s->mesh), uint64_t{0});
+  }
+  // The 16 shared faces, two triangles each, with the very same points.
+  EXPECT_EQ(shared_triangles(one.mesh, two.mesh), 32u);
+  // The staircase of box 1 encloses its 64 voxels exactly.
+  EXPECT_NEAR(surface::signed_volume(one.staircase), 64.0, 1e-9);
+}
+
+TEST(NetLabelSurface, VoxelsTouchingAlongAnEdgeOrACornerStayManifold) {
+  // Label 1: two voxels meeting along an edge; label 2: two meeting at a corner.
+  const auto volume = testing::label_grid({10, 6, 6}, [](int i, int j, int k) -> uint8_t {
+    if ((i == 1 && j == 1 && k == 2) || (i == 2 && j == 2 && k == 2)) return 1;
+    if ((i == 6 && j == 1 && k == 1) || (i == 7 && j == 2 && k == 2)) return 2;
+    return 0;
+  });
+  const auto net = smoothed_net(volume);
+  for (int32_t label : {1, 2}) {
+    const auto cut = conforming::net_label_surface(net, label, volume.geometry);
+    const auto statistics = surface::compute_surface_statistics(cut.mesh);
+    EXPECT_TRUE(statistics.closed) << label;
+    EXPECT_TRUE(statistics.manifold) << label;
+    EXPECT_EQ(statistics.components, 2u) << label;
+    EXPECT_GT(cut.split_points, 0u) << label;
+    EXPECT_EQ(surface::count_self_intersections(cut.mesh), uint64_t{0}) << label;
+  }
+}
+
+TEST(VoxelFidelity, TheStaircaseIsExactAndAShrunkCopyIsNot) {
+  const auto phantom = volume::make_phantom(volume::PhantomShape::kSphere);
+  const auto& v = phantom.volume;
+  const auto statistics = volume::compute_label_statistics(v);
+  const auto cut = conforming::net_label_surface(staircase_net(v), 1, v.geometry);
+  auto exact = surface::measure_voxel_fidelity(cut.staircase, v, statistics.labels.front(), {});
+  ASSERT_TRUE(exact.ok()) << exact.status();
+  EXPECT_NEAR(exact->volume_change, 0, 1e-9);
+  EXPECT_EQ(exact->misclassified, 0u);
+  EXPECT_GT(exact->boundary_voxels, 1000u);
+  EXPECT_EQ(surface::corresponding_hausdorff_voxels(cut.staircase, cut.staircase, v.geometry), 0);
+  // A sphere of radius 20 voxels whose surface moves in by a whole voxel:
+  // every boundary voxel's centre falls outside it.
+  TriangleMesh shrunk = cut.staircase;
+  for (auto& p : shrunk.points)
+    for (int k = 0; k < 3; ++k)
+      p[k] = phantom.centre[k] + (p[k] - phantom.centre[k]) * (19.5 / 20.5);
+  auto wrong = surface::measure_voxel_fidelity(shrunk, v, statistics.labels.front(), {});
+  ASSERT_TRUE(wrong.ok());
+  EXPECT_LT(wrong->volume_change, -0.1);
+  EXPECT_GT(wrong->misclassified_fraction(), 0.5);
+  EXPECT_GT(wrong->farthest_misclassified_voxels, 0.3);
+  EXPECT_GT(surface::sampled_hausdorff_voxels(shrunk, cut.staircase, v.geometry, {}), 0.9);
+}
+
+TEST(VoxelFidelity, AxisAlignedShareOfAStaircaseAndOfABall) {
+  const auto phantom = volume::make_phantom(volume::PhantomShape::kSphere);
+  const auto& v = phantom.volume;
+  const auto cut = conforming::net_label_surface(staircase_net(v), 1, v.geometry);
+  EXPECT_DOUBLE_EQ(surface::axis_aligned_share(cut.staircase, v.geometry), 1.0);
+  const auto net = conforming::net_label_surface(smoothed_net(v), 1, v.geometry);
+  EXPECT_LT(surface::axis_aligned_share(net.mesh, v.geometry), 0.15);
+}
+
+const SurfaceResult* output_of(const MeshResult& result, int32_t label) {
+  for (const auto& s : result.surfaces)
+    if (s.label == label && s.is_output) return &s;
+  return nullptr;
+}
+
+TEST(NetSurfaces, NestedLabelsShareTheirInterfacesWithoutOverlap) {
+  auto result = run_pipeline_on_volume(
+      volume::make_phantom(volume::PhantomShape::kNestedSpheres).volume, MeshParams{}, {});
+  ASSERT_TRUE(result.ok()) << result.status();
+  EXPECT_TRUE(result->warnings.empty());
+  std::map<int32_t, const SurfaceResult*> out;
+  for (int32_t label : {1, 2, 3}) {
+    out[label] = output_of(*result, label);
+    ASSERT_NE(out[label], nullptr);
+    const auto& s = *out[label];
+    EXPECT_EQ(s.stage, "net");
+    EXPECT_TRUE(s.fidelity->within_tolerance());
+    EXPECT_TRUE(s.statistics.closed);
+    EXPECT_TRUE(s.statistics.manifold);
+    EXPECT_EQ(s.self_intersections, uint64_t{0});
+    const auto& voxels = *s.fidelity->attempts[s.fidelity->delivered].voxels;
+    EXPECT_EQ(voxels.misclassified, 0u);
+    EXPECT_LE(voxels.hausdorff_voxels, 1.0);
+    // Marching Cubes puts a node on each voxel face; the net one in each
+    // cube, two more per closed component (Euler).
+    for (const auto& mc : result->surfaces)
+      if (mc.label == label && mc.stage == "marching_cubes")
+        EXPECT_LE(s.statistics.nodes, mc.statistics.nodes + 2 * s.statistics.components);
+  }
+  // Ball 1 sits in shell 2: every triangle of 1 is also one of 2's.
+  EXPECT_EQ(shared_triangles(out[1]->mesh, out[2]->mesh), out[1]->mesh.triangles.size());
+  // No node of the shell lies more than 0.1 voxel inside the ball.
+  const auto& ball = out[1]->mesh;
+  size_t inside = 0;
+  for (const auto& p : out[2]->mesh.points) {
+    if (winding_number(ball, p) < 0.5) continue;
+    // On the shared interface the node is the ball's own: not inside.
+    const bool on_ball =
+        std::any_of(ball.points.begin(), ball.points.end(), [&](const auto& q) { return q == p; });
+    if (!on_ball) ++inside;
+  }
+  EXPECT_EQ(inside, 0u);
+}
+
+// Analytic shapes on the grids hospitals send: closer to the true surface,
+// with truer normals, than the Slicer-like pipeline on the same volume.
+TEST(NetSurfaces, ThickSliceShapesAreTruerThanTheSlicerLikePipeline) {
+  const std::vector<testing::AnalyticShape> shapes{
+      testing::sphere_shape(25), testing::ellipsoid_shape(32, 22, 15), testing::torus_shape(25, 9)};
+  for (const auto& shape : shapes) {
+    const auto v = testing::sample_shape(shape, {0.6, 0.6, 4});
+    const auto statistics = volume::compute_label_statistics(v);
+    const auto slicer = testing::slicer_like_surfaces(v, statistics, {1});
+    ASSERT_EQ(slicer.size(), 1u);
+    auto result = run_pipeline_on_volume(v, MeshParams{}, {});
+    ASSERT_TRUE(result.ok()) << result.status();
+    const auto* ours = output_of(*result, 1);
+    ASSERT_NE(ours, nullptr);
+    EXPECT_EQ(ours->stage, "net") << shape.name;
+    const auto mine = testing::shape_error(ours->mesh, shape);
+    const auto theirs = testing::shape_error(slicer.front().mesh, shape);
+    EXPECT_LT(mine.rms_mm, theirs.rms_mm) << shape.name;
+    EXPECT_LT(mine.normal_p95_deg, theirs.normal_p95_deg) << shape.name;
+    // Within 0.15 of the thick spacing of the true surface.
+    EXPECT_LT(mine.rms_mm, 0.15 * 4) << shape.name;
+  }
+}
+
+TEST(NetSurfaces, CoarseIsotropicSphereIsWithinAQuarterVoxel) {
+  const auto shape = testing::sphere_shape(25);
+  auto result = run_pipeline_on_volume(testing::sample_shape(shape, {3, 3, 3}), MeshParams{}, {});
+  ASSERT_TRUE(result.ok()) << result.status();
+  const auto* ours = output_of(*result, 1);
+  ASSERT_NE(ours, nullptr);
+  const auto error = testing::shape_error(ours->mesh, shape);
+  EXPECT_LT(error.rms_mm, 0.25 * 3);
+  EXPECT_LT(error.normal_p95_deg, 10);
+}
+
+}  // namespace
+}  // namespace labelmesh
