@@ -1,0 +1,257 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// Smooth surfaces beside a Slicer-like VTK pipeline (tests/support/slicer_like.h),
+// in one run:
+//   phantoms   analytic shapes on coarse, anisotropic and oblique grids: RMS
+//              distance and 95th-percentile normal error against the true
+//              surface, for Marching Cubes, the Slicer-like surface and ours;
+//   volumes    every shared multi-label volume: the time of all labels'
+//              surfaces (both pipelines alternating, from reading the file),
+//              the axis-aligned area share per label (median), and how many
+//              labels each pipeline keeps within the voxel tolerance.
+// Usage: labelmesh_surface_bench [phantoms|volumes|all] [ROUNDS] [FILE ...]
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "core/conforming/label_interfaces.h"
+#include "core/conforming/net_label_surface.h"
+#include "core/pipeline/pipeline.h"
+#include "core/surface/voxel_fidelity.h"
+#include "core/surface/write_surface.h"
+#include "core/volume/label_statistics.h"
+#include "core/volume/read_label_volume.h"
+#include "support/analytic_shapes.h"
+#include "support/slicer_like.h"
+
+using namespace labelmesh;
+using labelmesh::testing::AnalyticShape;
+
+namespace {
+
+double seconds_of(const std::function<void()>& f) {
+  const auto start = std::chrono::steady_clock::now();
+  f();
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0;
+  std::sort(v.begin(), v.end());
+  const size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+// Default options, or the net's from LABELMESH_NET_ROUNDS, _INFLATE, _CUBE
+// and _THICK, and with LABELMESH_NET_ONLY the net alone (for tuning).
+MeshParams our_params() {
+  MeshParams params;
+  if (const char* v = std::getenv("LABELMESH_NET_ROUNDS"))
+    params.net.smoothing_rounds = std::atoi(v);
+  if (const char* v = std::getenv("LABELMESH_NET_INFLATE")) params.net.inflate_step = std::atof(v);
+  if (std::getenv("LABELMESH_NET_ONLY")) {
+    params.net.poisson_max_anisotropy = 0;
+    params.guard.fall_back = false;
+  }
+  if (const char* v = std::getenv("LABELMESH_NET_CUBE")) params.net.cube_fraction = std::atof(v);
+  if (const char* v = std::getenv("LABELMESH_NET_THICK")) params.net.thick_ratio = std::atof(v);
+  return params;
+}
+
+// Our delivered surface of label 1, and its method.
+surface::TriangleMesh our_surface(const volume::LabelVolume& volume, std::string& method) {
+  auto result = run_pipeline_on_volume(volume, our_params(), RunContext{});
+  if (!result.ok()) {
+    std::printf("  ours failed: %s\n", std::string(result.status().message()).c_str());
+    return {};
+  }
+  for (auto& s : result->surfaces)
+    if (s.is_output && s.label == 1) {
+      method = s.stage;
+      return std::move(s.mesh);
+    }
+  return {};
+}
+
+int bench_phantoms() {
+  struct Grid {
+    const char* name;
+    std::array<double, 3> spacing;
+    double degrees;
+  };
+  const std::vector<Grid> grids{{"3 mm", {3, 3, 3}, 0},
+                                {"1x1x3 mm", {1, 1, 3}, 0},
+                                {"0.6x0.6x4 mm", {0.6, 0.6, 4}, 0},
+                                {"1x1x3 mm oblique", {1, 1, 3}, 25}};
+  const std::vector<AnalyticShape> shapes{
+      testing::sphere_shape(25), testing::ellipsoid_shape(32, 22, 15), testing::torus_shape(25, 9),
+      testing::torus_shape(25, 4.5, "thin tube")};
+  std::printf("%-10s %-18s | %-22s | %-22s | %-22s | %s\n", "shape", "grid", "MC rms mm / p95 deg",
+              "Slicer-like", "ours", "ours / smallest spacing, method");
+  int failures = 0;
+  for (const auto& grid : grids) {
+    const double smallest = *std::min_element(grid.spacing.begin(), grid.spacing.end());
+    for (const auto& shape : shapes) {
+      const auto volume = testing::sample_shape(shape, grid.spacing, grid.degrees);
+      const auto statistics = volume::compute_label_statistics(volume);
+      auto mc = surface::extract_surfaces(volume, statistics, {1}, RunContext{});
+      const auto slicer = testing::slicer_like_surfaces(volume, statistics, {1});
+      std::string method;
+      const auto ours = our_surface(volume, method);
+      if (!mc.ok() || slicer.empty() || ours.triangles.empty()) {
+        ++failures;
+        continue;
+      }
+      // LABELMESH_BENCH_OUT=DIR keeps the three surfaces as STL, to look at.
+      if (const char* out = std::getenv("LABELMESH_BENCH_OUT")) {
+        std::string stem = std::string(out) + "/" + shape.name + "-" + grid.name;
+        std::replace(stem.begin() + static_cast<long>(std::strlen(out)), stem.end(), ' ', '_');
+        (void)surface::write_surface(mc->front().mesh, stem + "-mc.stl",
+                                     surface::SurfaceFormat::kStl);
+        (void)surface::write_surface(slicer.front().mesh, stem + "-slicer.stl",
+                                     surface::SurfaceFormat::kStl);
+        (void)surface::write_surface(ours, stem + "-ours.stl", surface::SurfaceFormat::kStl);
+      }
+      const auto e_mc = testing::shape_error(mc->front().mesh, shape);
+      const auto e_slicer = testing::shape_error(slicer.front().mesh, shape);
+      const auto e_ours = testing::shape_error(ours, shape);
+      std::printf("%-10s %-18s | %8.3f / %8.1f   | %8.3f / %8.1f   | %8.3f / %8.1f   | %.2f %s\n",
+                  shape.name.c_str(), grid.name, e_mc.rms_mm, e_mc.normal_p95_deg, e_slicer.rms_mm,
+                  e_slicer.normal_p95_deg, e_ours.rms_mm, e_ours.normal_p95_deg,
+                  e_ours.rms_mm / smallest, method.c_str());
+    }
+  }
+  return failures;
+}
+
+struct VolumeFigures {
+  std::vector<double> ours_share, slicer_share, mc_share;  // labels >= 1000 voxels
+  // The Slicer-like surfaces against the voxels, per label.
+  std::vector<double> slicer_misclassified, slicer_hausdorff, slicer_volume;
+  int labels = 0, ours_within = 0, slicer_within = 0, ours_within_slicer_plus5 = 0;
+  double ours_min_angle = 180;
+  int ours_poisson = 0;
+};
+
+int bench_volume(const std::string& path, int rounds) {
+  std::printf("\n%s\n", path.c_str());
+  // Time: both pipelines from the file to every label's surface, alternating.
+  std::vector<double> ours_s, slicer_s;
+  absl::StatusOr<MeshResult> result;
+  std::vector<surface::LabelSurface> slicer;
+  for (int r = 0; r < rounds; ++r) {
+    ours_s.push_back(seconds_of([&] { result = run_pipeline(path, our_params(), RunContext{}); }));
+    slicer_s.push_back(seconds_of([&] {
+      auto volume = volume::read_label_volume(path, {}, RunContext{});
+      if (!volume.ok()) return;
+      const auto statistics = volume::compute_label_statistics(*volume);
+      std::vector<int32_t> labels;
+      for (const auto& l : statistics.labels) labels.push_back(l.label);
+      slicer = testing::slicer_like_surfaces(*volume, statistics, labels);
+    }));
+  }
+  if (!result.ok()) {
+    std::printf("  ours failed: %s\n", std::string(result.status().message()).c_str());
+    return 1;
+  }
+  std::vector<double> ratios;
+  for (int r = 0; r < rounds; ++r) ratios.push_back(ours_s[r] / slicer_s[r]);
+  std::printf(
+      "  seconds, median of %d alternating: ours %.2f, Slicer-like %.2f, ratio %.2f "
+      "(pairs %.2f-%.2f)\n",
+      rounds, median(ours_s), median(slicer_s), median(ratios),
+      *std::min_element(ratios.begin(), ratios.end()),
+      *std::max_element(ratios.begin(), ratios.end()));
+
+  // The Slicer-like surfaces measured as ours are, against the voxels.
+  auto volume = volume::read_label_volume(path, {}, RunContext{});
+  if (!volume.ok()) return 1;
+  const auto statistics = volume::compute_label_statistics(*volume);
+  conforming::InterfaceParams flat;
+  flat.smoothing_rounds = 0;
+  flat.subdivide_thick_quads = false;
+  conforming::InterfaceFigures figures;
+  std::vector<int32_t> labels;
+  for (const auto& l : statistics.labels) labels.push_back(l.label);
+  const auto staircase = conforming::label_interfaces(*volume, labels, flat, figures);
+  VolumeFigures f;
+  for (size_t i = 0; i < labels.size() && i < slicer.size(); ++i) {
+    const auto* label = statistics.find(labels[i]);
+    const SurfaceResult* ours = nullptr;
+    const SurfaceResult* mc = nullptr;
+    for (const auto& s : result->surfaces) {
+      if (s.label != labels[i]) continue;
+      if (s.is_output) ours = &s;
+      if (s.stage == "marching_cubes") mc = &s;
+    }
+    if (ours == nullptr || !ours->fidelity) continue;
+    ++f.labels;
+    const auto& chosen = ours->fidelity->attempts[ours->fidelity->delivered];
+    if (chosen.within_tolerance) ++f.ours_within;
+    if (ours->stage.rfind("poisson", 0) == 0) ++f.ours_poisson;
+    f.ours_min_angle = std::min(f.ours_min_angle, ours->statistics.min_angle_deg);
+    if (const char* out = std::getenv("LABELMESH_BENCH_OUT")) {
+      const std::string stem = std::string(out) + "/label" + std::to_string(labels[i]);
+      (void)surface::write_surface(slicer[i].mesh, stem + "-slicer.stl",
+                                   surface::SurfaceFormat::kStl);
+      (void)surface::write_surface(ours->mesh, stem + "-ours.stl", surface::SurfaceFormat::kStl);
+    }
+    auto slicer_voxels = surface::measure_voxel_fidelity(slicer[i].mesh, *volume, *label, {});
+    if (!slicer_voxels.ok()) continue;
+    const auto cut = conforming::net_label_surface(staircase, labels[i], volume->geometry);
+    slicer_voxels->hausdorff_voxels = surface::sampled_hausdorff_voxels(
+        slicer[i].mesh, cut.staircase, volume->geometry, RunContext{});
+    f.slicer_misclassified.push_back(100 * slicer_voxels->misclassified_fraction());
+    f.slicer_hausdorff.push_back(slicer_voxels->hausdorff_voxels);
+    f.slicer_volume.push_back(100 * std::abs(slicer_voxels->volume_change));
+    SurfaceAttempt attempt;
+    attempt.voxels = *slicer_voxels;
+    if (is_within(attempt, ours->fidelity->tolerance)) ++f.slicer_within;
+    if (label->voxels < 1000) continue;
+    const double our_share = ours->axis_aligned_share.value_or(1);
+    f.ours_share.push_back(our_share);
+    f.slicer_share.push_back(slicer_voxels->axis_aligned_share);
+    if (mc && mc->axis_aligned_share) f.mc_share.push_back(*mc->axis_aligned_share);
+    if (our_share <= slicer_voxels->axis_aligned_share + 0.05) ++f.ours_within_slicer_plus5;
+  }
+  std::printf(
+      "  labels %d: within the voxel tolerance ours %d, Slicer-like %d; ours by Poisson %d; "
+      "ours min angle %.1f deg\n",
+      f.labels, f.ours_within, f.slicer_within, f.ours_poisson, f.ours_min_angle);
+  std::printf(
+      "  Slicer-like against the voxels, median over labels: misclassified %.2f %% of boundary "
+      "voxels, Hausdorff %.2f voxels, |volume change| %.2f %%\n",
+      median(f.slicer_misclassified), median(f.slicer_hausdorff), median(f.slicer_volume));
+  std::printf(
+      "  axis-aligned share, median over %zu labels >= 1000 voxels: MC %.1f %%, "
+      "Slicer-like %.1f %%, ours %.1f %%; ours within Slicer-like + 5 points: %d\n",
+      f.ours_share.size(), 100 * median(f.mc_share), 100 * median(f.slicer_share),
+      100 * median(f.ours_share), f.ours_within_slicer_plus5);
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const std::string what = argc > 1 ? argv[1] : "all";
+  const int rounds = argc > 2 ? std::max(1, std::atoi(argv[2])) : 3;
+  std::vector<std::string> files;
+  for (int i = 3; i < argc; ++i) files.push_back(argv[i]);
+  if (files.empty()) {
+    const std::string data = LABELMESH_SHARED_DATA;
+    for (const char* name :
+         {"totalseg_example_seg_dicom.nii.gz", "totalseg_example_seg_fast_force_split.nii.gz",
+          "totalseg_example_seg_mr.nii.gz", "MRIcrop-seg_converted.nii.gz",
+          "msd_prostate_mask_00.nii", "iso2mesh_brain_seg_converted.nii.gz", "frogtissue.mhd"})
+      files.push_back(data + "/" + name);
+  }
+  int failures = 0;
+  if (what == "phantoms" || what == "all") failures += bench_phantoms();
+  if (what == "volumes" || what == "all")
+    for (const auto& f : files) failures += bench_volume(f, rounds);
+  return failures == 0 ? 0 : 1;
+}
