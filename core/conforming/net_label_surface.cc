@@ -17,7 +17,84 @@ struct EdgeUse {
   uint64_t key = 0;    // the edge's two points, lower id first
   uint64_t voxel = 0;  // the label's voxel the triangle bounds
   uint32_t triangle = 0;
+  bool forward = false;  // the triangle runs the edge from the lower id
 };
+
+// The corner (3 t + k) of triangle t at `point`.
+uint32_t corner_at(const std::vector<std::array<uint32_t, 3>>& triangles, uint32_t t,
+                   uint32_t point) {
+  const auto& tri = triangles[t];
+  const int k = tri[0] == point ? 0 : (tri[1] == point ? 1 : 2);
+  return 3 * t + static_cast<uint32_t>(k);
+}
+
+// Corners (3 per triangle) joined across the edges the surface crosses
+// smoothly: each class is one fan of triangles around a point. On an edge of
+// more than two triangles (the label's voxels meet only along it) the two
+// triangles around each voxel stay together, except on the edges in
+// `connect`, where each voxel's triangle joins the other voxel's that runs
+// the edge the other way. `uses` is sorted by edge, then voxel.
+geometry::DisjointSets fan_classes(const std::vector<std::array<uint32_t, 3>>& triangles,
+                                   const std::vector<EdgeUse>& uses,
+                                   const std::vector<uint64_t>& connect) {
+  geometry::DisjointSets corners(3 * triangles.size());
+  const auto join = [&](uint64_t key, uint32_t t1, uint32_t t2) {
+    const auto a = static_cast<uint32_t>(key >> 32), b = static_cast<uint32_t>(key);
+    corners.unite(corner_at(triangles, t1, a), corner_at(triangles, t2, a));
+    corners.unite(corner_at(triangles, t1, b), corner_at(triangles, t2, b));
+  };
+  for (size_t first = 0; first < uses.size();) {
+    size_t last = first;
+    const uint64_t key = uses[first].key;
+    while (last < uses.size() && uses[last].key == key) ++last;
+    if (last - first == 2) {
+      join(key, uses[first].triangle, uses[first + 1].triangle);
+    } else if (last - first == 4 && std::binary_search(connect.begin(), connect.end(), key)) {
+      // Two voxels, two triangles each: join across the voxels.
+      for (size_t i = first; i < first + 2; ++i)
+        for (size_t j = first + 2; j < last; ++j)
+          if (uses[i].forward != uses[j].forward) join(key, uses[i].triangle, uses[j].triangle);
+    } else {
+      for (size_t i = first + 1; i < last; ++i) {
+        if (uses[i].voxel == uses[i - 1].voxel) join(key, uses[i - 1].triangle, uses[i].triangle);
+      }
+    }
+    first = last;
+  }
+  return corners;
+}
+
+// The net edges (keys) whose triangles still share one edge of output points
+// three or more times once each fan class is its own point.
+std::vector<uint64_t> edges_used_more_than_twice(
+    const std::vector<std::array<uint32_t, 3>>& triangles, geometry::DisjointSets& corners) {
+  struct Use {
+    uint64_t classes;
+    uint64_t key;
+  };
+  std::vector<Use> used;
+  used.reserve(3 * triangles.size());
+  for (uint32_t t = 0; t < triangles.size(); ++t) {
+    for (uint32_t k = 0; k < 3; ++k) {
+      const uint32_t ca = corners.find(3 * t + k), cb = corners.find(3 * t + (k + 1) % 3);
+      const uint32_t a = triangles[t][k], b = triangles[t][(k + 1) % 3];
+      used.push_back({ca < cb ? (uint64_t{ca} << 32) | cb : (uint64_t{cb} << 32) | ca,
+                      a < b ? (uint64_t{a} << 32) | b : (uint64_t{b} << 32) | a});
+    }
+  }
+  std::sort(used.begin(), used.end(),
+            [](const Use& x, const Use& y) { return x.classes < y.classes; });
+  std::vector<uint64_t> keys;
+  for (size_t first = 0; first < used.size();) {
+    size_t last = first;
+    while (last < used.size() && used[last].classes == used[first].classes) ++last;
+    if (last - first > 2) keys.push_back(used[first].key);
+    first = last;
+  }
+  std::sort(keys.begin(), keys.end());
+  keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+  return keys;
+}
 
 // The label's voxel centre of a padded linear index, LPS mm.
 Vec3 voxel_centre(uint64_t padded, const InterfaceSurface& net,
@@ -58,41 +135,20 @@ NetLabelSurface net_label_surface(const InterfaceSurface& net, int32_t label,
     for (int k = 0; k < 3; ++k) {
       const uint32_t a = triangles[t][k], b = triangles[t][(k + 1) % 3];
       const uint64_t key = a < b ? (uint64_t{a} << 32) | b : (uint64_t{b} << 32) | a;
-      uses.push_back({key, voxel[t], t});
+      uses.push_back({key, voxel[t], t, a < b});
     }
   }
   std::sort(uses.begin(), uses.end(), [](const EdgeUse& x, const EdgeUse& y) {
     return x.key != y.key ? x.key < y.key
                           : (x.voxel != y.voxel ? x.voxel < y.voxel : x.triangle < y.triangle);
   });
-  // Corners (3 per triangle) joined across the edges the surface crosses
-  // smoothly: each class is one fan of triangles around a point.
-  geometry::DisjointSets corners(3 * triangles.size());
-  const auto corner = [&](uint32_t t, uint32_t point) {
-    const auto& tri = triangles[t];
-    const int k = tri[0] == point ? 0 : (tri[1] == point ? 1 : 2);
-    return 3 * t + static_cast<uint32_t>(k);
-  };
-  const auto join = [&](uint64_t key, uint32_t t1, uint32_t t2) {
-    const auto a = static_cast<uint32_t>(key >> 32), b = static_cast<uint32_t>(key);
-    corners.unite(corner(t1, a), corner(t2, a));
-    corners.unite(corner(t1, b), corner(t2, b));
-  };
-  for (size_t first = 0; first < uses.size();) {
-    size_t last = first;
-    while (last < uses.size() && uses[last].key == uses[first].key) ++last;
-    if (last - first == 2) {
-      join(uses[first].key, uses[first].triangle, uses[first + 1].triangle);
-    } else {
-      // More than two triangles on one edge: the label's voxels meet only
-      // along it. The two triangles around each voxel stay together.
-      for (size_t i = first + 1; i < last; ++i) {
-        if (uses[i].voxel == uses[i - 1].voxel)
-          join(uses[i].key, uses[i - 1].triangle, uses[i].triangle);
-      }
-    }
-    first = last;
-  }
+  std::vector<uint64_t> connect;  // edges where the voxels are joined, sorted
+  geometry::DisjointSets corners = fan_classes(triangles, uses, connect);
+  // An edge whose two voxels the surface joins around both its ends
+  // anyway still has four triangles once the points are split: there the
+  // voxels are joined along the edge too, which keeps it manifold.
+  connect = edges_used_more_than_twice(triangles, corners);
+  if (!connect.empty()) corners = fan_classes(triangles, uses, connect);
 
   // One output point per class; where a net point has several, each copy
   // moves a little towards the voxels of its own fan.
