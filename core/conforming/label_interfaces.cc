@@ -241,6 +241,72 @@ void smooth(const Stencil& stencil, const std::vector<Vec3>& centre, const Vec3&
   }
 }
 
+// Each label's enclosed volume over its quads (split 0-1-2, 0-2-3), with
+// points `x`: the quads are wound from sides[0] into sides[1], so a quad
+// adds to sides[0]'s volume and takes from sides[1]'s.
+std::unordered_map<int32_t, double> label_volumes(const Net& net, const std::vector<Vec3>& x) {
+  std::unordered_map<int32_t, double> volume;
+  for (size_t q = 0; q < net.quads.size(); ++q) {
+    const auto& c = net.quads[q];
+    const double v = (geometry::dot(x[c[0]], geometry::cross(x[c[1]], x[c[2]])) +
+                      geometry::dot(x[c[0]], geometry::cross(x[c[2]], x[c[3]]))) /
+                     6;
+    volume[net.quad_sides[q][0]] += v;
+    volume[net.quad_sides[q][1]] -= v;
+  }
+  return volume;
+}
+
+// Moves the points where only one label meets the outside along their
+// normal, by the label's lost volume over its area there, so each label
+// keeps its voxels' volume where smoothing shrank it (thin labels most):
+// interfaces between labels stay where smoothing put them. Points stay in
+// their boxes.
+void restore_volumes(const Net& net, const std::vector<Vec3>& centre, const Vec3& half_box,
+                     std::vector<Vec3>& points) {
+  const auto target = label_volumes(net, centre);
+  for (int round = 0; round < 3; ++round) {
+    const auto now = label_volumes(net, points);
+    // Per point: the one label it bounds against the outside (or -1 when it
+    // touches another label too), and its area-weighted outward normal.
+    std::vector<int32_t> owner(points.size(), INT32_MIN);
+    std::vector<Vec3> normal(points.size(), Vec3{0, 0, 0});
+    std::unordered_map<int32_t, double> area;
+    for (size_t q = 0; q < net.quads.size(); ++q) {
+      const auto& c = net.quads[q];
+      const auto& sides = net.quad_sides[q];
+      const bool outer = sides[0] == kOutside || sides[1] == kOutside;
+      const int32_t label = sides[0] == kOutside ? sides[1] : sides[0];
+      // Twice the quad's vector area, pointing from sides[0] to sides[1].
+      Vec3 n = geometry::add(geometry::cross(geometry::sub(points[c[1]], points[c[0]]),
+                                             geometry::sub(points[c[2]], points[c[0]])),
+                             geometry::cross(geometry::sub(points[c[2]], points[c[0]]),
+                                             geometry::sub(points[c[3]], points[c[0]])));
+      if (sides[0] == kOutside) n = geometry::scale(n, -1);
+      if (outer) area[label] += 0.5 * geometry::norm(n);
+      for (uint32_t p : c) {
+        if (!outer || (owner[p] != INT32_MIN && owner[p] != label)) {
+          owner[p] = -1;
+          continue;
+        }
+        owner[p] = label;
+        normal[p] = geometry::add(normal[p], n);
+      }
+    }
+    for (size_t p = 0; p < points.size(); ++p) {
+      if (owner[p] < 0) continue;
+      const int32_t label = owner[p];
+      const double lost = target.at(label) - now.at(label);
+      const double length = geometry::norm(normal[p]);
+      if (length == 0 || area[label] == 0) continue;
+      const Vec3 step = geometry::scale(normal[p], lost / area[label] / length);
+      for (int k = 0; k < 3; ++k)
+        points[p][k] = std::clamp(points[p][k] + step[k], centre[p][k] - half_box[k],
+                                  centre[p][k] + half_box[k]);
+    }
+  }
+}
+
 double smallest_angle_cosine_max(const Vec3& a, const Vec3& b, const Vec3& c) {
   // The largest cosine among the triangle's angles: the smallest angle's.
   const auto cosine = [](const Vec3& at, const Vec3& p, const Vec3& q) {
@@ -351,6 +417,7 @@ InterfaceSurface label_interfaces(const volume::LabelVolume& volume,
                       half * geometry.spacing[2] * params.box_scale[2]};
   std::vector<Vec3> points = net.centre;
   smooth(stencil, net.centre, half_box, params, points);
+  if (params.restore_volumes) restore_volumes(net, net.centre, half_box, points);
   if (params.subdivide_thick_quads) subdivide_quads(geometry.spacing, net, points, net.centre);
 
   InterfaceSurface surface;

@@ -33,6 +33,9 @@ struct InterfaceParams {
   // fraction of half the voxel: below 1, so points of neighbouring cubes
   // never meet.
   double cube_fraction = 0.9;
+  // After smoothing, give each label back the volume smoothing took, by
+  // moving its points that meet only the outside along their normals.
+  bool restore_volumes = false;
   // The box along each axis is this many times cube_fraction's (a grid cut
   // into thinner slices may let its points move as far as the thick ones').
   std::array<double, 3> box_scale{1, 1, 1};

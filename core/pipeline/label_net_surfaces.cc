@@ -26,6 +26,7 @@ conforming::InterfaceParams interface_params(const NetOptions& options) {
   params.shrink_step = options.shrink_step;
   params.inflate_step = options.inflate_step;
   params.cube_fraction = options.cube_fraction;
+  params.restore_volumes = options.restore_volumes;
   params.subdivide_thick_quads = false;
   return params;
 }

@@ -42,6 +42,9 @@ struct NetOptions {
   // How far a point may leave its staircase position along each axis, as a
   // fraction of half the voxel: below 1, so no voxel centre changes sides.
   double cube_fraction = 0.95;
+  // Give each label back the volume smoothing took from it, where it meets
+  // only the outside (thin labels shrink most).
+  bool restore_volumes = true;
   // An axis whose spacing is at least thick_ratio times the others' is cut
   // into slices about thin_ratio times theirs by shape-based interpolation
   // before the net is made: the net then slopes between the slices instead

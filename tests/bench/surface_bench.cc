@@ -57,6 +57,7 @@ MeshParams our_params() {
     params.net.poisson_max_anisotropy = 0;
     params.guard.fall_back = false;
   }
+  if (std::getenv("LABELMESH_NET_NO_RESTORE")) params.net.restore_volumes = false;
   if (const char* v = std::getenv("LABELMESH_NET_CUBE")) params.net.cube_fraction = std::atof(v);
   if (const char* v = std::getenv("LABELMESH_NET_THICK")) params.net.thick_ratio = std::atof(v);
   return params;
