@@ -2,11 +2,8 @@
 #include "core/pipeline/label_net_surfaces.h"
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
-#include <mutex>
 #include <optional>
-#include <thread>
 
 #include "core/conforming/label_interfaces.h"
 #include "core/conforming/net_label_surface.h"
@@ -79,7 +76,6 @@ double anisotropy(const volume::ImageGeometry& geometry) {
 struct LabelOutcome {
   std::vector<SurfaceResult> surfaces;
   std::vector<StageTiming> stages;
-  absl::Status status;
 };
 
 class LabelGuard {
@@ -269,120 +265,77 @@ class LabelGuard {
 
 }  // namespace
 
-absl::Status add_net_surfaces(const std::vector<volume::LabelVolume>& layers,
-                              const std::vector<size_t>& layer_of,
-                              const volume::VolumeStatistics& statistics,
-                              const std::vector<int32_t>& labels,
-                              const std::vector<SurfaceTolerance>& tolerance_of,
-                              const MeshParams& params, const RunContext& context,
-                              std::vector<SurfaceResult>& surfaces,
-                              std::vector<StageTiming>& stages) {
+conforming::InterfaceParams net_interface_params(const NetOptions& options) {
+  return interface_params(options);
+}
+
+absl::StatusOr<LabelNets> build_label_nets(const std::vector<volume::LabelVolume>& layers,
+                                           const std::vector<size_t>& layer_of,
+                                           const std::vector<int32_t>& labels,
+                                           const MeshParams& params, const RunContext& context,
+                                           std::vector<StageTiming>& stages) {
   if (auto s = check_net_options(params.net); !s.ok()) return s;
   const size_t count = labels.size();
-  // One net per layer, of that layer's selected labels.
-  std::vector<conforming::InterfaceSurface> nets(layers.size());
-  std::vector<volume::ImageGeometry> net_geometry(layers.size());
-  // The layers' own unsmoothed nets, where the net was made on thinner slices.
-  std::vector<std::optional<conforming::InterfaceSurface>> staircases(layers.size());
-  std::vector<bool> poisson_first(count, false);
-  {
-    StageTimer timer(stages, "surface_net");
-    context.report("surface_net", 0);
-    for (size_t layer = 0; layer < layers.size(); ++layer) {
-      std::vector<int32_t> here;
-      for (size_t i = 0; i < count; ++i)
-        if (layer_of[i] == layer) here.push_back(labels[i]);
-      if (here.empty()) continue;
-      conforming::InterfaceFigures figures;
-      const auto cut = thick_slices(layers[layer].geometry, params.net);
-      if (cut.axis < 0) {
-        net_geometry[layer] = layers[layer].geometry;
-        nets[layer] = conforming::label_interfaces(layers[layer], here,
-                                                   interface_params(params.net), figures);
-      } else {
-        absl::StatusOr<volume::LabelVolume> thin;
-        {
-          StageTimer thick_timer(stages, "thick_slices");
-          thin = conforming::interpolate_thick_slices(layers[layer], here, cut, context);
-        }
-        if (!thin.ok()) return thin.status();
-        net_geometry[layer] = thin->geometry;
-        // Points of the thinner grid may move as far as the thick slices'.
-        auto thin_params = interface_params(params.net);
-        thin_params.box_scale[cut.axis] = cut.parts;
-        nets[layer] = conforming::label_interfaces(*thin, here, thin_params, figures);
-        conforming::InterfaceParams flat = interface_params(params.net);
-        flat.smoothing_rounds = 0;
-        staircases[layer] = conforming::label_interfaces(layers[layer], here, flat, figures);
+  LabelNets built;
+  built.nets.resize(layers.size());
+  built.geometry.resize(layers.size());
+  built.staircases.resize(layers.size());
+  built.poisson_first.assign(count, false);
+  StageTimer timer(stages, "surface_net");
+  context.report("surface_net", 0);
+  for (size_t layer = 0; layer < layers.size(); ++layer) {
+    std::vector<int32_t> here;
+    for (size_t i = 0; i < count; ++i)
+      if (layer_of[i] == layer) here.push_back(labels[i]);
+    if (here.empty()) continue;
+    conforming::InterfaceFigures figures;
+    const auto cut = thick_slices(layers[layer].geometry, params.net);
+    if (cut.axis < 0) {
+      built.geometry[layer] = layers[layer].geometry;
+      built.nets[layer] =
+          conforming::label_interfaces(layers[layer], here, interface_params(params.net), figures);
+    } else {
+      absl::StatusOr<volume::LabelVolume> thin;
+      {
+        StageTimer thick_timer(stages, "thick_slices");
+        thin = conforming::interpolate_thick_slices(layers[layer], here, cut, context);
       }
-      if (auto s = context.check_stop(); !s.ok()) return s;
-      const auto touching = touching_labels(nets[layer]);
-      const bool fine_grid =
-          anisotropy(layers[layer].geometry) <= params.net.poisson_max_anisotropy;
-      for (size_t i = 0; i < count; ++i) {
-        if (layer_of[i] != layer) continue;
-        poisson_first[i] =
-            fine_grid && !std::binary_search(touching.begin(), touching.end(), labels[i]);
-      }
+      if (!thin.ok()) return thin.status();
+      built.geometry[layer] = thin->geometry;
+      // Points of the thinner grid may move as far as the thick slices'.
+      auto thin_params = interface_params(params.net);
+      thin_params.box_scale[cut.axis] = cut.parts;
+      built.nets[layer] = conforming::label_interfaces(*thin, here, thin_params, figures);
+      conforming::InterfaceParams flat = interface_params(params.net);
+      flat.smoothing_rounds = 0;
+      built.staircases[layer] = conforming::label_interfaces(layers[layer], here, flat, figures);
     }
-    context.report("surface_net", 1);
+    if (auto s = context.check_stop(); !s.ok()) return s;
+    const auto touching = touching_labels(built.nets[layer]);
+    const bool fine_grid = anisotropy(layers[layer].geometry) <= params.net.poisson_max_anisotropy;
+    for (size_t i = 0; i < count; ++i) {
+      if (layer_of[i] != layer) continue;
+      built.poisson_first[i] =
+          fine_grid && !std::binary_search(touching.begin(), touching.end(), labels[i]);
+    }
   }
+  context.report("surface_net", 1);
+  return built;
+}
 
-  // Progress callbacks expect one caller at a time.
-  std::mutex progress_mutex;
-  RunContext shared = context;
-  if (context.progress) {
-    shared.progress = [&](const ProgressUpdate& update) {
-      std::lock_guard<std::mutex> lock(progress_mutex);
-      context.progress(update);
-    };
-  }
-  std::vector<LabelOutcome> outcomes(count);
-  std::atomic<size_t> next{0};
-  auto work = [&] {
-    for (size_t i = next++; i < count; i = next++) {
-      const auto* label = statistics.find(labels[i]);
-      auto& outcome = outcomes[i];
-      if (label == nullptr) {
-        outcome.status =
-            absl::InvalidArgumentError(cat("label ", labels[i], " is not in the volume"));
-        continue;
-      }
-      try {
-        const size_t layer = layer_of[i];
-        LabelGuard guard(layers[layer], nets[layer], net_geometry[layer],
-                         staircases[layer] ? &*staircases[layer] : nullptr, *label, tolerance_of[i],
-                         params, shared, outcome);
-        outcome.status = guard.run(poisson_first[i]);
-      } catch (const std::bad_alloc&) {
-        outcome.status = absl::ResourceExhaustedError(cat("label ", labels[i], ": out of memory"));
-      }
-    }
-  };
-  unsigned threads = params.threads > 0 ? params.threads : std::thread::hardware_concurrency();
-  threads = static_cast<unsigned>(std::clamp<size_t>(threads, 1, std::max<size_t>(count, 1)));
-  std::vector<std::thread> helpers;
-  for (unsigned t = 1; t < threads; ++t) helpers.emplace_back(work);
-  work();
-  for (auto& helper : helpers) helper.join();
-
-  for (size_t i = 0; i < count; ++i) {
-    auto& outcome = outcomes[i];
-    if (outcome.status.code() == absl::StatusCode::kCancelled ||
-        outcome.status.code() == absl::StatusCode::kInvalidArgument)
-      return outcome.status;
-    if (!outcome.status.ok()) {
-      if (!params.labels.empty()) return outcome.status;
-      SurfaceResult failed;
-      failed.label = labels[i];
-      failed.stage = "net";
-      failed.error = std::string(outcome.status.message());
-      outcome.surfaces = {};
-      outcome.surfaces.push_back(std::move(failed));
-    }
-    for (auto& surface : outcome.surfaces) surfaces.push_back(std::move(surface));
-    for (const auto& stage : outcome.stages) add_stage_time(stages, stage.name, stage.seconds);
-  }
+absl::Status add_net_label_surface(const LabelNets& nets, size_t layer, bool poisson_first,
+                                   const volume::LabelVolume& volume,
+                                   const volume::LabelStatistics& label,
+                                   const SurfaceTolerance& tolerance, const MeshParams& params,
+                                   const RunContext& context, std::vector<SurfaceResult>& surfaces,
+                                   std::vector<StageTiming>& stages) {
+  LabelOutcome outcome;
+  LabelGuard guard(volume, nets.nets[layer], nets.geometry[layer],
+                   nets.staircases[layer] ? &*nets.staircases[layer] : nullptr, label, tolerance,
+                   params, context, outcome);
+  if (auto s = guard.run(poisson_first); !s.ok()) return s;
+  for (auto& surface : outcome.surfaces) surfaces.push_back(std::move(surface));
+  for (const auto& stage : outcome.stages) add_stage_time(stages, stage.name, stage.seconds);
   return absl::OkStatus();
 }
 

@@ -5,9 +5,13 @@
 #pragma once
 
 #include <cstddef>
+#include <optional>
 #include <vector>
 
 #include "absl/status/status.h"
+#include "absl/status/statusor.h"
+#include "core/conforming/interface_surface.h"
+#include "core/conforming/label_interfaces.h"
 #include "core/pipeline/mesh_params.h"
 #include "core/pipeline/mesh_result.h"
 #include "core/util/run_context.h"
@@ -15,26 +19,49 @@
 
 namespace labelmesh {
 
-// Appends each label's output surface. The guard's ladder, in order:
-//   1. poisson: only for a label that touches no other selected label, is at
-//      least params.poisson.min_thickness_voxels thick and lies on a grid no
-//      more anisotropic than params.net.poisson_max_anisotropy (the Poisson
-//      path with its own guard, label_surfaces.h);
-//   2. net: the label's part of the shared net;
+// The shared nets of a run: one per layer, of that layer's selected labels,
+// built once before the labels are meshed.
+struct LabelNets {
+  std::vector<conforming::InterfaceSurface> nets;
+  // The grid each net was made on: the layer's, or thinner slices of it.
+  std::vector<volume::ImageGeometry> geometry;
+  // The layer's own unsmoothed net, where the net was made on thinner slices.
+  std::vector<std::optional<conforming::InterfaceSurface>> staircases;
+  // Per label (in the order given): whether the guard tries Poisson first,
+  // as the label touches no other selected label on a near-isotropic grid.
+  std::vector<bool> poisson_first;
+};
+
+// The smoothing of the shared net for `options`.
+conforming::InterfaceParams net_interface_params(const NetOptions& options);
+
+// Builds the nets of `labels`; `layer_of[i]` is the layer of `labels[i]`.
+// Errors: INVALID_ARGUMENT for bad options, RESOURCE_EXHAUSTED when thinner
+// slices cannot be allocated, CANCELLED.
+absl::StatusOr<LabelNets> build_label_nets(const std::vector<volume::LabelVolume>& layers,
+                                           const std::vector<size_t>& layer_of,
+                                           const std::vector<int32_t>& labels,
+                                           const MeshParams& params, const RunContext& context,
+                                           std::vector<StageTiming>& stages);
+
+// Appends `label`'s output surface (and, when Poisson is delivered, its
+// repaired stage). The guard's ladder, in order:
+//   1. poisson, when `poisson_first` and the label is at least
+//      params.poisson.min_thickness_voxels thick (the Poisson path with its
+//      own guard, label_surfaces.h);
+//   2. net: the label's part of the shared net of `layer`;
 //   3. the Poisson path with its mask fallbacks, when neither is within the
 //      tolerance.
-// Every attempt is measured against the label's voxels (volume,
-// misclassified voxel centres, Hausdorff distance to the voxels' boundary);
-// the first within the tolerance is delivered, else the one least outside
-// it. `layer_of[i]` is the layer of `labels[i]`; `tolerance_of[i]` its
-// tolerance. Errors: CANCELLED; INVALID_ARGUMENT for bad options.
-absl::Status add_net_surfaces(const std::vector<volume::LabelVolume>& layers,
-                              const std::vector<size_t>& layer_of,
-                              const volume::VolumeStatistics& statistics,
-                              const std::vector<int32_t>& labels,
-                              const std::vector<SurfaceTolerance>& tolerance_of,
-                              const MeshParams& params, const RunContext& context,
-                              std::vector<SurfaceResult>& surfaces,
-                              std::vector<StageTiming>& stages);
+// Every attempt is measured against the label's voxels in `volume`
+// (volume, misclassified voxel centres, Hausdorff distance to the voxels'
+// boundary); the first within `tolerance` is delivered, else the one least
+// outside it. Errors: CANCELLED; INTERNAL when the net has no triangle of
+// the label.
+absl::Status add_net_label_surface(const LabelNets& nets, size_t layer, bool poisson_first,
+                                   const volume::LabelVolume& volume,
+                                   const volume::LabelStatistics& label,
+                                   const SurfaceTolerance& tolerance, const MeshParams& params,
+                                   const RunContext& context, std::vector<SurfaceResult>& surfaces,
+                                   std::vector<StageTiming>& stages);
 
 }  // namespace labelmesh

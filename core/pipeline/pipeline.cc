@@ -162,10 +162,12 @@ absl::Status add_every_label_surface(const std::vector<volume::LabelVolume>& lay
                                      const MeshParams& params, const RunContext& context,
                                      std::vector<SurfaceResult>& surfaces,
                                      std::vector<StageTiming>& stages) {
+  // The shared nets are built once, before any label.
+  std::optional<LabelNets> nets;
   if (params.surface == SurfaceMethod::kNet) {
-    return add_net_surfaces(layers, layer_of, input.statistics, labels,
-                            label_tolerances(layers.front().geometry, input, labels, params.guard),
-                            params, context, surfaces, stages);
+    auto built = build_label_nets(layers, layer_of, labels, params, context, stages);
+    if (!built.ok()) return built.status();
+    nets = std::move(*built);
   }
   const auto tolerances = label_tolerances(layers.front().geometry, input, labels, params.guard);
   const size_t count = labels.size();
@@ -208,8 +210,11 @@ absl::Status add_every_label_surface(const std::vector<volume::LabelVolume>& lay
       label_context.label = &in_progress[i];
       absl::Status status;
       try {
-        status = add_label_surfaces(layers[layer_of[i]], *statistics, params, tolerance,
-                                    label_context, label_surfaces[i], label_stages[i]);
+        status = nets ? add_net_label_surface(*nets, layer_of[i], nets->poisson_first[i],
+                                              layers[layer_of[i]], *statistics, tolerance, params,
+                                              label_context, label_surfaces[i], label_stages[i])
+                      : add_label_surfaces(layers[layer_of[i]], *statistics, params, tolerance,
+                                           label_context, label_surfaces[i], label_stages[i]);
       } catch (const std::bad_alloc&) {
         status = absl::ResourceExhaustedError(cat("label ", labels[i], ": out of memory"));
       }
@@ -219,7 +224,9 @@ absl::Status add_every_label_surface(const std::vector<volume::LabelVolume>& lay
       if (label_error) {
         SurfaceResult failed;
         failed.label = labels[i];
-        failed.stage = params.surface == SurfaceMethod::kPoisson ? "poisson" : "repaired";
+        failed.stage = params.surface == SurfaceMethod::kNet       ? "net"
+                       : params.surface == SurfaceMethod::kPoisson ? "poisson"
+                                                                   : "repaired";
         failed.error = std::string(status.message());
         label_surfaces[i] = {};
         label_surfaces[i].push_back(std::move(failed));

@@ -241,11 +241,12 @@ double axis_aligned_share(const TriangleMesh& mesh, const volume::ImageGeometry&
   // The voxel axes in LPS: the direction matrix's columns.
   const std::array<Vec3, 3> axes{Vec3{d[0], d[3], d[6]}, Vec3{d[1], d[4], d[7]},
                                  Vec3{d[2], d[5], d[8]}};
+  const std::vector<Vec3> at = index_points(mesh, geometry);
   double aligned = 0, total = 0;
   for (const auto& t : mesh.triangles) {
     const Vec3 &a = mesh.points[t[0]], &b = mesh.points[t[1]], &c = mesh.points[t[2]];
     const Vec3 centroid =
-        geometry.to_index(geometry::scale(geometry::add(a, geometry::add(b, c)), 1.0 / 3));
+        geometry::scale(geometry::add(at[t[0]], geometry::add(at[t[1]], at[t[2]])), 1.0 / 3);
     bool cap = false;
     for (int k = 0; k < 3; ++k)
       cap = cap || centroid[k] < 0 || centroid[k] > double(geometry.dims[k] - 1);

@@ -11,6 +11,7 @@
 
 #include "core/conforming/label_interfaces.h"
 #include "core/conforming/net_label_surface.h"
+#include "core/pipeline/label_net_surfaces.h"
 #include "core/pipeline/pipeline.h"
 #include "core/surface/surface_checks.h"
 #include "core/surface/surface_statistics.h"
@@ -37,15 +38,8 @@ conforming::InterfaceSurface staircase_net(const volume::LabelVolume& volume) {
 }
 
 conforming::InterfaceSurface smoothed_net(const volume::LabelVolume& volume) {
-  const NetOptions options;
-  conforming::InterfaceParams params;
-  params.smoothing_rounds = options.smoothing_rounds;
-  params.shrink_step = options.shrink_step;
-  params.inflate_step = options.inflate_step;
-  params.cube_fraction = options.cube_fraction;
-  params.subdivide_thick_quads = false;
   conforming::InterfaceFigures figures;
-  return conforming::label_interfaces(volume, {}, params, figures);
+  return conforming::label_interfaces(volume, {}, net_interface_params(NetOptions{}), figures);
 }
 
 // Triangles of `a` whose three points are also a triangle of `b` (the same
