@@ -115,6 +115,7 @@ NetLabelSurface net_label_surface(const InterfaceSurface& net, int32_t label,
   // The label's triangles, wound outward, and the voxel each bounds.
   std::vector<std::array<uint32_t, 3>> triangles;
   std::vector<uint64_t> voxel;
+  std::vector<uint32_t> net_triangles;
   for (size_t t = 0; t < net.triangles.size(); ++t) {
     const auto& sides = net.sides[t];
     if (sides[0] != label && sides[1] != label) continue;
@@ -125,8 +126,10 @@ NetLabelSurface net_label_surface(const InterfaceSurface& net, int32_t label,
     if (!behind) std::swap(triangle[1], triangle[2]);
     triangles.push_back(triangle);
     voxel.push_back(net.side_voxels[t][behind ? 0 : 1]);
+    net_triangles.push_back(static_cast<uint32_t>(t));
   }
   NetLabelSurface result;
+  result.net_triangles = std::move(net_triangles);
   if (triangles.empty()) return result;
 
   std::vector<EdgeUse> uses;
@@ -189,7 +192,33 @@ NetLabelSurface net_label_surface(const InterfaceSurface& net, int32_t label,
         mesh.points[p], geometry::scale(geometry::sub(towards, mesh.points[p]), kSplitNudge));
   }
   staircase.triangles = mesh.triangles;
+  for (uint32_t t = 0; t < mesh.triangles.size(); ++t)
+    for (const uint32_t p : mesh.triangles[t])
+      if (copies[source[p]] >= 2) {
+        result.moved_triangles.push_back(t);
+        break;
+      }
   return result;
+}
+
+uint64_t net_label_self_intersections(const InterfaceSurface& net,
+                                      const surface::TrianglePairs& net_crossings,
+                                      const NetLabelSurface& cut, int32_t label) {
+  std::vector<uint32_t> moved;
+  moved.reserve(cut.moved_triangles.size());
+  for (const uint32_t t : cut.moved_triangles) moved.push_back(cut.net_triangles[t]);
+  std::sort(moved.begin(), moved.end());
+  const auto kept = [&](uint32_t t) {
+    const auto& sides = net.sides[t];
+    return (sides[0] == label || sides[1] == label) &&
+           !std::binary_search(moved.begin(), moved.end(), t);
+  };
+  uint64_t count = 0;
+  for (const auto& [a, b] : net_crossings)
+    if (kept(a) && kept(b)) ++count;
+  return count +
+         surface::crossing_triangles_near(cut.mesh.points, cut.mesh.triangles, cut.moved_triangles)
+             .size();
 }
 
 }  // namespace labelmesh::conforming

@@ -84,11 +84,13 @@ class LabelGuard {
   // slices of it); `staircase`, when set, is the layer's own unsmoothed net.
   LabelGuard(const volume::LabelVolume& layer, const conforming::InterfaceSurface& net,
              const volume::ImageGeometry& net_geometry,
-             const conforming::InterfaceSurface* staircase, const volume::LabelStatistics& label,
+             const conforming::InterfaceSurface* staircase,
+             const surface::TrianglePairs& net_crossings, const volume::LabelStatistics& label,
              const SurfaceTolerance& tolerance, const MeshParams& params, const RunContext& context,
              LabelOutcome& outcome)
       : layer_(layer),
         net_(net),
+        net_crossings_(net_crossings),
         net_geometry_(net_geometry),
         staircase_net_(staircase),
         label_(label),
@@ -239,7 +241,10 @@ class LabelGuard {
     {
       StageTimer timer(outcome_.stages, "self_intersections");
       context_.report("self_intersections", 0);
-      output.self_intersections = surface::count_self_intersections(output.mesh);
+      output.self_intersections =
+          chosen.method == SurfaceAttemptMethod::kNet
+              ? conforming::net_label_self_intersections(net_, net_crossings_, cut_, label_.label)
+              : surface::count_self_intersections(output.mesh);
     }
     outcome_.surfaces.push_back(std::move(output));
     return absl::OkStatus();
@@ -247,6 +252,7 @@ class LabelGuard {
 
   const volume::LabelVolume& layer_;
   const conforming::InterfaceSurface& net_;
+  const surface::TrianglePairs& net_crossings_;
   const volume::ImageGeometry& net_geometry_;
   const conforming::InterfaceSurface* staircase_net_;
   const volume::LabelStatistics& label_;
@@ -269,18 +275,21 @@ conforming::InterfaceParams net_interface_params(const NetOptions& options) {
   return interface_params(options);
 }
 
-absl::StatusOr<LabelNets> build_label_nets(const std::vector<volume::LabelVolume>& layers,
-                                           const std::vector<size_t>& layer_of,
-                                           const std::vector<int32_t>& labels,
-                                           const MeshParams& params, const RunContext& context,
-                                           std::vector<StageTiming>& stages) {
-  if (auto s = check_net_options(params.net); !s.ok()) return s;
+namespace {
+
+// The smoothed nets, without their crossings.
+absl::StatusOr<LabelNets> smoothed_nets(const std::vector<volume::LabelVolume>& layers,
+                                        const std::vector<size_t>& layer_of,
+                                        const std::vector<int32_t>& labels,
+                                        const MeshParams& params, const RunContext& context,
+                                        std::vector<StageTiming>& stages) {
   const size_t count = labels.size();
   LabelNets built;
   built.nets.resize(layers.size());
   built.geometry.resize(layers.size());
   built.staircases.resize(layers.size());
   built.poisson_first.assign(count, false);
+  built.crossings.resize(layers.size());
   StageTimer timer(stages, "surface_net");
   context.report("surface_net", 0);
   for (size_t layer = 0; layer < layers.size(); ++layer) {
@@ -323,6 +332,29 @@ absl::StatusOr<LabelNets> build_label_nets(const std::vector<volume::LabelVolume
   return built;
 }
 
+// Finds each net's crossing triangle pairs, once for all its labels.
+void find_net_crossings(LabelNets& built, std::vector<StageTiming>& stages) {
+  StageTimer timer(stages, "self_intersections");
+  for (size_t layer = 0; layer < built.nets.size(); ++layer)
+    built.crossings[layer] =
+        surface::crossing_triangles(built.nets[layer].points, built.nets[layer].triangles);
+}
+
+}  // namespace
+
+absl::StatusOr<LabelNets> build_label_nets(const std::vector<volume::LabelVolume>& layers,
+                                           const std::vector<size_t>& layer_of,
+                                           const std::vector<int32_t>& labels,
+                                           const MeshParams& params, const RunContext& context,
+                                           std::vector<StageTiming>& stages) {
+  if (auto s = check_net_options(params.net); !s.ok()) return s;
+  auto built = smoothed_nets(layers, layer_of, labels, params, context, stages);
+  if (!built.ok()) return built.status();
+  find_net_crossings(*built, stages);
+  if (auto s = context.check_stop(); !s.ok()) return s;
+  return built;
+}
+
 absl::Status add_net_label_surface(const LabelNets& nets, size_t layer, bool poisson_first,
                                    const volume::LabelVolume& volume,
                                    const volume::LabelStatistics& label,
@@ -331,8 +363,8 @@ absl::Status add_net_label_surface(const LabelNets& nets, size_t layer, bool poi
                                    std::vector<StageTiming>& stages) {
   LabelOutcome outcome;
   LabelGuard guard(volume, nets.nets[layer], nets.geometry[layer],
-                   nets.staircases[layer] ? &*nets.staircases[layer] : nullptr, label, tolerance,
-                   params, context, outcome);
+                   nets.staircases[layer] ? &*nets.staircases[layer] : nullptr,
+                   nets.crossings[layer], label, tolerance, params, context, outcome);
   if (auto s = guard.run(poisson_first); !s.ok()) return s;
   for (auto& surface : outcome.surfaces) surfaces.push_back(std::move(surface));
   for (const auto& stage : outcome.stages) add_stage_time(stages, stage.name, stage.seconds);

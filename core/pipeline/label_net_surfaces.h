@@ -14,6 +14,7 @@
 #include "core/conforming/label_interfaces.h"
 #include "core/pipeline/mesh_params.h"
 #include "core/pipeline/mesh_result.h"
+#include "core/surface/crossing_triangles.h"
 #include "core/util/run_context.h"
 #include "core/volume/label_volume.h"
 
@@ -30,6 +31,9 @@ struct LabelNets {
   // Per label (in the order given): whether the guard tries Poisson first,
   // as the label touches no other selected label on a near-isotropic grid.
   std::vector<bool> poisson_first;
+  // Per layer: the net's crossing triangle pairs, found once for all its
+  // labels (every label's surface is made of the net's triangles).
+  std::vector<surface::TrianglePairs> crossings;
 };
 
 // The smoothing of the shared net for `options`.

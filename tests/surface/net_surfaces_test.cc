@@ -283,7 +283,9 @@ TEST(NetSurfacesRealData, EveryBrainLabelIsAClosedManifold) {
   auto v = volume::read_label_volume(path, {}, RunContext{});
   ASSERT_TRUE(v.ok()) << v.status();
   const auto net = smoothed_net(*v);
+  const auto net_crossings = surface::crossing_triangles(net.points, net.triangles);
   uint32_t split = 0;
+  uint64_t crossings = 0;
   for (const auto& label : volume::compute_label_statistics(*v).labels) {
     const auto cut = conforming::net_label_surface(net, label.label, v->geometry);
     const auto s = surface::compute_surface_statistics(cut.mesh);
@@ -291,8 +293,15 @@ TEST(NetSurfacesRealData, EveryBrainLabelIsAClosedManifold) {
     EXPECT_EQ(s.non_manifold_edges, 0u) << label.label;
     EXPECT_EQ(s.non_manifold_vertices, 0u) << label.label;
     split += cut.split_points;
+    // The count from the net's pairs is CGAL's count on the label alone.
+    const uint64_t from_net =
+        conforming::net_label_self_intersections(net, net_crossings, cut, label.label);
+    EXPECT_EQ(from_net, surface::count_self_intersections(cut.mesh).value_or(UINT64_MAX))
+        << label.label;
+    crossings += from_net;
   }
-  EXPECT_GT(split, 1000u);  // the splitting is exercised
+  EXPECT_GT(split, 1000u);   // the splitting is exercised
+  EXPECT_GT(crossings, 0u);  // and so is the count
 }
 
 }  // namespace

@@ -1,0 +1,227 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+#include "core/surface/crossing_triangles.h"
+
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+
+#include <algorithm>
+
+#include "absl/container/flat_hash_map.h"
+
+#include "core/util/side_by_side.h"
+
+namespace labelmesh::surface {
+namespace {
+
+using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
+using Point = Kernel::Point_3;
+using Triangle = std::array<uint32_t, 3>;
+
+class CrossingTest {
+ public:
+  CrossingTest(const std::vector<std::array<double, 3>>& points,
+               const std::vector<Triangle>& triangles)
+      : triangles_(triangles) {
+    points_.reserve(points.size());
+    for (const auto& p : points) points_.emplace_back(p[0], p[1], p[2]);
+  }
+
+  bool degenerate(uint32_t t) const {
+    const auto& v = triangles_[t];
+    return CGAL::collinear(points_[v[0]], points_[v[1]], points_[v[2]]);
+  }
+
+  CGAL::Bbox_3 box(uint32_t t) const {
+    const auto& v = triangles_[t];
+    return points_[v[0]].bbox() + points_[v[1]].bbox() + points_[v[2]].bbox();
+  }
+
+  bool cross(uint32_t a, uint32_t b) const {
+    const Triangle& s = triangles_[a];
+    const Triangle& t = triangles_[b];
+    int shared = 0;
+    int s_at = -1, t_at = -1;  // a shared corner of each
+    bool s_shared[3] = {false, false, false};
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j)
+        if (s[i] == t[j]) {
+          ++shared;
+          s_shared[i] = true;
+          s_at = i;
+          t_at = j;
+        }
+    if (shared == 3) return true;  // the same triangle twice
+    if (shared == 2) {
+      // Along a shared edge: crossing only when folded flat onto each other,
+      // the two far corners on the same side of the edge.
+      int s_far = 0;
+      while (s_shared[s_far]) ++s_far;
+      uint32_t t_far = t[0];
+      for (int j = 0; j < 3; ++j)
+        if (t[j] != s[(s_far + 1) % 3] && t[j] != s[(s_far + 2) % 3]) t_far = t[j];
+      const Point& p = points_[s[(s_far + 1) % 3]];
+      const Point& q = points_[s[(s_far + 2) % 3]];
+      const Point& r = points_[s[s_far]];
+      const Point& u = points_[t_far];
+      return CGAL::coplanar(p, q, r, u) && CGAL::coplanar_orientation(p, q, r, u) == CGAL::POSITIVE;
+    }
+    const Kernel::Triangle_3 st(points_[s[0]], points_[s[1]], points_[s[2]]);
+    const Kernel::Triangle_3 tt(points_[t[0]], points_[t[1]], points_[t[2]]);
+    if (shared == 1) {
+      // At one shared point: crossing when the edge opposite it in either
+      // triangle meets the other.
+      const Kernel::Segment_3 s_opposite(points_[s[(s_at + 1) % 3]], points_[s[(s_at + 2) % 3]]);
+      const Kernel::Segment_3 t_opposite(points_[t[(t_at + 1) % 3]], points_[t[(t_at + 2) % 3]]);
+      return CGAL::do_intersect(st, t_opposite) || CGAL::do_intersect(tt, s_opposite);
+    }
+    return CGAL::do_intersect(st, tt);
+  }
+
+ private:
+  const std::vector<Triangle>& triangles_;
+  std::vector<Point> points_;
+};
+
+// The triangles' boxes in a grid whose cells are at least as wide as any
+// box along each axis, each box filed under the cell of its low corner. Two
+// boxes that meet then have their low corners in the same or neighbouring
+// cells, so each triangle's candidates are those of 27 cells. (CGAL's
+// general box intersection spends its time scanning long sorted runs on a
+// surface of many small boxes of one size.)
+class BoxGrid {
+ public:
+  BoxGrid(const CrossingTest& test, size_t count) : boxes_(count) {
+    for (uint32_t t = 0; t < count; ++t) boxes_[t] = test.box(t);
+    if (count == 0) return;
+    for (int a = 0; a < 3; ++a) {
+      low_[a] = boxes_[0].min(a);
+      double high = boxes_[0].max(a);
+      cell_[a] = 0;
+      for (const auto& b : boxes_) {
+        low_[a] = std::min(low_[a], b.min(a));
+        high = std::max(high, b.max(a));
+        cell_[a] = std::max(cell_[a], b.max(a) - b.min(a));
+      }
+      // At most 2^20 cells along an axis, and never zero wide.
+      cell_[a] = std::max({cell_[a], (high - low_[a]) / double(1 << 20), 1e-9});
+    }
+    std::vector<std::pair<uint64_t, uint32_t>> filed(count);
+    for (uint32_t t = 0; t < count; ++t) filed[t] = {key(cell_of(t)), t};
+    std::sort(filed.begin(), filed.end());
+    order_.resize(count);
+    for (size_t i = 0; i < count; ++i) {
+      order_[i] = filed[i].second;
+      auto& range = cells_[filed[i].first];
+      if (range.second == 0) range.first = static_cast<uint32_t>(i);
+      range.second = static_cast<uint32_t>(i + 1);
+    }
+  }
+
+  // Calls visit(u) for every triangle u whose box meets t's (u != t).
+  template <typename Visit>
+  void for_each_meeting(uint32_t t, Visit visit) const {
+    const auto c = cell_of(t);
+    const CGAL::Bbox_3& box = boxes_[t];
+    for (int64_t dz = -1; dz <= 1; ++dz)
+      for (int64_t dy = -1; dy <= 1; ++dy)
+        for (int64_t dx = -1; dx <= 1; ++dx) {
+          const auto found = cells_.find(key({c[0] + dx, c[1] + dy, c[2] + dz}));
+          if (found == cells_.end()) continue;
+          for (uint32_t i = found->second.first; i < found->second.second; ++i) {
+            const uint32_t u = order_[i];
+            if (u != t && CGAL::do_overlap(box, boxes_[u])) visit(u);
+          }
+        }
+  }
+
+ private:
+  std::array<int64_t, 3> cell_of(uint32_t t) const {
+    std::array<int64_t, 3> c;
+    for (int a = 0; a < 3; ++a) c[a] = int64_t((boxes_[t].min(a) - low_[a]) / cell_[a]);
+    return c;
+  }
+  // Cells -1 .. 2^20 + 1 along each axis, 21 bits each.
+  static uint64_t key(const std::array<int64_t, 3>& c) {
+    return uint64_t(c[0] + 1) | uint64_t(c[1] + 1) << 21 | uint64_t(c[2] + 1) << 42;
+  }
+
+  std::vector<CGAL::Bbox_3> boxes_;
+  std::array<double, 3> low_{0, 0, 0}, cell_{1, 1, 1};
+  std::vector<uint32_t> order_;
+  absl::flat_hash_map<uint64_t, std::pair<uint32_t, uint32_t>> cells_;
+};
+
+// The crossing pairs of each triangle of `from` with the triangles whose
+// boxes meet it, for which keep(from's, other) holds (each unordered pair
+// must be kept once over all calls). Degenerate triangles, which CGAL leaves
+// out of its box test, are paired with themselves instead.
+template <typename Keep>
+TrianglePairs crossings_from(const CrossingTest& test, const BoxGrid& grid,
+                             const std::vector<uint32_t>& degenerate, uint32_t begin, uint32_t end,
+                             const std::vector<uint32_t>* from, Keep keep) {
+  TrianglePairs pairs;
+  for (uint32_t i = begin; i < end; ++i) {
+    const uint32_t s = from != nullptr ? (*from)[i] : i;
+    if (std::binary_search(degenerate.begin(), degenerate.end(), s)) {
+      pairs.emplace_back(s, s);
+      continue;
+    }
+    grid.for_each_meeting(s, [&](uint32_t t) {
+      if (!keep(s, t) || std::binary_search(degenerate.begin(), degenerate.end(), t)) return;
+      if (test.cross(s, t)) pairs.emplace_back(std::min(s, t), std::max(s, t));
+    });
+  }
+  return pairs;
+}
+
+std::vector<uint32_t> degenerate_triangles(const CrossingTest& test, size_t count) {
+  std::vector<uint32_t> degenerate;
+  for (uint32_t t = 0; t < count; ++t)
+    if (test.degenerate(t)) degenerate.push_back(t);
+  return degenerate;
+}
+
+void sort_pairs(TrianglePairs& pairs) {
+  std::sort(pairs.begin(), pairs.end());
+  pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
+}
+
+}  // namespace
+
+TrianglePairs crossing_triangles(const std::vector<std::array<double, 3>>& points,
+                                 const std::vector<std::array<uint32_t, 3>>& triangles) {
+  const CrossingTest test(points, triangles);
+  const uint32_t count = static_cast<uint32_t>(triangles.size());
+  const std::vector<uint32_t> degenerate = degenerate_triangles(test, count);
+  const BoxGrid grid(test, count);
+  // Two halves on two threads; a pair is kept from its smaller triangle.
+  const auto smaller_first = [](uint32_t s, uint32_t t) { return s < t; };
+  TrianglePairs low, high;
+  side_by_side(
+      [&] { low = crossings_from(test, grid, degenerate, 0, count / 2, nullptr, smaller_first); },
+      [&] {
+        high = crossings_from(test, grid, degenerate, count / 2, count, nullptr, smaller_first);
+      });
+  low.insert(low.end(), high.begin(), high.end());
+  sort_pairs(low);
+  return low;
+}
+
+TrianglePairs crossing_triangles_near(const std::vector<std::array<double, 3>>& points,
+                                      const std::vector<std::array<uint32_t, 3>>& triangles,
+                                      const std::vector<uint32_t>& among) {
+  if (among.empty()) return {};
+  const CrossingTest test(points, triangles);
+  const uint32_t count = static_cast<uint32_t>(triangles.size());
+  std::vector<bool> in_among(count, false);
+  for (const uint32_t t : among) in_among[t] = true;
+  const std::vector<uint32_t> degenerate = degenerate_triangles(test, count);
+  const BoxGrid grid(test, count);
+  // A pair inside `among` comes twice, once from each side: keep one.
+  TrianglePairs pairs =
+      crossings_from(test, grid, degenerate, 0, static_cast<uint32_t>(among.size()), &among,
+                     [&](uint32_t s, uint32_t t) { return !in_among[t] || s < t; });
+  sort_pairs(pairs);
+  return pairs;
+}
+
+}  // namespace labelmesh::surface
