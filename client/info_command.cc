@@ -18,6 +18,7 @@ struct InfoOptions {
   std::string path;
   bool json = false;
   uint64_t max_voxels = volume::ReadLimits{}.max_voxels;
+  std::string overlapping = "refuse";
 };
 
 // A name from the file, with anything a terminal could act on replaced.
@@ -41,6 +42,8 @@ void print_text(const std::string& path, const v1::InputSummary& s) {
       s.direction(5), s.direction(6), s.direction(7), s.direction(8));
   std::printf("convention   %s\n", s.convention().c_str());
   std::printf("voxel type   %s\n", s.voxel_type().c_str());
+  if (s.layers() > 1)
+    std::printf("layers       %u (overlapping segments kept apart)\n", s.layers());
   if (s.repeated_planes_size() == 3) {
     std::printf("drawn at     %.6g x %.6g x %.6g mm (planes repeated %u x %u x %u)\n",
                 s.drawn_spacing(0), s.drawn_spacing(1), s.drawn_spacing(2), s.repeated_planes(0),
@@ -62,15 +65,22 @@ CommandRunner add_info_command(CLI::App& app) {
   auto options = std::make_shared<InfoOptions>();
   CLI::App* info = app.add_subcommand("info", "Show a label volume's geometry and labels");
   info->add_option("file", options->path,
-                   "Label volume (.nii .nii.gz .mha .mhd .nrrd .nhdr .inr .inr.gz .vti .dcm)")
+                   "Label volume (.nii .nii.gz .mha .mhd .nrrd .nhdr .inr .inr.gz .vti, or a "
+                   "DICOM SEG of any name)")
       ->required();
   info->add_flag("--json", options->json, "Print the summary as protobuf JSON (InputSummary)");
   info->add_option("--max-voxels", options->max_voxels, "Refuse volumes with more voxels than this")
+      ->capture_default_str();
+  info->add_option("--overlapping", options->overlapping,
+                   "Overlapping segments (DICOM SEG, 3D Slicer): refuse the input naming them, or "
+                   "separate: count each segment whole")
+      ->check(CLI::IsMember({"refuse", "separate"}))
       ->capture_default_str();
   info->footer(kExitCodeHelp);
   return [options] {
     volume::ReadLimits limits;
     limits.max_voxels = options->max_voxels;
+    limits.separate_overlapping = options->overlapping == "separate";
     auto summary = summarise_volume(options->path, limits, RunContext{});
     if (!summary.ok()) {
       std::fprintf(stderr, "labelmesh info: %s\n", std::string(summary.status().message()).c_str());

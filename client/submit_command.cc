@@ -21,6 +21,7 @@
 #include "client/server_connection.h"
 #include "core/pipeline/job_options.h"
 #include "core/pipeline/report.h"
+#include "core/volume/volume_header.h"
 #include "labelmesh/v1/service.grpc.pb.h"
 #include "server/sha256.h"
 
@@ -84,7 +85,12 @@ absl::StatusOr<v1::SubmitReply> upload_once(const ServerConnection& connection,
   auto options = to_mesh_options(flags.pipeline);
   if (!options.ok()) return options.status();
   *spec.mutable_options() = *options;
-  spec.set_file_name(std::filesystem::path(flags.path).filename().string());
+  // The server knows a format by its name's extension: a DICOM file named
+  // otherwise (dcmqi's label.seg, a PACS file) is sent as one.
+  std::string file_name = std::filesystem::path(flags.path).filename().string();
+  if (!volume::format_from_path(file_name) && volume::is_dicom_file(flags.path))
+    file_name += ".dcm";
+  spec.set_file_name(file_name);
   spec.set_size_bytes(size);
   spec.set_sha256(*digest);
   spec.set_keep_input(flags.keep_input);

@@ -40,6 +40,15 @@ VolumeSummary summary_of(const volume::LabelVolume& volume) {
   return summary;
 }
 
+// The same for a volume whose overlapping segments lie in layers: the
+// first layer's placement, every layer's labels.
+VolumeSummary summary_of(const std::vector<volume::LabelVolume>& layers) {
+  VolumeSummary summary = summary_of(layers.front());
+  if (layers.size() > 1) summary.statistics = layered_statistics(layers);
+  summary.layers = static_cast<uint32_t>(layers.size());
+  return summary;
+}
+
 // The labels to mesh: those asked for (each must be present), or all.
 absl::StatusOr<std::vector<int32_t>> choose_labels(const std::string& path,
                                                    const volume::VolumeStatistics& statistics,
@@ -348,7 +357,7 @@ absl::StatusOr<VolumeSummary> summarise_volume(const std::string& path,
   try {
     auto volume = volume::read_label_volume(path, limits, context);
     if (!volume.ok()) return volume.status();
-    return summary_of(*volume);
+    return summary_of(volume_layers(*volume));
   } catch (...) {
     return current_exception_status(path);
   }
@@ -386,6 +395,18 @@ absl::StatusOr<MeshResult> run_stages(const std::string& path, const MeshParams&
   return run_on_volume(path, std::move(volume), params, context, std::move(result));
 }
 
+// Under --strict, any warning (a label outside tolerance, a surface or a
+// volume mesh not delivered) fails the run.
+absl::Status refuse_warnings_if_strict(const std::string& path, const MeshResult& result,
+                                       const MeshParams& params) {
+  if (!params.guard.strict || result.warnings.empty()) return absl::OkStatus();
+  const auto& first = result.warnings.front();
+  return absl::FailedPreconditionError(
+      cat(path, ": strict: ", result.warnings.size(),
+          " label(s) delivered outside tolerance or not at all; first, label ", first.label, ": ",
+          first.reason));
+}
+
 // The stages after reading; `path` names the input in messages.
 absl::StatusOr<MeshResult> run_on_volume(const std::string& path,
                                          absl::StatusOr<volume::LabelVolume> volume,
@@ -396,9 +417,7 @@ absl::StatusOr<MeshResult> run_on_volume(const std::string& path,
   const std::vector<volume::LabelVolume> layers = volume_layers(*volume);
   {
     StageTimer timer(result.stages, "label_statistics");
-    result.input = summary_of(layers.front());
-    if (layers.size() > 1) result.input.statistics = layered_statistics(layers);
-    result.input.layers = static_cast<uint32_t>(layers.size());
+    result.input = summary_of(layers);
     volume::apply_label_table(params.label_names, result.input.descriptions);
   }
   auto labels = choose_labels(path, result.input.statistics, params.labels);
@@ -419,6 +438,7 @@ absl::StatusOr<MeshResult> run_on_volume(const std::string& path,
               "segments with --volume tet"));
     }
     if (auto s = add_conforming_mesh(*volume, *labels, params, context, result); !s.ok()) return s;
+    if (auto s = refuse_warnings_if_strict(path, result, params); !s.ok()) return s;
     keep_label_image();
     return result;
   }
@@ -479,13 +499,8 @@ absl::StatusOr<MeshResult> run_on_volume(const std::string& path,
   }
   for (auto& surface : quality_surfaces) result.surfaces.push_back(std::move(surface));
   result.warnings = collect_warnings(result.surfaces, params);
-  if (params.guard.strict && !result.warnings.empty()) {
-    const auto& first = result.warnings.front();
-    return absl::FailedPreconditionError(
-        cat(path, ": strict: ", result.warnings.size(),
-            " label(s) delivered outside tolerance or not at all; first, label ", first.label, ": ",
-            first.reason));
-  }
+  // Refused before the volume meshes, which would take long for nothing.
+  if (auto s = refuse_warnings_if_strict(path, result, params); !s.ok()) return s;
 
   if (tetrahedra) {
     if (auto s = add_volume_mesh(params, volume->geometry, context, result); !s.ok()) return s;
@@ -493,6 +508,7 @@ absl::StatusOr<MeshResult> run_on_volume(const std::string& path,
   if (params.volume == VolumeMethod::kMixed || params.volume == VolumeMethod::kHex) {
     if (auto s = add_mixed_mesh(params, volume->geometry, context, result); !s.ok()) return s;
   }
+  if (auto s = refuse_warnings_if_strict(path, result, params); !s.ok()) return s;
   keep_label_image();
   return result;
 }

@@ -2,6 +2,7 @@
 #include "core/volume/volume_header.h"
 
 #include <algorithm>
+#include <fstream>
 
 #include "core/util/text.h"
 #include "core/volume/header_checks.h"
@@ -80,14 +81,28 @@ std::optional<ImageFormat> format_from_path(std::string_view path) {
   return std::nullopt;
 }
 
+bool is_dicom_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  char start[132];
+  if (!in.read(start, sizeof start)) return false;
+  return std::string_view(start + 128, 4) == "DICM";
+}
+
+std::optional<ImageFormat> format_of_file(const std::string& path) {
+  if (auto format = format_from_path(path)) return format;
+  if (is_dicom_file(path)) return ImageFormat::kDicomSeg;
+  return std::nullopt;
+}
+
 absl::StatusOr<VolumeHeader> check_volume_header(const std::string& path,
                                                  const ReadLimits& limits) {
-  auto format = format_from_path(path);
+  auto format = format_of_file(path);
   if (!format) {
+    if (auto size = internal::file_size(path); !size.ok()) return size.status();
     return absl::InvalidArgumentError(
         cat(path,
-            ": file name: unknown extension; expected .nii, .nii.gz, .mha, .mhd, .nrrd, .nhdr, "
-            ".inr, .inr.gz, .vti or .dcm (DICOM SEG)"));
+            ": file name: unknown extension and not a DICOM file; expected .nii, .nii.gz, .mha, "
+            ".mhd, .nrrd, .nhdr, .inr, .inr.gz, .vti, or a DICOM SEG (.dcm or any name)"));
   }
   if (auto size = internal::file_size(path); !size.ok()) return size.status();
   const bool gzip = std::string_view(to_lower(path)).ends_with(".gz");

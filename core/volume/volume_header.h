@@ -88,6 +88,14 @@ struct VolumeHeader {
 // The format a path names by its extension, or nullopt.
 std::optional<ImageFormat> format_from_path(std::string_view path);
 
+// Whether `path` is a DICOM Part-10 file: "DICM" after its 128-byte
+// preamble, whatever its name (dcmqi's label.seg, a PACS file with none).
+bool is_dicom_file(const std::string& path);
+
+// The format of `path`: by its extension, else DICOM SEG when its content
+// says so, else nullopt.
+std::optional<ImageFormat> format_of_file(const std::string& path);
+
 // Parses and checks the header of `path`. Errors are INVALID_ARGUMENT naming
 // the file and field ("scan.nii: dim[2]: is 0, ..."), NOT_FOUND for a missing
 // file. Never echoes free-text header fields (patient data can hide there).

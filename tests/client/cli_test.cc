@@ -286,5 +286,60 @@ TEST(Cli, HelpDocumentsExitCodes) {
   EXPECT_NE(run.output.find("3 bad input"), std::string::npos) << run.output;
 }
 
+// --strict gives exit 4 on any warning, a volume mesh not delivered included:
+// at 2 mm hexahedra every nested shell is left out.
+TEST(Cli, StrictFailsWhenAVolumeMeshIsNotDelivered) {
+  const auto dir = testing::scratch_dir("cli-strict-hex");
+  const auto input = (dir / "nested.nii.gz").string();
+  ASSERT_EQ(run_cli("phantom nested-spheres --out " + input).exit_code, 0);
+  const std::string mesh = "mesh " + input + " --volume hex --hex-size 2 --formats vtu";
+  const CliRun lenient = run_cli(mesh + " --out " + (dir / "lenient").string() + " 2>&1");
+  EXPECT_EQ(lenient.exit_code, 0) << lenient.output;
+  const CliRun strict = run_cli(mesh + " --strict --out " + (dir / "strict").string() + " 2>&1");
+  EXPECT_EQ(strict.exit_code, 4) << strict.output;
+  EXPECT_NE(strict.output.find("no volume mesh"), std::string::npos) << strict.output;
+}
+
+// A DICOM SEG is known by its content: dcmqi's label.seg and a PACS file
+// with no extension read like the .dcm they are.
+TEST(Cli, DicomSegIsKnownByItsContentWhateverItsName) {
+  const auto seg = testing::shared_data("dicom-seg/dcmqi-24x38x3-seg.dcm");
+  if (!std::filesystem::exists(seg)) GTEST_SKIP() << "missing " << seg;
+  const auto dir = testing::scratch_dir("cli-dicom-names");
+  const CliRun named = run_cli("info " + seg);
+  ASSERT_EQ(named.exit_code, 0) << named.output;
+  ASSERT_NE(named.output.find("format       dicom-seg"), std::string::npos) << named.output;
+  for (const char* name : {"label.seg", "1.2.840.113619.2.55"}) {
+    const auto copy = dir / name;
+    std::filesystem::copy_file(seg, copy, std::filesystem::copy_options::overwrite_existing);
+    const CliRun info = run_cli("info " + copy.string());
+    EXPECT_EQ(info.exit_code, 0) << info.output;
+    // The same labels, line for line, below the file name.
+    EXPECT_EQ(info.output.substr(info.output.find('\n')),
+              named.output.substr(named.output.find('\n')))
+        << name;
+    const CliRun mesh =
+        run_cli("mesh " + copy.string() + " --out " + (dir / name).string() + "-out");
+    EXPECT_EQ(mesh.exit_code, 0) << mesh.output;
+  }
+  // Not DICOM and no known extension: bad input, saying both.
+  std::ofstream(dir / "notes.seg") << std::string(200, 'x');
+  const CliRun refused = run_cli("info " + (dir / "notes.seg").string());
+  EXPECT_EQ(refused.exit_code, 3) << refused.output;
+  EXPECT_NE(refused.output.find("not a DICOM file"), std::string::npos) << refused.output;
+}
+
+TEST(Cli, InfoCountsOverlappingSegmentsKeptApart) {
+  const auto seg = testing::shared_data("dicom-seg/highdicom-seg_image_ct_binary_overlap.dcm");
+  if (!std::filesystem::exists(seg)) GTEST_SKIP() << "missing " << seg;
+  const CliRun refused = run_cli("info " + seg);
+  EXPECT_EQ(refused.exit_code, 3) << refused.output;
+  EXPECT_NE(refused.output.find("--overlapping separate"), std::string::npos) << refused.output;
+  const CliRun separate = run_cli("info --overlapping separate " + seg);
+  ASSERT_EQ(separate.exit_code, 0) << separate.output;
+  EXPECT_NE(separate.output.find("layers       2"), std::string::npos) << separate.output;
+  EXPECT_NE(separate.output.find("labels       2"), std::string::npos) << separate.output;
+}
+
 }  // namespace
 }  // namespace labelmesh

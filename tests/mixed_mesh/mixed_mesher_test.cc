@@ -345,6 +345,15 @@ TEST(MixedVolumeStage, HexahedraOnlyLeavesOutWhatCannotBeValid) {
   EXPECT_EQ(report.volume().hexahedra(), 0u);
   EXPECT_EQ(report.volume().files_size(), 0);
   EXPECT_FALSE(fs::exists(dir / "coarse" / "volume.vtu"));
+
+  // --strict: a volume mesh not delivered fails the run like a surface does.
+  params->guard.strict = true;
+  result = run_pipeline(path, *params, {});
+  ASSERT_FALSE(result.ok());
+  EXPECT_EQ(result.status().code(), absl::StatusCode::kFailedPrecondition);
+  EXPECT_NE(std::string(result.status().message()).find("strict: 3 label(s)"), std::string::npos)
+      << result.status();
+  EXPECT_NE(std::string(result.status().message()).find("no volume mesh"), std::string::npos);
 }
 
 TEST(MixedVolumeStage, TetGenNodeFilesAreRefusedForMixedMeshes) {
