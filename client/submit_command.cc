@@ -39,7 +39,7 @@ struct SubmitFlags {
   bool json = false;
   bool keep_input = false;
   std::string request_id;
-  int retries = 3;
+  int retries = 5;
 };
 
 // A fresh request id: 32 random hex digits.
@@ -55,6 +55,16 @@ std::string random_request_id() {
 bool retryable(const absl::Status& status) {
   return status.code() == absl::StatusCode::kUnavailable ||
          status.code() == absl::StatusCode::kAborted;
+}
+
+// How long to wait before try `attempt` + 2: 1, 2, 4, ... s, at most 30 s,
+// each with up to half as much again at random, so that clients cut off
+// together (a NATS restart, say) do not all come back at once.
+std::chrono::milliseconds retry_delay(int attempt) {
+  const int64_t base = std::min<int64_t>(int64_t{1000} << std::min(attempt, 5), 30'000);
+  static thread_local std::mt19937_64 random{std::random_device{}()};
+  std::uniform_int_distribution<int64_t> extra(0, base / 2);
+  return std::chrono::milliseconds(base + extra(random));
 }
 
 // The upload's percentage and rate on a terminal.
@@ -126,7 +136,7 @@ absl::StatusOr<v1::SubmitReply> upload(const ServerConnection& connection,
     if (reply.ok() || !retryable(reply.status()) || attempt >= flags.retries) return reply;
     std::fprintf(stderr, "labelmesh submit: %s; trying again\n",
                  std::string(reply.status().message()).c_str());
-    std::this_thread::sleep_for(std::chrono::seconds(1 << attempt));
+    std::this_thread::sleep_for(retry_delay(attempt));
   }
 }
 

@@ -184,42 +184,52 @@ const TokenHolder* ClientAuthenticator::find_token(std::string_view presented) c
 absl::StatusOr<ClientIdentity> ClientAuthenticator::identify(
     const grpc::ServerContextBase& context) {
   if (anonymous()) return ClientIdentity{kAnonymous, false};
+  auto identity = has_tokens() ? identify_by_token(context) : identify_by_certificate(context);
+  // The credential is checked first: a valid one is never backed off, so
+  // failures from an address (behind an ingress or NAT, everyone's) hold
+  // back only the failing calls, not the clients that share it.
+  if (identity.ok()) return identity;
   const std::string host = peer_host(context.peer());
   const absl::Time now = absl::Now();
   if (auto status = backoff_.check(host, now); !status.ok()) return status;
-  std::string name;
-  if (has_tokens()) {
-    const auto& metadata = context.client_metadata();
-    auto it = metadata.find("authorization");
-    std::string_view presented;
-    if (it != metadata.end()) presented = std::string_view(it->second.data(), it->second.size());
-    constexpr std::string_view kScheme = "Bearer ";
-    const TokenHolder* holder = nullptr;
-    if (presented.substr(0, kScheme.size()) == kScheme) {
-      holder = find_token(presented.substr(kScheme.size()));
-    }
-    if (holder == nullptr) {
-      backoff_.failed(host, now);
-      return absl::UnauthenticatedError(
-          "missing or wrong bearer token (metadata 'authorization: Bearer <token>')");
-    }
-    name = holder->name;
-  } else {
-    // Mutual TLS: the transport verified the certificate; its CN names the client.
-    const auto auth = context.auth_context();
-    const auto names = auth ? auth->FindPropertyValues(GRPC_X509_CN_PROPERTY_NAME)
-                            : std::vector<grpc::string_ref>{};
-    const std::string_view common_name =
-        names.empty() ? std::string_view() : std::string_view(names[0].data(), names[0].size());
-    if (!is_identity_name(common_name) || is_reserved_name(common_name)) {
-      backoff_.failed(host, now);
-      return absl::UnauthenticatedError(
-          "the client certificate has no common name usable as an identity "
-          "(1-64 of A-Z a-z 0-9 . _ @ -, not 'anonymous' or 'token')");
-    }
-    name.assign(names[0].data(), names[0].size());
+  backoff_.failed(host, now);
+  return identity.status();
+}
+
+absl::StatusOr<ClientIdentity> ClientAuthenticator::identify_by_token(
+    const grpc::ServerContextBase& context) const {
+  const auto& metadata = context.client_metadata();
+  auto it = metadata.find("authorization");
+  std::string_view presented;
+  if (it != metadata.end()) presented = std::string_view(it->second.data(), it->second.size());
+  constexpr std::string_view kScheme = "Bearer ";
+  const TokenHolder* holder = nullptr;
+  if (presented.substr(0, kScheme.size()) == kScheme) {
+    holder = find_token(presented.substr(kScheme.size()));
   }
-  return ClientIdentity{name, admins_.count(name) > 0};
+  if (holder == nullptr) {
+    return absl::UnauthenticatedError(
+        "missing or wrong bearer token (metadata 'authorization: Bearer <token>')");
+  }
+  return ClientIdentity{holder->name, admins_.count(holder->name) > 0};
+}
+
+absl::StatusOr<ClientIdentity> ClientAuthenticator::identify_by_certificate(
+    const grpc::ServerContextBase& context) const {
+  // Mutual TLS: the transport verified the certificate; its CN names the client.
+  const auto auth = context.auth_context();
+  const auto names =
+      auth ? auth->FindPropertyValues(GRPC_X509_CN_PROPERTY_NAME) : std::vector<grpc::string_ref>{};
+  const std::string_view common_name =
+      names.empty() ? std::string_view() : std::string_view(names[0].data(), names[0].size());
+  if (!is_identity_name(common_name) || is_reserved_name(common_name)) {
+    return absl::UnauthenticatedError(
+        "the client certificate has no common name usable as an identity "
+        "(1-64 of A-Z a-z 0-9 . _ @ -, not 'anonymous' or 'token')");
+  }
+  std::string name(common_name);
+  const bool admin = admins_.count(name) > 0;
+  return ClientIdentity{std::move(name), admin};
 }
 
 }  // namespace labelmesh::server

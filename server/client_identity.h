@@ -38,7 +38,7 @@ struct TokenHolder {
 // characters; both unique. Errors name the file and line.
 absl::StatusOr<std::vector<TokenHolder>> read_clients_file(const std::string& path);
 
-// Refuses every call from a host for a while once it failed authentication
+// Refuses the failing calls from a host for a while once it failed authentication
 // `allowed_failures` times: first `first_backoff`, doubling with each further
 // failure up to `longest_backoff`. A host's failures are forgotten after
 // `kForgetAfter` without one, not by a success (a client with a token of its
@@ -80,13 +80,20 @@ class ClientAuthenticator {
   bool has_tokens() const { return !tokens_.empty(); }
 
   // The caller's identity; UNAUTHENTICATED for a missing or wrong token,
-  // RESOURCE_EXHAUSTED while its host is backed off.
+  // RESOURCE_EXHAUSTED for one while its host is backed off. A valid
+  // credential is never backed off: the backoff makes failures cheap for
+  // the server (they are neither checked further nor audited), and tokens
+  // must be random enough not to be guessed (docs/service.md).
   absl::StatusOr<ClientIdentity> identify(const grpc::ServerContextBase& context);
 
  private:
   ClientAuthenticator(std::vector<TokenHolder> tokens, bool mutual_tls,
                       std::set<std::string> admins, const ServerConfig& config);
   const TokenHolder* find_token(std::string_view presented) const;
+  // UNAUTHENTICATED, counting nothing, for a credential that names no client.
+  absl::StatusOr<ClientIdentity> identify_by_token(const grpc::ServerContextBase& context) const;
+  absl::StatusOr<ClientIdentity> identify_by_certificate(
+      const grpc::ServerContextBase& context) const;
 
   const std::vector<TokenHolder> tokens_;
   const bool mutual_tls_;

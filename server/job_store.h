@@ -31,6 +31,9 @@ class JobStore {
   virtual absl::StatusOr<uint64_t> free_bytes() const = 0;
 
   virtual bool queue_full() const = 0;
+  // UNAVAILABLE while the store cannot take jobs (a cluster frontend cut off
+  // from NATS): checked before an upload is received.
+  virtual absl::Status available() const { return absl::OkStatus(); }
   // Moves the upload into a new job and queues it; returns the queue position.
   // RESOURCE_EXHAUSTED when the queue is full, UNAVAILABLE after close().
   virtual absl::StatusOr<uint32_t> accept(v1::JobRecord record, const std::string& upload_path) = 0;

@@ -247,6 +247,11 @@ grpc::Status MeshingService::submit(grpc::ServerContext& context,
     reason = "shutting_down";
     return grpc::Status(grpc::StatusCode::UNAVAILABLE, "the server is shutting down");
   }
+  // Refused before the upload, not after it has all been received.
+  if (auto status = store_.available(); !status.ok()) {
+    reason = "store_unavailable";
+    return to_grpc(status);
+  }
   auto stream = streams_.open(context.peer());
   if (!stream.ok()) {
     reason = "too_many_streams";

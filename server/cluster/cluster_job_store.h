@@ -73,6 +73,10 @@ class ClusterJobStore final : public JobStore {
   size_t remove_abandoned_uploads(absl::Duration age) const;
   // False while this frontend cannot reach NATS.
   bool connected() const { return cluster_.client->connected(); }
+  absl::Status available() const override {
+    if (connected()) return absl::OkStatus();
+    return absl::UnavailableError("the cluster's NATS server is unreachable; try again later");
+  }
 
   // Closes every follow (UNAVAILABLE); listen() refuses from now on.
   void close();

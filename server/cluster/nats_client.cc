@@ -11,7 +11,9 @@ absl::Status nats_error(natsStatus status, std::string_view what) {
     case NATS_OK:
       return absl::OkStatus();
     case NATS_TIMEOUT:
-      return absl::DeadlineExceededError(text);
+      // Unanswered: the server is away (the client keeps reconnecting) or
+      // overloaded. Clients retry UNAVAILABLE; DEADLINE_EXCEEDED is theirs.
+      return absl::UnavailableError(absl::StrCat(text, " (NATS did not answer in time)"));
     case NATS_NOT_FOUND:
       return absl::NotFoundError(text);
     case NATS_NO_SERVER:

@@ -46,9 +46,9 @@ class NatsClient {
 // exists (another machine made it). Errors: those of nats_error.
 absl::Status add_stream(NatsClient& client, jsStreamConfig& config);
 
-// A failed call as a status naming `what`: NATS_TIMEOUT is
-// DEADLINE_EXCEEDED, NATS_NOT_FOUND NOT_FOUND, a closed or absent server
-// UNAVAILABLE, the rest INTERNAL with the client's own text.
+// A failed call as a status naming `what`: NATS_NOT_FOUND is NOT_FOUND; an
+// unanswered call (NATS_TIMEOUT) or a closed or absent server UNAVAILABLE, so
+// that clients try again; the rest INTERNAL with the client's own text.
 absl::Status nats_error(natsStatus status, std::string_view what);
 
 }  // namespace labelmesh::cluster

@@ -184,5 +184,15 @@ TEST(NatsClient, NoServerIsUnavailable) {
   EXPECT_EQ(client.status().code(), absl::StatusCode::kUnavailable) << client.status();
 }
 
+// An unanswered call (NATS away, the client reconnecting) is UNAVAILABLE, what
+// clients retry, not DEADLINE_EXCEEDED, which is for their own deadlines.
+TEST(NatsClient, AnUnansweredCallIsUnavailable) {
+  const absl::Status status = nats_error(NATS_TIMEOUT, "publish job-x");
+  EXPECT_EQ(status.code(), absl::StatusCode::kUnavailable);
+  EXPECT_NE(std::string(status.message()).find("publish job-x"), std::string::npos) << status;
+  EXPECT_EQ(nats_error(NATS_NOT_FOUND, "get").code(), absl::StatusCode::kNotFound);
+  EXPECT_TRUE(nats_error(NATS_OK, "get").ok());
+}
+
 }  // namespace
 }  // namespace labelmesh::cluster

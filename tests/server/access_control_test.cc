@@ -6,6 +6,7 @@
 #include <grpcpp/generic/generic_stub.h>
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <chrono>
 #include <thread>
 
@@ -166,6 +167,7 @@ TEST_F(AccessControlTest, DeleteRemovesInputAndResultsAtOnce) {
 }
 
 TEST_F(AccessControlTest, ARunningJobDeletedIsStoppedAndGone) {
+  LABELMESH_SKIP_WITHOUT_SHARED_DATA();
   ServiceHarness service(config_);
   service.token = kAliceToken;
   // The liver runs for several seconds: long enough to be deleted mid-run.
@@ -225,23 +227,59 @@ TEST_F(AccessControlTest, RepeatedFailedAuthenticationIsBackedOff) {
   };
   service.token = "wrong-token-0123456789";
   for (int i = 0; i < 3; ++i) EXPECT_EQ(list_code(), grpc::StatusCode::UNAUTHENTICATED);
-  // Backed off: even the right token is refused for a second.
-  service.token = kAliceToken;
+  // Backed off: a wrong token is refused unchecked for a second; the right
+  // one is never held back.
   EXPECT_EQ(list_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
-  std::this_thread::sleep_for(std::chrono::milliseconds(1200));
+  service.token = kAliceToken;
   EXPECT_EQ(list_code(), grpc::StatusCode::OK);
-  // A success does not clear the count: the next failure backs off again
-  // (a client could otherwise guess between calls with a token of its own).
+  std::this_thread::sleep_for(std::chrono::milliseconds(1200));
+  // A success does not clear the count: the next failure backs off again.
   service.token = "wrong-token-0123456789";
   EXPECT_EQ(list_code(), grpc::StatusCode::UNAUTHENTICATED);
-  service.token = kAliceToken;
   EXPECT_EQ(list_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
+  service.token = kAliceToken;
+  EXPECT_EQ(list_code(), grpc::StatusCode::OK);
   EXPECT_NE(
       service.server().metrics().text().find("labelmesh_rejections_total{reason=\"auth_backoff\"}"),
       std::string::npos);
   // Each failed authentication is audited; the backed-off calls are only
   // counted, so that a client hammering the server cannot fill the disk.
   EXPECT_EQ(audit_lines().size(), 4u);
+}
+
+// An attacker with no credentials on the same address as a valid client
+// (behind an ingress or NAT, every client shares one) does not lock it out.
+TEST_F(AccessControlTest, FailedLoginsDoNotLockOutAValidClientOnTheSameHost) {
+  config_.auth_failures_before_backoff = 2;
+  config_.auth_first_backoff = absl::Seconds(5);
+  ServiceHarness service(config_);
+  std::atomic<bool> done{false};
+  std::atomic<int> attacker_calls{0}, attacker_backed_off{0};
+  std::thread attacker([&] {
+    while (!done) {
+      grpc::ClientContext ctx;
+      ctx.AddMetadata("authorization", "Bearer wrong-token-0123456789");
+      ctx.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(5));
+      v1::ListJobsReply reply;
+      const auto code = service.stub().ListJobs(&ctx, {}, &reply).error_code();
+      ++attacker_calls;
+      if (code == grpc::StatusCode::RESOURCE_EXHAUSTED) ++attacker_backed_off;
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    }
+  });
+  service.token = kAliceToken;
+  int served = 0;
+  for (int i = 0; i < 20; ++i) {
+    auto ctx = service.context();
+    v1::ListJobsReply reply;
+    served += service.stub().ListJobs(ctx.get(), {}, &reply).ok();
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  done = true;
+  attacker.join();
+  EXPECT_EQ(served, 20);
+  EXPECT_GT(attacker_calls.load(), 5);
+  EXPECT_GE(attacker_backed_off.load(), attacker_calls.load() - 2);
 }
 
 // The status of a reflection call carrying no request.

@@ -360,6 +360,35 @@ TEST_F(ClusterRolesTest, AFrontendIsReadyWhileItReachesNatsAndLiveThroughout) {
   (*frontend)->shutdown();
 }
 
+// A frontend cut off from NATS refuses a Submit at once as UNAVAILABLE (what
+// `labelmesh submit` retries), before taking the upload; once NATS is back
+// the same Submit is accepted.
+TEST_F(ClusterRolesTest, ASubmitWhileNatsIsDownIsUnavailableAtOnce) {
+  using Status = grpc::health::v1::HealthCheckResponse;
+  testing::ServiceHarness frontend(role_config(dir_, "frontend", nats_->url()));
+  const int port = frontend.server().port();
+  const fs::path volume = testing::write_phantom(dir_, volume::PhantomShape::kSphere);
+  auto wait_for = [&](Status::ServingStatus wanted) {
+    for (int i = 0; i < 150 && health(port, "") != wanted; ++i)
+      std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    return health(port, "");
+  };
+  nats_->stop();
+  ASSERT_EQ(wait_for(Status::NOT_SERVING), Status::NOT_SERVING);
+  v1::SubmitReply reply;
+  const auto start = std::chrono::steady_clock::now();
+  const grpc::Status refused = frontend.submit(volume, {}, &reply);
+  EXPECT_EQ(refused.error_code(), grpc::StatusCode::UNAVAILABLE) << refused.error_message();
+  EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(3));
+  EXPECT_NE(refused.error_message().find("NATS"), std::string::npos) << refused.error_message();
+  nats_->restart();
+  ASSERT_EQ(wait_for(Status::SERVING), Status::SERVING);
+  const grpc::Status accepted = frontend.submit(volume, {}, &reply);
+  EXPECT_TRUE(accepted.ok()) << accepted.error_message();
+  EXPECT_FALSE(reply.job_id().empty());
+  frontend.shutdown();
+}
+
 TEST_F(ClusterRolesTest, AWorkerRunsAJobFromTheSharedDirectoryAndServesOnlyHealth) {
   // A sphere phantom accepted as a frontend would, run by a real worker.
   const fs::path volume = testing::write_phantom(dir_, volume::PhantomShape::kSphere);
