@@ -88,6 +88,7 @@ TEST(Cli, MeshWritesSurfacesAndReport) {
 
 // Names from an ITK-SNAP label file reach the file names and the report.
 TEST(Cli, LabelNamesNameTheSurfaceFiles) {
+  LABELMESH_SKIP_WITHOUT_SHARED_DATA();
   const auto dir = testing::scratch_dir("cli-label-names");
   const std::string out = (dir / "out").string();
   const CliRun run = run_cli("mesh " + testing::shared_data("MRIcrop-seg_converted.nii.gz") +
@@ -239,6 +240,7 @@ TEST(Cli, BadPoissonOptionsAreUsageErrors) {
 }
 
 TEST(Cli, InfoJsonOnRealData) {
+  LABELMESH_SKIP_WITHOUT_SHARED_DATA();
   const CliRun run = run_cli("info --json " + testing::shared_data("liver.inr.gz"));
   ASSERT_EQ(run.exit_code, 0) << run.output;
   v1::InputSummary summary;
@@ -303,6 +305,7 @@ TEST(Cli, StrictFailsWhenAVolumeMeshIsNotDelivered) {
 // A DICOM SEG is known by its content: dcmqi's label.seg and a PACS file
 // with no extension read like the .dcm they are.
 TEST(Cli, DicomSegIsKnownByItsContentWhateverItsName) {
+  LABELMESH_SKIP_WITHOUT_SHARED_DATA();
   const auto seg = testing::shared_data("dicom-seg/dcmqi-24x38x3-seg.dcm");
   if (!std::filesystem::exists(seg)) GTEST_SKIP() << "missing " << seg;
   const auto dir = testing::scratch_dir("cli-dicom-names");
@@ -330,6 +333,7 @@ TEST(Cli, DicomSegIsKnownByItsContentWhateverItsName) {
 }
 
 TEST(Cli, InfoCountsOverlappingSegmentsKeptApart) {
+  LABELMESH_SKIP_WITHOUT_SHARED_DATA();
   const auto seg = testing::shared_data("dicom-seg/highdicom-seg_image_ct_binary_overlap.dcm");
   if (!std::filesystem::exists(seg)) GTEST_SKIP() << "missing " << seg;
   const CliRun refused = run_cli("info " + seg);

@@ -163,6 +163,9 @@ def main():
         solve_two_materials(work, report, "nested")
     # The prostate's two zones (0.6 x 0.6 x 4 mm slices): the peripheral zone
     # stiff, the transition zone soft.
+    if not pathlib.Path(args.prostate).exists():
+        print(f"SKIP: the nested labels passed; missing shared data file {args.prostate}")
+        sys.exit(77)
     with tempfile.TemporaryDirectory(prefix="labelmesh-conforming-") as tmp:
         work = pathlib.Path(tmp)
         report = mesh_conforming(args.labelmesh, pathlib.Path(args.prostate), work, "inp")

@@ -129,6 +129,7 @@ TEST(VolumeMeshes, SelfIntersectingSurfaceIsRefusedByLabel) {
 }
 
 TEST(VolumeMeshesRealData, LiverTetrahedraAreValid) {
+  LABELMESH_SKIP_WITHOUT_SHARED_DATA();
   const MeshResult result = mesh_with_tets(testing::shared_data("liver.inr.gz"), {255});
   ASSERT_TRUE(result.volume.has_value());
   const VolumeResult& volume = *result.volume;

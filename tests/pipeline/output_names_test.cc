@@ -30,6 +30,7 @@ TEST(OutputNames, UnnamedLabelsKeepTheirNumberOnly) {
 }
 
 TEST(OutputNames, ADicomSegSegmentNamesItsSurfaceFiles) {
+  LABELMESH_SKIP_WITHOUT_SHARED_DATA();
   const auto out = testing::scratch_dir("named-outputs");
   MeshParams params;
   auto result =

@@ -27,6 +27,7 @@ MeshParams poisson_params() {
 class SharedVolumes : public ::testing::TestWithParam<const char*> {};
 
 TEST_P(SharedVolumes, EveryLabelIsWithinToleranceOrTooSmall) {
+  LABELMESH_SKIP_WITHOUT_SHARED_DATA();
   auto result = run_pipeline(testing::shared_data(GetParam()), poisson_params(), RunContext{});
   ASSERT_TRUE(result.ok()) << result.status();
   std::set<int32_t> too_small;
@@ -67,6 +68,7 @@ INSTANTIATE_TEST_SUITE_P(Files, SharedVolumes,
 // Brain label 8 has a groove that the mask surface bridges at its label's
 // sizing and at half of it; a quarter resolves it.
 TEST(SharedVolumesBrain, ANarrowGrooveGetsTheFinestMaskSurface) {
+  LABELMESH_SKIP_WITHOUT_SHARED_DATA();
   MeshParams params = poisson_params();
   params.labels = {8};
   auto result =

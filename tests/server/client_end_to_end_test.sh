@@ -8,6 +8,10 @@
 # Usage: client_end_to_end_test.sh LABELMESHD LABELMESH SHARED_DATA
 set -euo pipefail
 labelmeshd=$1 labelmesh=$2 data=$3
+if [ ! -f "$data/liver.inr.gz" ]; then
+  echo "SKIP: missing shared data file $data/liver.inr.gz"
+  exit 77
+fi
 work=$(mktemp -d)
 server_pid=
 stop_server() {

@@ -455,6 +455,7 @@ TEST_F(MeshingServiceTest, UploadsThatCouldOnlyFailLaterAreRefusedAtSubmit) {
 // (segments that overlap, no patient geometry) is refused before it queues,
 // and what can comes back with its segments' names.
 TEST_F(MeshingServiceTest, ADicomSegIsMeshedWithItsSegmentNamesOrRefusedAtSubmit) {
+  LABELMESH_SKIP_WITHOUT_SHARED_DATA();
   ServiceHarness service(config_);
   v1::SubmitReply reply;
   for (const char* refused : {"dicom-seg/highdicom-seg_image_ct_binary_overlap.dcm",
@@ -507,6 +508,7 @@ TEST_F(MeshingServiceTest, ADicomSegIsMeshedWithItsSegmentNamesOrRefusedAtSubmit
 // With overlapping segments kept apart, the SEG refused above is meshed:
 // each segment on its own.
 TEST_F(MeshingServiceTest, OverlappingSegmentsCanBeMeshedEachOnItsOwn) {
+  LABELMESH_SKIP_WITHOUT_SHARED_DATA();
   ServiceHarness service(config_);
   v1::MeshOptions options = repaired_options();
   options.set_overlapping_segments(v1::OVERLAPPING_SEGMENTS_SEPARATE);
@@ -529,6 +531,7 @@ TEST_F(MeshingServiceTest, OverlappingSegmentsCanBeMeshedEachOnItsOwn) {
 }
 
 TEST_F(MeshingServiceTest, CancelStopsARunningJobWithinASecond) {
+  LABELMESH_SKIP_WITHOUT_SHARED_DATA();
   ServiceHarness service(config_);
   v1::SubmitReply reply;
   ASSERT_TRUE(service.submit(shared_data("liver.inr.gz"), liver_options(), &reply).ok());
@@ -574,6 +577,7 @@ TEST_F(MeshingServiceTest, CancelStopsARunningJobWithinASecond) {
 }
 
 TEST_F(MeshingServiceTest, JobOverTheDeadlineFailsWithDeadlineExceeded) {
+  LABELMESH_SKIP_WITHOUT_SHARED_DATA();
   config_.job_timeout = absl::Seconds(1);
   ServiceHarness service(config_);
   v1::SubmitReply reply;

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -15,10 +16,22 @@
 
 namespace labelmesh::testing {
 
-// ../shared/data beside the checkout: the real segmentations.
+// ../shared/data beside the checkout: the real segmentations; the
+// environment's LABELMESH_SHARED_DATA, when set, names another copy.
 inline std::string shared_data(std::string_view name) {
-  return (std::filesystem::path(LABELMESH_SHARED_DATA) / std::string(name)).string();
+  const char* elsewhere = std::getenv("LABELMESH_SHARED_DATA");
+  const std::filesystem::path dir =
+      elsewhere != nullptr && *elsewhere != '\0' ? elsewhere : LABELMESH_SHARED_DATA;
+  return (dir / std::string(name)).string();
 }
+
+// Skips the running test, naming the folder, when the real segmentations
+// are missing (a clone without ../shared/data): never a crash or a failure.
+#define LABELMESH_SKIP_WITHOUT_SHARED_DATA()                                \
+  if (const auto sources = ::labelmesh::testing::shared_data("SOURCES.md"); \
+      !std::filesystem::exists(sources))                                    \
+  GTEST_SKIP() << "missing the real segmentations (" << sources             \
+               << "): ../shared/data beside the checkout"
 
 // A fresh directory for one test, removed by the next run of the same test.
 // It sits under the running test's own name, so tests that ctest runs side by

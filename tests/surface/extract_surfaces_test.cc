@@ -170,6 +170,7 @@ void expect_volumes_match_voxels(const std::string& file, uint64_t min_voxels, d
 }
 
 TEST(ExtractSurfacesRealData, LiverSurfacesAreClosedManifoldAndKeepVolume) {
+  LABELMESH_SKIP_WITHOUT_SHARED_DATA();
   auto v = volume::read_label_volume(testing::shared_data("liver.inr.gz"), {}, RunContext{});
   ASSERT_TRUE(v.ok()) << v.status();
   const auto stats = volume::compute_label_statistics(*v);
@@ -185,6 +186,7 @@ TEST(ExtractSurfacesRealData, LiverSurfacesAreClosedManifoldAndKeepVolume) {
 }
 
 TEST(ExtractSurfacesRealData, MirroredAxesStillFaceOutwards) {
+  LABELMESH_SKIP_WITHOUT_SHARED_DATA();
   // x and y flipped in the header (a negative-determinant grid).
   expect_volumes_match_voxels("totalseg_example_seg_mr.nii.gz", 10000, 0.03);
 }

@@ -234,6 +234,7 @@ TEST(NetSurfaces, CoarseIsotropicSphereIsWithinAQuarterVoxel) {
 // every voxel centre and far smoother than Marching Cubes; --strict refuses
 // the run when any label is outside.
 TEST(NetSurfacesRealData, MrLabelsAreFaithfulSmoothOrWarned) {
+  LABELMESH_SKIP_WITHOUT_SHARED_DATA();
   const auto path = testing::shared_data("totalseg_example_seg_mr.nii.gz");
   if (!std::filesystem::exists(path)) GTEST_SKIP() << "missing " << path;
   auto result = run_pipeline(path, MeshParams{}, {});
@@ -278,6 +279,7 @@ TEST(NetSurfacesRealData, MrLabelsAreFaithfulSmoothOrWarned) {
 // voxels can (along edges, at corners, around tunnels): each label's cut is
 // still a closed 2-manifold.
 TEST(NetSurfacesRealData, EveryBrainLabelIsAClosedManifold) {
+  LABELMESH_SKIP_WITHOUT_SHARED_DATA();
   const auto path = testing::shared_data("iso2mesh_brain_seg_converted.nii.gz");
   if (!std::filesystem::exists(path)) GTEST_SKIP() << "missing " << path;
   auto v = volume::read_label_volume(path, {}, RunContext{});

@@ -464,6 +464,7 @@ TEST(PoissonSurface, HollowComponentsKeepTheirCavity) {
 }
 
 TEST(PoissonSurfaceRealData, LiverMeetsTheQualityTargets) {
+  LABELMESH_SKIP_WITHOUT_SHARED_DATA();
   const auto path = testing::shared_data("liver.inr.gz");
   MeshParams params = poisson_everywhere();
   params.labels = {255};

@@ -225,6 +225,7 @@ std::string synthetic_seg(std::string_view transfer_syntax, bool explicit_vr, bo
 }
 
 TEST(DicomSegHeader, ReadsTheDcmqiSegGeometry) {
+  LABELMESH_SKIP_WITHOUT_SHARED_DATA();
   const DicomSegHeader h = parse_ok(seg_file("dcmqi-24x38x3-seg.dcm"));
   EXPECT_EQ(h.transfer_syntax_uid, "1.2.840.10008.1.2.1");
   EXPECT_EQ(h.sop_class_uid, "1.2.840.10008.5.1.4.1.1.66.4");
@@ -259,6 +260,7 @@ TEST(DicomSegHeader, ReadsTheDcmqiSegGeometry) {
 }
 
 TEST(DicomSegHeader, ReadsTheImplicitVrHighdicomGeometry) {
+  LABELMESH_SKIP_WITHOUT_SHARED_DATA();
   const DicomSegHeader h = parse_ok(seg_file("highdicom-seg_image_ct_binary.dcm"));
   EXPECT_EQ(h.transfer_syntax_uid, "1.2.840.10008.1.2");
   EXPECT_EQ(h.sop_class_uid, "1.2.840.10008.5.1.4.1.1.66.4");
@@ -287,6 +289,7 @@ TEST(DicomSegHeader, ReadsTheImplicitVrHighdicomGeometry) {
 }
 
 TEST(DicomSegHeader, ReadsWhichSegmentEachFrameHoldsWhenSegmentsOverlap) {
+  LABELMESH_SKIP_WITHOUT_SHARED_DATA();
   const DicomSegHeader h = parse_ok(seg_file("highdicom-seg_image_ct_binary_overlap.dcm"));
   EXPECT_EQ(h.segments, 2u);
   EXPECT_EQ(h.segment_numbers, std::vector<uint16_t>({1, 2}));
@@ -296,6 +299,7 @@ TEST(DicomSegHeader, ReadsWhichSegmentEachFrameHoldsWhenSegmentsOverlap) {
 }
 
 TEST(DicomSegHeader, ReadsAFractionalSegmentation) {
+  LABELMESH_SKIP_WITHOUT_SHARED_DATA();
   const DicomSegHeader h = parse_ok(seg_file("highdicom-seg_image_ct_binary_fractional.dcm"));
   EXPECT_EQ(h.segmentation_type, "FRACTIONAL");
   EXPECT_EQ(h.bits_allocated, 8);
@@ -305,6 +309,7 @@ TEST(DicomSegHeader, ReadsAFractionalSegmentation) {
 }
 
 TEST(DicomSegHeader, NotesSlideMicroscopyPlanePositions) {
+  LABELMESH_SKIP_WITHOUT_SHARED_DATA();
   const DicomSegHeader h = parse_ok(seg_file("highdicom-seg_image_sm_control.dcm"));
   EXPECT_TRUE(h.has_plane_position_slide);
   EXPECT_EQ(h.frames, 20u);
@@ -313,11 +318,13 @@ TEST(DicomSegHeader, NotesSlideMicroscopyPlanePositions) {
 }
 
 TEST(DicomSegHeader, ReadsTheLabelmapSopClass) {
+  LABELMESH_SKIP_WITHOUT_SHARED_DATA();
   const DicomSegHeader h = parse_ok(seg_file("dcmqi-sparse-labelmap-noppv.dcm"));
   EXPECT_EQ(h.sop_class_uid, "1.2.840.10008.5.1.4.1.1.66.7");
 }
 
 TEST(DicomSegHeader, EndsEveryRealFileAtItsPixelData) {
+  LABELMESH_SKIP_WITHOUT_SHARED_DATA();
   for (const auto& entry : std::filesystem::directory_iterator(testing::shared_data("dicom-seg"))) {
     if (entry.path().extension() != ".dcm") continue;
     const DicomSegHeader h = parse_ok(entry.path().string());
@@ -372,6 +379,7 @@ TEST(DicomSegHeader, ReportsAMissingFileAsNotFound) {
 }
 
 TEST(DicomSegHeader, RefusesAFileWithoutTheDicmMagic) {
+  LABELMESH_SKIP_WITHOUT_SHARED_DATA();
   const auto dir = testing::scratch_dir("DicomSegHeader.NoMagic");
   std::string bytes = dcmqi_bytes();
   bytes.replace(128, 4, "DICX");
@@ -379,6 +387,7 @@ TEST(DicomSegHeader, RefusesAFileWithoutTheDicmMagic) {
 }
 
 TEST(DicomSegHeader, NamesRowsWhenRowsIsZero) {
+  LABELMESH_SKIP_WITHOUT_SHARED_DATA();
   const auto dir = testing::scratch_dir("DicomSegHeader.RowsZero");
   std::string bytes = dcmqi_bytes();
   put_u16(bytes, kDcmqiRowsValue, 0);
@@ -386,6 +395,7 @@ TEST(DicomSegHeader, NamesRowsWhenRowsIsZero) {
 }
 
 TEST(DicomSegHeader, RefusesBitsAllocatedASegmentationCannotHave) {
+  LABELMESH_SKIP_WITHOUT_SHARED_DATA();
   const auto dir = testing::scratch_dir("DicomSegHeader.Bits");
   std::string bytes = dcmqi_bytes();
   put_u16(bytes, kDcmqiBitsAllocatedValue, 12);
@@ -393,6 +403,7 @@ TEST(DicomSegHeader, RefusesBitsAllocatedASegmentationCannotHave) {
 }
 
 TEST(DicomSegHeader, RefusesAFrameCountThePerFrameGroupsDoNotMatch) {
+  LABELMESH_SKIP_WITHOUT_SHARED_DATA();
   const auto dir = testing::scratch_dir("DicomSegHeader.FrameCount");
   std::string bytes = dcmqi_bytes();
   bytes[kDcmqiNumberOfFramesValue] = '2';
@@ -403,6 +414,7 @@ TEST(DicomSegHeader, RefusesAFrameCountThePerFrameGroupsDoNotMatch) {
 }
 
 TEST(DicomSegHeader, RefusesLengthsThatRunPastTheFile) {
+  LABELMESH_SKIP_WITHOUT_SHARED_DATA();
   const auto dir = testing::scratch_dir("DicomSegHeader.LongLengths");
   std::string bytes = dcmqi_bytes();
   put_u32(bytes, kDcmqiSharedGroupsLength, 0xFFFFFFF0);
@@ -422,6 +434,7 @@ TEST(DicomSegHeader, RefusesLengthsThatRunPastTheFile) {
 }
 
 TEST(DicomSegHeader, RefusesEncapsulatedPixelData) {
+  LABELMESH_SKIP_WITHOUT_SHARED_DATA();
   const auto dir = testing::scratch_dir("DicomSegHeader.Encapsulated");
   std::string bytes = dcmqi_bytes();
   put_u32(bytes, kDcmqiPixelDataLength, 0xFFFFFFFF);
@@ -429,6 +442,7 @@ TEST(DicomSegHeader, RefusesEncapsulatedPixelData) {
 }
 
 TEST(DicomSegHeader, RefusesCompressedTransferSyntaxesByName) {
+  LABELMESH_SKIP_WITHOUT_SHARED_DATA();
   const auto dir = testing::scratch_dir("DicomSegHeader.Compressed");
   std::string bytes = dcmqi_bytes();
   bytes.replace(kDcmqiTransferSyntaxValue, 20, std::string("1.2.840.10008.1.2.5\0", 20));
@@ -438,6 +452,7 @@ TEST(DicomSegHeader, RefusesCompressedTransferSyntaxesByName) {
 }
 
 TEST(DicomSegHeader, NeverEchoesATransferSyntaxThatIsNotAUid) {
+  LABELMESH_SKIP_WITHOUT_SHARED_DATA();
   const auto dir = testing::scratch_dir("DicomSegHeader.FreeText");
   std::string bytes = dcmqi_bytes();
   bytes.replace(kDcmqiTransferSyntaxValue, 20, "Doe^John 1970-01-01 ");
@@ -447,6 +462,7 @@ TEST(DicomSegHeader, NeverEchoesATransferSyntaxThatIsNotAUid) {
 }
 
 TEST(DicomSegHeader, RefusesDecimalStringsThatAreNotFiniteNumbers) {
+  LABELMESH_SKIP_WITHOUT_SHARED_DATA();
   const auto dir = testing::scratch_dir("DicomSegHeader.Decimals");
   const std::string original = dcmqi_bytes();
   for (std::string_view bad : {"nan         ", "inf         ", "4.6x6490e+01", "0x1p3       "}) {
@@ -461,6 +477,7 @@ TEST(DicomSegHeader, RefusesDecimalStringsThatAreNotFiniteNumbers) {
 }
 
 TEST(DicomSegHeader, RefusesAHeaderOverItsBudget) {
+  LABELMESH_SKIP_WITHOUT_SHARED_DATA();
   const auto dir = testing::scratch_dir("DicomSegHeader.Budget");
   const std::string bytes = dcmqi_bytes();
   expect_invalid(parse_bytes(dir, bytes, 2000), "", "runs past the 2000-byte limit on the header");
@@ -546,6 +563,7 @@ TEST(DicomSegHeader, RefusesMisplacedDelimitersAndUndefinedLengths) {
 }
 
 TEST(DicomSegHeader, RefusesAnExplicitVrThatContradictsTheDictionary) {
+  LABELMESH_SKIP_WITHOUT_SHARED_DATA();
   const auto dir = testing::scratch_dir("DicomSegHeader.WrongVr");
   std::string bytes = dcmqi_bytes();
   bytes.replace(kDcmqiRowsValue - 4, 2, "SS");
@@ -582,6 +600,7 @@ TEST(DicomSegHeader, RefusesMoreFramesOrSegmentsThanItsLimits) {
 }
 
 TEST(DicomSegHeader, NamesWhatATruncationCuts) {
+  LABELMESH_SKIP_WITHOUT_SHARED_DATA();
   const auto dir = testing::scratch_dir("DicomSegHeader.Truncations");
   const std::string bytes = dcmqi_bytes();
   const std::pair<size_t, std::string_view> cuts[] = {
@@ -598,6 +617,7 @@ TEST(DicomSegHeader, NamesWhatATruncationCuts) {
 }
 
 TEST(DicomSegHeader, FailsCleanlyWhereverTheFileIsCut) {
+  LABELMESH_SKIP_WITHOUT_SHARED_DATA();
   const auto dir = testing::scratch_dir("DicomSegHeader.EveryCut");
   const auto path = dir / "seg.dcm";
   for (const char* name : {"dcmqi-24x38x3-seg.dcm", "highdicom-seg_image_ct_binary.dcm"}) {

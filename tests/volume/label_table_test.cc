@@ -19,6 +19,7 @@ std::string write_table(const std::string& file, const std::string& text) {
 }
 
 TEST(LabelTable, ReadsAnItkSnapLabelFile) {
+  LABELMESH_SKIP_WITHOUT_SHARED_DATA();
   auto table = read_label_table(testing::shared_data("MRIcrop-seg.label"));
   ASSERT_TRUE(table.ok()) << table.status();
   // Twelve rows; label 0 ("Clear") is the background.

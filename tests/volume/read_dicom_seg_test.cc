@@ -51,6 +51,7 @@ absl::Status refusal_of(const std::string& name) {
 }
 
 TEST(DicomSeg, DcmqiSegAgreesWithItsLabelMapVoxelForVoxelInPatientSpace) {
+  LABELMESH_SKIP_WITHOUT_SHARED_DATA();
   const LabelVolume seg = read_or_fail(seg_file("dcmqi-24x38x3-seg.dcm"));
   const LabelVolume map = read_or_fail(seg_file("dcmqi-24x38x3-label.nrrd"));
   ASSERT_EQ(seg.format, ImageFormat::kDicomSeg);
@@ -86,6 +87,7 @@ TEST(DicomSeg, DcmqiSegAgreesWithItsLabelMapVoxelForVoxelInPatientSpace) {
 }
 
 TEST(DicomSeg, SegmentsBecomeLabelsWithNameColourAndCodes) {
+  LABELMESH_SKIP_WITHOUT_SHARED_DATA();
   const LabelVolume seg = read_or_fail(seg_file("dcmqi-24x38x3-seg.dcm"));
   ASSERT_EQ(seg.descriptions.size(), 1u);
   const LabelDescription& liver = seg.descriptions[0];
@@ -100,6 +102,7 @@ TEST(DicomSeg, SegmentsBecomeLabelsWithNameColourAndCodes) {
 }
 
 TEST(DicomSeg, ImplicitVrBinaryFramesWithoutSliceSpacingTakeTheirGaps) {
+  LABELMESH_SKIP_WITHOUT_SHARED_DATA();
   const LabelVolume seg = read_or_fail(seg_file("highdicom-seg_image_ct_binary.dcm"));
   EXPECT_EQ(seg.geometry.dims, (std::array<int64_t, 3>{16, 16, 3}));
   EXPECT_NEAR(seg.geometry.spacing[2], 1.25, 1e-6);
@@ -112,6 +115,7 @@ TEST(DicomSeg, ImplicitVrBinaryFramesWithoutSliceSpacingTakeTheirGaps) {
 }
 
 TEST(DicomSeg, OneFrameTakesItsSpacingFromTheHeader) {
+  LABELMESH_SKIP_WITHOUT_SHARED_DATA();
   const LabelVolume seg = read_or_fail(seg_file("highdicom-seg_image_ct_binary_single_frame.dcm"));
   EXPECT_EQ(seg.geometry.dims, (std::array<int64_t, 3>{128, 128, 1}));
   EXPECT_NEAR(seg.geometry.spacing[2], 5.0, 1e-9);
@@ -119,6 +123,7 @@ TEST(DicomSeg, OneFrameTakesItsSpacingFromTheHeader) {
 }
 
 TEST(DicomSeg, FractionalPixelsAreInsideFromTheThreshold) {
+  LABELMESH_SKIP_WITHOUT_SHARED_DATA();
   const std::string path = seg_file("highdicom-seg_image_ct_binary_fractional.dcm");
   ReadLimits any_value, half, whole;
   any_value.fractional_threshold = 1e-9;
@@ -134,6 +139,7 @@ TEST(DicomSeg, FractionalPixelsAreInsideFromTheThreshold) {
 }
 
 TEST(DicomSeg, OverlappingSegmentsAreAnErrorNamingThem) {
+  LABELMESH_SKIP_WITHOUT_SHARED_DATA();
   const absl::Status status = refusal_of("highdicom-seg_image_ct_binary_overlap.dcm");
   EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument);
   // pydicom: the two segments' frames share 16 pixels.
@@ -178,6 +184,7 @@ std::vector<vtkImageData*> images_of(const LabelVolume& volume) {
 }
 
 TEST(DicomSeg, OverlappingSegmentsKeptApartLieWholeInLayersOfTheirOwn) {
+  LABELMESH_SKIP_WITHOUT_SHARED_DATA();
   const std::string path = seg_file("highdicom-seg_image_ct_binary_overlap.dcm");
   ReadLimits limits;
   limits.separate_overlapping = true;
@@ -214,6 +221,7 @@ TEST(DicomSeg, OverlappingSegmentsKeptApartLieWholeInLayersOfTheirOwn) {
 }
 
 TEST(DicomSeg, KeepingOverlapsApartChangesNothingWhenNothingOverlaps) {
+  LABELMESH_SKIP_WITHOUT_SHARED_DATA();
   ReadLimits separate;
   separate.separate_overlapping = true;
   for (const char* name : {"dcmqi-24x38x3-seg.dcm", "highdicom-seg_image_ct_binary.dcm"}) {
@@ -232,6 +240,7 @@ TEST(DicomSeg, KeepingOverlapsApartChangesNothingWhenNothingOverlaps) {
 }
 
 TEST(DicomSeg, LayersKeptApartCountAgainstTheVoxelLimit) {
+  LABELMESH_SKIP_WITHOUT_SHARED_DATA();
   const std::string path = seg_file("highdicom-seg_image_ct_binary_overlap.dcm");
   ReadLimits limits;
   limits.separate_overlapping = true;
@@ -247,6 +256,7 @@ TEST(DicomSeg, LayersKeptApartCountAgainstTheVoxelLimit) {
 }
 
 TEST(DicomSeg, SparseFramesLandOnTheSliceGridAcrossTheGap) {
+  LABELMESH_SKIP_WITHOUT_SHARED_DATA();
   // Frames at z -99.48 and 103.02 to 105.52 mm, 1.25 mm apart: 165 slices.
   auto header = check_volume_header(seg_file("highdicom-seg_image_ct_binary_overlap.dcm"));
   ASSERT_TRUE(header.ok()) << header.status();
@@ -255,6 +265,7 @@ TEST(DicomSeg, SparseFramesLandOnTheSliceGridAcrossTheGap) {
 }
 
 TEST(DicomSeg, WhatHasNoPatientSpaceVolumeIsRefusedSayingWhy) {
+  LABELMESH_SKIP_WITHOUT_SHARED_DATA();
   const absl::Status radiograph = refusal_of("highdicom-seg_image_cr_binary.dcm");
   EXPECT_EQ(radiograph.code(), absl::StatusCode::kInvalidArgument);
   EXPECT_TRUE(absl::StrContains(radiograph.message(), "no 3D patient-space geometry"))
@@ -271,6 +282,7 @@ TEST(DicomSeg, WhatHasNoPatientSpaceVolumeIsRefusedSayingWhy) {
 // DCMTK finds segment n as the n-th item; a file numbered otherwise would
 // put names on the wrong labels, so it is refused.
 TEST(DicomSeg, SegmentsNumberedOutOfOrderAreRefused) {
+  LABELMESH_SKIP_WITHOUT_SHARED_DATA();
   const std::string path = seg_file("dcmqi-24x38x3-seg.dcm");
   auto header = internal::parse_dicom_seg_header(path);
   ASSERT_TRUE(header.ok()) << header.status();
@@ -283,6 +295,7 @@ TEST(DicomSeg, SegmentsNumberedOutOfOrderAreRefused) {
 }
 
 TEST(DicomSeg, TheVoxelLimitHoldsBeforeAnythingIsRead) {
+  LABELMESH_SKIP_WITHOUT_SHARED_DATA();
   ReadLimits tiny;
   tiny.max_voxels = 24 * 38 * 3 - 1;
   const auto status =

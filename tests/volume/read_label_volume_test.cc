@@ -144,6 +144,7 @@ class RealData : public ::testing::TestWithParam<RealVolume> {};
 
 // Through summarise_volume(), the code behind `labelmesh info`.
 TEST_P(RealData, MatchesSources) {
+  LABELMESH_SKIP_WITHOUT_SHARED_DATA();
   const RealVolume& expected = GetParam();
   const auto summary =
       summarise_volume(testing::shared_data(expected.file), ReadLimits{}, RunContext{});
@@ -225,6 +226,7 @@ INSTANTIATE_TEST_SUITE_P(
     });
 
 TEST(RealData, ObliqueProstateMatchesNibabelsAffine) {
+  LABELMESH_SKIP_WITHOUT_SHARED_DATA();
   // nibabel (independent of our parser) gives the RAS affine; ours is LPS.
   const std::string path = testing::shared_data("msd_prostate_mask_00.nii");
   const std::string command =

@@ -72,6 +72,7 @@ TEST(RepeatedPlanes, AnEmptyVolumeRepeatsNone) {
 }
 
 TEST(RepeatedPlanesRealData, TheLiverWasDrawnOnEveryThirdSlice) {
+  LABELMESH_SKIP_WITHOUT_SHARED_DATA();
   // 76 runs of exactly three equal slices: drawn at 2 mm, stored at 0.67 mm.
   auto liver = read_label_volume(testing::shared_data("liver.inr.gz"), ReadLimits{}, RunContext{});
   ASSERT_TRUE(liver.ok()) << liver.status();

@@ -138,6 +138,10 @@ def main():
     parser.add_argument("--hex-size", default="0")
     parser.add_argument("--hex-interior-size", default="0")
     args = parser.parse_args()
+    liver = pathlib.Path(args.data) / "liver.inr.gz"
+    if not liver.exists():
+        print(f"SKIP: missing shared data file {liver}")
+        sys.exit(77)
     with tempfile.TemporaryDirectory(prefix="labelmesh-fe-") as tmp:
         work = pathlib.Path(tmp)
         (work / "names.json").write_text('{"255": "liver"}')
