@@ -100,8 +100,38 @@ absl::StatusOr<LabelDescriptions> read_text_table(const std::string& path,
   return table;
 }
 
+// The deepest nesting a label table needs is 3 ({"5": {"color": [r, g, b]}});
+// protobuf's parser takes minutes over tens of thousands of levels.
+constexpr int kMostJsonDepth = 8;
+
+// Whether the objects and arrays of `text` (outside strings) nest deeper
+// than `most`: one pass, ending at the first level too deep.
+bool nests_deeper_than(std::string_view text, int most) {
+  int depth = 0;
+  bool in_string = false, escaped = false;
+  for (const char c : text) {
+    if (in_string) {
+      if (escaped)
+        escaped = false;
+      else if (c == '\\')
+        escaped = true;
+      else if (c == '"')
+        in_string = false;
+    } else if (c == '"') {
+      in_string = true;
+    } else if (c == '{' || c == '[') {
+      if (++depth > most) return true;
+    } else if (c == '}' || c == ']') {
+      --depth;
+    }
+  }
+  return false;
+}
+
 absl::StatusOr<LabelDescriptions> read_json_table(const std::string& path,
                                                   const std::string& text) {
+  if (nests_deeper_than(text, kMostJsonDepth))
+    return field_error(path, "JSON", absl::StrCat("nests deeper than ", kMostJsonDepth, " levels"));
   google::protobuf::Struct map;
   if (!google::protobuf::util::JsonStringToMessage(text, &map).ok())
     return field_error(path, "JSON", "is not a JSON object");

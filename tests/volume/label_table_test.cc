@@ -6,6 +6,7 @@
 #include <fstream>
 
 #include "absl/strings/match.h"
+#include "absl/time/clock.h"
 #include "core/util/utf8.h"
 #include "support/test_files.h"
 
@@ -94,6 +95,25 @@ TEST(LabelTable, ErrorsNameTheFileAndLine) {
     EXPECT_TRUE(absl::StrContains(table.status().message(), c.expected)) << table.status();
   }
   EXPECT_EQ(read_label_table("/no/such/table.label").status().code(), absl::StatusCode::kNotFound);
+}
+
+TEST(LabelTable, DeeplyNestedJsonIsRefusedAtOnce) {
+  const std::string deep = "{\"1\": " + std::string(32000, '[') + std::string(32000, ']') + "}";
+  const auto path = write_table("deep.json", deep);
+  const absl::Time start = absl::Now();
+  const auto refused = read_label_table(path);
+  EXPECT_LT(absl::Now() - start, absl::Seconds(1));
+  ASSERT_FALSE(refused.ok());
+  EXPECT_EQ(refused.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_TRUE(absl::StrContains(refused.status().message(), "deep.json")) << refused.status();
+  EXPECT_TRUE(absl::StrContains(refused.status().message(), "nests deeper than 8"))
+      << refused.status();
+  // Brackets inside a name do not count; a colour nests three deep.
+  const auto fine = read_label_table(write_table(
+      "fine.json", R"({"5": {"name": "[[[[[[[[[[ liver {{{{{{{{{{", "color": [1, 2, 3]}})"));
+  ASSERT_TRUE(fine.ok()) << fine.status();
+  ASSERT_EQ(fine->size(), 1u);
+  EXPECT_EQ((*fine)[0].name, "[[[[[[[[[[ liver {{{{{{{{{{");
 }
 
 TEST(LabelTable, ATableNamesOverWhatTheVolumeSaid) {
