@@ -1,8 +1,9 @@
 #!/usr/bin/python3
 # SPDX-License-Identifier: AGPL-3.0-or-later
 """Proves the labelmesh gRPC API usable from Python: starts labelmeshd, runs a
-whole job on a sphere phantom (submit, watch, get, list, fetch), and checks two
-error statuses. Exits non-zero with a message on the first failed check."""
+whole job on a sphere phantom (submit, watch, get, list, fetch), checks two
+error statuses, and runs the README's client snippet as written. Exits
+non-zero with a message on the first failed check."""
 
 import argparse
 import hashlib
@@ -135,6 +136,37 @@ def check_errors(grpc, pb, stub, data):
                   "GetJob of an unknown job")
 
 
+def readme_snippet():
+    """The README's Python client, verbatim: the code block after "From Python"."""
+    readme = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "README.md")
+    text = open(readme).read()
+    start = text.index("```python\n", text.index("From Python")) + len("```python\n")
+    return text[start:text.index("```", start)]
+
+
+def run_readme_snippet(python_api, volume_path, address, tmp):
+    """Runs the README's client from a directory laid out like a checkout
+    (build/release/python), and checks the files it fetched."""
+    work = os.path.join(tmp, "readme")
+    os.makedirs(os.path.join(work, "build", "release"))
+    os.symlink(os.path.abspath(python_api), os.path.join(work, "build", "release", "python"))
+    with open(os.path.join(work, "client.py"), "w") as out:
+        out.write(readme_snippet())
+    run = subprocess.run([sys.executable, "client.py", volume_path, address], cwd=work,
+                         capture_output=True, text=True, timeout=JOB_SECONDS)
+    check(run.returncode == 0, f"the README's client exited {run.returncode}: "
+          f"{run.stdout[-2000:]}{run.stderr[-2000:]}")
+    wrote = sorted(line.split(" ", 1)[1] for line in run.stdout.splitlines()
+                   if line.startswith("wrote "))
+    check("report.json" in wrote, f"the README's client fetched no report.json: {wrote}")
+    check(any(name.endswith(".stl") for name in wrote), f"no .stl fetched: {wrote}")
+    in_folders = [name for name in wrote if "/" in name]
+    check(in_folders, f"no vtm block in a folder fetched: {wrote}")
+    for name in wrote:
+        check(os.path.getsize(os.path.join(work, name)) > 0, f"{name}: empty")
+    print(f"README client: {len(wrote)} files, {len(in_folders)} in folders")
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--labelmeshd", required=True, help="server binary")
@@ -165,6 +197,7 @@ def main():
                 stub = service_pb2_grpc.MeshingServiceStub(channel)
                 data = run_whole_job(pb, options_pb, stub, volume_path)
                 check_errors(grpc, pb, stub, data)
+                run_readme_snippet(args.python_api, volume_path, address, tmp)
         except (CheckFailed, grpc.RpcError) as error:
             failure = error
         finally:
