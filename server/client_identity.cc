@@ -38,7 +38,9 @@ bool is_token_text(std::string_view token) {
 }
 
 // Identities the server gives itself: no client may be named so.
-bool is_reserved_name(std::string_view name) { return name == kAnonymous || name == "token"; }
+bool is_reserved_name(std::string_view name) {
+  return name == kAnonymous || name == kSharedTokenIdentity;
+}
 
 absl::StatusOr<std::string> read_single_token(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
@@ -88,9 +90,7 @@ absl::StatusOr<std::vector<TokenHolder>> read_clients_file(const std::string& pa
   return holders;
 }
 
-// The key a host's failures count under: its address, or for IPv6 its /64
-// (one host holds a whole /64 and could step through it).
-std::string backoff_key(const std::string& host) {
+std::string host_key(const std::string& host) {
   std::string_view text = host;
   if (text.substr(0, 5) != "ipv6:") return host;
   text.remove_prefix(5);
@@ -108,8 +108,15 @@ std::string backoff_key(const std::string& host) {
   return absl::StrCat("ipv6:", prefix, "/64");
 }
 
+ShareKeys share_keys(const ClientIdentity& identity, const std::string& peer) {
+  std::string host = host_key(peer_host(peer));
+  if (identity.name == kAnonymous || identity.name == kSharedTokenIdentity)
+    return {absl::StrCat(identity.name, "@", host), host};
+  return {identity.name, std::move(host)};
+}
+
 absl::Status AuthBackoff::check(const std::string& peer, absl::Time now) {
-  const std::string host = backoff_key(peer);
+  const std::string host = host_key(peer);
   std::lock_guard lock(mutex_);
   auto it = hosts_.find(host);
   if (it == hosts_.end() || it->second.blocked_until <= now) return absl::OkStatus();
@@ -119,7 +126,7 @@ absl::Status AuthBackoff::check(const std::string& peer, absl::Time now) {
 }
 
 void AuthBackoff::failed(const std::string& peer, absl::Time now) {
-  const std::string host = backoff_key(peer);
+  const std::string host = host_key(peer);
   std::lock_guard lock(mutex_);
   if (hosts_.size() >= kMaxTrackedHosts && hosts_.find(host) == hosts_.end()) {
     std::erase_if(hosts_, [now](const auto& entry) {
@@ -154,7 +161,7 @@ absl::StatusOr<std::unique_ptr<ClientAuthenticator>> ClientAuthenticator::from_c
         return absl::InvalidArgumentError(
             "--auth-token-file: the shared token is also a client's token in --clients-file");
     }
-    tokens.push_back({"token", std::move(*token), false});
+    tokens.push_back({kSharedTokenIdentity, std::move(*token), false});
   }
   std::set<std::string> admins(config.admin_identities.begin(), config.admin_identities.end());
   for (const auto& holder : tokens) {

@@ -26,6 +26,23 @@ struct ClientIdentity {
 
 // The identity of calls on a server with no client authentication.
 inline constexpr char kAnonymous[] = "anonymous";
+// The identity of calls with the --auth-token-file token, which every client
+// may share.
+inline constexpr char kSharedTokenIdentity[] = "token";
+
+// The key a peer host counts under, for the backoff and for stream and
+// upload shares: its address, or for IPv6 its /64 (one host holds a whole
+// /64 and could step through it).
+std::string host_key(const std::string& host);
+
+// Where a call's streams and uploads count (StreamCounts): `client` is its
+// identity, except that the identities every client may share (anonymous,
+// the shared token's) count per host; `host` is host_key of the peer.
+struct ShareKeys {
+  std::string client;
+  std::string host;
+};
+ShareKeys share_keys(const ClientIdentity& identity, const std::string& peer);
 
 struct TokenHolder {
   std::string name;

@@ -84,9 +84,14 @@ void add_server_flags(CLI::App& app, ServerConfig& c) {
           ->capture_default_str(),
       "LABELMESHD_MAX_UPLOAD_BYTES");
   env(app.add_option("--max-streams-per-client", c.max_streams_per_client,
-                     "Submit, Watch and Fetch streams one client host may hold open")
+                     "Submit, Watch and Fetch streams one client may hold open (anonymous and "
+                     "--auth-token-file clients: per host)")
           ->capture_default_str(),
       "LABELMESHD_MAX_STREAMS_PER_CLIENT");
+  env(app.add_option("--max-streams-per-host", c.max_streams_per_host,
+                     "Submit, Watch and Fetch streams all clients on one host may hold open")
+          ->capture_default_str(),
+      "LABELMESHD_MAX_STREAMS_PER_HOST");
   env(app.add_option("--max-streams", c.max_streams, "Streams all clients may hold open")
           ->capture_default_str(),
       "LABELMESHD_MAX_STREAMS");
@@ -96,6 +101,14 @@ void add_server_flags(CLI::App& app, ServerConfig& c) {
   env(add_duration(app, "--transfer-deadline", c.transfer_deadline,
                    "Longest an upload or a fetch may take"),
       "LABELMESHD_TRANSFER_DEADLINE");
+  env(app.add_option("--min-transfer-rate", c.min_transfer_rate,
+                     "Bytes per second an upload or a fetch must move over each "
+                     "--transfer-rate-window, or be cancelled (0: no minimum)")
+          ->capture_default_str(),
+      "LABELMESHD_MIN_TRANSFER_RATE");
+  env(add_duration(app, "--transfer-rate-window", c.transfer_rate_window,
+                   "The window --min-transfer-rate is measured over"),
+      "LABELMESHD_TRANSFER_RATE_WINDOW");
   env(app.add_option("--spool-reserve-bytes", c.spool_reserve_bytes,
                      "Free spool disk space kept for running jobs; uploads into it are refused")
           ->capture_default_str(),
@@ -111,6 +124,15 @@ void add_server_flags(CLI::App& app, ServerConfig& c) {
                      "Uploads received at once")
           ->capture_default_str(),
       "LABELMESHD_MAX_CONCURRENT_UPLOADS");
+  env(app.add_option("--max-uploads-per-client", c.max_uploads_per_client,
+                     "Uploads received at once from one client (anonymous and --auth-token-file "
+                     "clients: per host)")
+          ->capture_default_str(),
+      "LABELMESHD_MAX_UPLOADS_PER_CLIENT");
+  env(app.add_option("--max-uploads-per-host", c.max_uploads_per_host,
+                     "Uploads received at once from all clients on one host")
+          ->capture_default_str(),
+      "LABELMESHD_MAX_UPLOADS_PER_HOST");
   env(app.add_option("--max-message-bytes", c.max_message_bytes, "Largest gRPC message")
           ->capture_default_str(),
       "LABELMESHD_MAX_MESSAGE_BYTES");

@@ -40,20 +40,6 @@ grpc::Status stalled_or(const StreamWatchdog::Ticket& ticket, grpc::Status other
   return grpc::Status(grpc::StatusCode::DEADLINE_EXCEEDED, reason);
 }
 
-// Counts an upload in flight for as long as it lives.
-class UploadSlot {
- public:
-  UploadSlot(std::atomic<int>& count, int limit) : count_(count) {
-    acquired_ = count_.fetch_add(1) < limit;
-  }
-  ~UploadSlot() { count_.fetch_sub(1); }
-  bool acquired() const { return acquired_; }
-
- private:
-  std::atomic<int>& count_;
-  bool acquired_;
-};
-
 // A Watch refused before it streams anything.
 class RefusedWatch final : public grpc::ServerWriteReactor<v1::JobEvent> {
  public:
@@ -109,13 +95,22 @@ MeshingService::MeshingService(JobStore& store, const ServerConfig& config, Metr
       metrics_(metrics),
       authenticator_(authenticator),
       audit_(audit),
-      streams_(config.max_streams_per_client, config.max_streams) {}
+      streams_({config.max_streams_per_client, config.max_streams_per_host, config.max_streams},
+               "streams"),
+      uploads_({config.max_uploads_per_client, config.max_uploads_per_host,
+                config.max_concurrent_uploads},
+               "uploads") {}
 
 absl::StatusOr<std::unique_ptr<StreamCounts::Slot>> MeshingService::open_stream(
-    const grpc::ServerContextBase& context) {
-  auto slot = streams_.open(context.peer());
+    const grpc::ServerContextBase& context, const ClientIdentity& identity) {
+  const ShareKeys keys = share_keys(identity, context.peer());
+  auto slot = streams_.open(keys.client, keys.host);
   if (!slot.ok()) metrics_.rejected("too_many_streams");
   return slot;
+}
+
+TransferRate MeshingService::transfer_rate() const {
+  return {config_.min_transfer_rate, config_.transfer_rate_window};
 }
 
 absl::StatusOr<ClientIdentity> MeshingService::identify(const grpc::ServerContextBase& context,
@@ -185,7 +180,7 @@ grpc::Status MeshingService::receive_upload(grpc::ServerReader<v1::SubmitRequest
   uint64_t received = 0;
   v1::SubmitRequest message;
   while (reader.Read(&message)) {
-    ticket.touch();
+    ticket.touch(received + message.chunk().size());
     if (!message.has_chunk()) {
       return refuse("bad_request", "after the spec, every message must be a chunk");
     }
@@ -200,9 +195,11 @@ grpc::Status MeshingService::receive_upload(grpc::ServerReader<v1::SubmitRequest
     received += chunk.size();
   }
   if (const std::string stalled = ticket.cancelled_because(); !stalled.empty()) {
-    reason = "stalled";
+    reason = absl::StrContains(stalled, "too slow") ? "too_slow" : "stalled";
     return grpc::Status(grpc::StatusCode::DEADLINE_EXCEEDED, stalled);
   }
+  // The checks that follow are progress too, but move no bytes.
+  ticket.end_transfer();
   if (auto status = out.finish(); !status.ok()) return spool_failed(status);
   if (received < spec.size_bytes()) {
     return refuse("bad_request", absl::StrCat("upload: truncated, ", received, " of ",
@@ -252,20 +249,20 @@ grpc::Status MeshingService::submit(grpc::ServerContext& context,
     reason = "store_unavailable";
     return to_grpc(status);
   }
-  auto stream = streams_.open(context.peer());
+  const ShareKeys keys = share_keys(identity, context.peer());
+  auto stream = streams_.open(keys.client, keys.host);
   if (!stream.ok()) {
     reason = "too_many_streams";
     return to_grpc(stream.status());
   }
   // The spec is the first step: a client that sends nothing is dropped too.
-  auto ticket =
-      watchdog_.watch(&context, config_.stream_idle_timeout, config_.transfer_deadline, "upload");
-  UploadSlot slot(uploads_, config_.max_concurrent_uploads);
-  if (!slot.acquired()) {
+  auto ticket = watchdog_.watch(&context, config_.stream_idle_timeout, config_.transfer_deadline,
+                                "upload", transfer_rate());
+  // Shares of the upload slots: one client, or one host, cannot take them all.
+  auto upload_slot = uploads_.open(keys.client, keys.host);
+  if (!upload_slot.ok()) {
     reason = "too_many_uploads";
-    return grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED,
-                        absl::StrCat("too many uploads at once (limit ",
-                                     config_.max_concurrent_uploads, "); try again later"));
+    return to_grpc(upload_slot.status());
   }
   v1::SubmitRequest first;
   if (!reader.Read(&first) || !first.has_spec()) {
@@ -396,7 +393,7 @@ grpc::ServerWriteReactor<v1::JobEvent>* MeshingService::Watch(grpc::CallbackServ
   auto identity = identify(*context, "Watch");
   if (!identity.ok()) return refuse(to_grpc(identity.status()));
   if (auto status = authorize(*identity, request->job_id()); !status.ok()) return refuse(status);
-  auto stream = open_stream(*context);
+  auto stream = open_stream(*context, *identity);
   if (!stream.ok()) return refuse(to_grpc(stream.status()));
   return WatchReactor::start(store_, watchdog_, config_.stream_idle_timeout, context,
                              request->job_id(), std::move(*stream));
@@ -474,19 +471,21 @@ grpc::Status MeshingService::Fetch(grpc::ServerContext* context, const v1::Fetch
   if (!job.ok()) return to_grpc(job.status());
   std::ifstream in(store_.artifact_path(*job, artifact->name()), std::ios::binary);
   if (!in) return grpc::Status(grpc::StatusCode::NOT_FOUND, "the artifact expired or was removed");
-  auto stream = open_stream(*context);
+  auto stream = open_stream(*context, *identity);
   if (!stream.ok()) return to_grpc(stream.status());
-  auto ticket =
-      watchdog_.watch(context, config_.stream_idle_timeout, config_.transfer_deadline, "fetch");
+  auto ticket = watchdog_.watch(context, config_.stream_idle_timeout, config_.transfer_deadline,
+                                "fetch", transfer_rate());
   v1::FetchChunk chunk;
   *chunk.mutable_artifact() = *artifact;
   std::string buffer(kChunkBytes, '\0');
+  uint64_t sent = 0;
   do {
     in.read(buffer.data(), static_cast<std::streamsize>(buffer.size()));
     chunk.set_data(buffer.data(), static_cast<size_t>(in.gcount()));
     if (!writer->Write(chunk))
       return stalled_or(*ticket, grpc::Status(grpc::StatusCode::CANCELLED, "reader left"));
-    ticket->touch();
+    sent += chunk.data().size();
+    ticket->touch(sent);
     chunk.clear_artifact();
   } while (in);
   return grpc::Status::OK;

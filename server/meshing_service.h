@@ -60,7 +60,9 @@ class MeshingService final
                               StreamWatchdog::Ticket& ticket, std::string& reason);
   // A place among the client's streams, or RESOURCE_EXHAUSTED (counted).
   absl::StatusOr<std::unique_ptr<StreamCounts::Slot>> open_stream(
-      const grpc::ServerContextBase& context);
+      const grpc::ServerContextBase& context, const ClientIdentity& identity);
+  // The least an upload or a fetch must move, from the config.
+  TransferRate transfer_rate() const;
   // RESOURCE_EXHAUSTED "spool disk full" when an upload of this size would
   // leave less than the reserve free.
   absl::Status check_spool_space(uint64_t upload_bytes) const;
@@ -77,8 +79,8 @@ class MeshingService final
   std::timed_mutex volume_reader_;
   std::set<std::pair<std::string, std::string>> requests_in_flight_;
   std::atomic<bool> accepting_{true};
-  std::atomic<int> uploads_{0};
   StreamCounts streams_;
+  StreamCounts uploads_;
   StreamWatchdog watchdog_;
 };
 

@@ -34,7 +34,7 @@ class Metrics {
   void queue_wait(double seconds);
   void stage_finished(const std::string& stage, double seconds);
   // reason: queue_full, too_many_uploads, too_large, bad_request, bad_digest,
-  // bad_volume, unauthenticated, disk_full, spool_error.
+  // bad_volume, unauthenticated, disk_full, spool_error, stalled, too_slow.
   void rejected(const std::string& reason);
   void upload_bytes(uint64_t bytes);
   void set_spool_space(uint64_t free_bytes, bool under_reserve);

@@ -55,13 +55,20 @@ absl::Status validate_config(const ServerConfig& c) {
   if (c.max_upload_bytes < 1) return bad("max-upload-bytes", "must be positive");
   if (c.max_voxels < 1) return bad("max-voxels", "must be positive");
   if (c.max_concurrent_uploads < 1) return bad("max-concurrent-uploads", "must be at least 1");
+  if (c.max_uploads_per_client < 1) return bad("max-uploads-per-client", "must be at least 1");
+  if (c.max_uploads_per_host < c.max_uploads_per_client)
+    return bad("max-uploads-per-host", "must be at least --max-uploads-per-client");
   if (c.max_streams_per_client < 1) return bad("max-streams-per-client", "must be at least 1");
+  if (c.max_streams_per_host < c.max_streams_per_client)
+    return bad("max-streams-per-host", "must be at least --max-streams-per-client");
   if (c.max_streams < c.max_streams_per_client)
     return bad("max-streams", "must be at least --max-streams-per-client");
   if (c.stream_idle_timeout <= absl::ZeroDuration())
     return bad("stream-idle-timeout", "must be positive");
   if (c.transfer_deadline <= absl::ZeroDuration())
     return bad("transfer-deadline", "must be positive");
+  if (c.transfer_rate_window < absl::Seconds(1))
+    return bad("transfer-rate-window", "must be at least 1s");
   if (c.max_message_bytes < (2 << 20)) {
     return bad("max-message-bytes", "must be at least 2 MiB (chunks are 1 MiB)");
   }

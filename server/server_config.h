@@ -51,16 +51,27 @@ struct ServerConfig {
   // with this much output. 0: no limit.
   uint64_t max_job_output_bytes = uint64_t{2} << 30;
   uint64_t max_voxels = uint64_t{1} << 31;
+  // Uploads received at once: in all, per client and per client host. A
+  // client is its identity; the identities every client may share
+  // (anonymous, the --auth-token-file token) count per host instead.
   int max_concurrent_uploads = 8;
-  // Streams (Submit, Watch, Fetch) one client host and all clients may hold
-  // open at once.
+  int max_uploads_per_client = 4;
+  int max_uploads_per_host = 6;
+  // Streams (Submit, Watch, Fetch) one client, one client host and all
+  // clients may hold open at once; clients count as for uploads.
   int max_streams_per_client = 16;
+  int max_streams_per_host = 64;
   int max_streams = 256;
   // A stream that makes no progress this long is cancelled: an upload whose
   // next chunk does not come, a fetch or watch whose reader stopped reading.
   absl::Duration stream_idle_timeout = absl::Seconds(30);
   // Longest an upload or a fetch may take in all.
   absl::Duration transfer_deadline = absl::Minutes(30);
+  // An upload or a fetch that moves fewer bytes per second than this over a
+  // window, once its bytes have started, is cancelled: trickled bytes would
+  // otherwise hold a slot until the transfer deadline. 0: no minimum.
+  uint64_t min_transfer_rate = uint64_t{64} << 10;
+  absl::Duration transfer_rate_window = absl::Seconds(30);
   // Largest gRPC message either way; upload and fetch chunks are 1 MiB.
   int max_message_bytes = 4 << 20;
 

@@ -16,25 +16,36 @@ std::string peer_host(const std::string& peer) {
 
 StreamCounts::Slot::~Slot() {
   std::lock_guard lock(counts_.mutex_);
+  if (--counts_.by_client_[client_] == 0) counts_.by_client_.erase(client_);
   if (--counts_.by_host_[host_] == 0) counts_.by_host_.erase(host_);
   --counts_.open_;
 }
 
-absl::StatusOr<std::unique_ptr<StreamCounts::Slot>> StreamCounts::open(const std::string& peer) {
-  const std::string host = peer_host(peer);
+absl::StatusOr<std::unique_ptr<StreamCounts::Slot>> StreamCounts::open(const std::string& client,
+                                                                       const std::string& host) {
+  auto held = [](const std::map<std::string, int>& counts, const std::string& key) {
+    auto it = counts.find(key);
+    return it == counts.end() ? 0 : it->second;
+  };
   std::lock_guard lock(mutex_);
-  if (open_ >= total_) {
-    return absl::ResourceExhaustedError(
-        absl::StrCat("the server holds its most streams (", total_, "); try again later"));
+  if (open_ >= limits_.total) {
+    return absl::ResourceExhaustedError(absl::StrCat("the server holds its most ", what_, " (",
+                                                     limits_.total, "); try again later"));
   }
-  int& mine = by_host_[host];  // per_client_ >= 1: a new host never stops here
-  if (mine >= per_client_) {
-    return absl::ResourceExhaustedError(absl::StrCat("this client holds its most streams at once (",
-                                                     per_client_, "); close one first"));
+  if (held(by_client_, client) >= limits_.per_client) {
+    return absl::ResourceExhaustedError(absl::StrCat("this client holds its most ", what_,
+                                                     " at once (", limits_.per_client,
+                                                     "); close one first"));
   }
-  ++mine;
+  if (held(by_host_, host) >= limits_.per_host) {
+    return absl::ResourceExhaustedError(absl::StrCat("this client's host holds its most ", what_,
+                                                     " at once (", limits_.per_host,
+                                                     "); try again later"));
+  }
+  ++by_client_[client];
+  ++by_host_[host];
   ++open_;
-  return std::unique_ptr<Slot>(new Slot(*this, host));
+  return std::unique_ptr<Slot>(new Slot(*this, client, host));
 }
 
 StreamWatchdog::StreamWatchdog() : thread_([this] { loop(); }) {}
@@ -65,6 +76,26 @@ void StreamWatchdog::Ticket::touch() {
   if (it != watchdog_.entries_.end()) it->second.last_touch = absl::Now();
 }
 
+void StreamWatchdog::Ticket::touch(uint64_t transferred) {
+  std::lock_guard lock(watchdog_.mutex_);
+  auto it = watchdog_.entries_.find(id_);
+  if (it == watchdog_.entries_.end()) return;
+  Entry& entry = it->second;
+  if (!entry.transfer.started) {
+    // The first bytes were on their way since the request came.
+    entry.transfer.started = true;
+    entry.transfer.window_start = entry.last_touch;
+  }
+  entry.transfer.bytes = transferred;
+  entry.last_touch = absl::Now();
+}
+
+void StreamWatchdog::Ticket::end_transfer() {
+  std::lock_guard lock(watchdog_.mutex_);
+  auto it = watchdog_.entries_.find(id_);
+  if (it != watchdog_.entries_.end()) it->second.transfer.rate.bytes_per_second = 0;
+}
+
 std::string StreamWatchdog::Ticket::cancelled_because() const {
   std::lock_guard lock(watchdog_.mutex_);
   auto it = watchdog_.entries_.find(id_);
@@ -74,11 +105,13 @@ std::string StreamWatchdog::Ticket::cancelled_because() const {
 std::unique_ptr<StreamWatchdog::Ticket> StreamWatchdog::watch(grpc::ServerContextBase* context,
                                                               absl::Duration idle,
                                                               absl::Duration total,
-                                                              std::string what) {
+                                                              std::string what, TransferRate rate) {
   const absl::Time now = absl::Now();
   std::lock_guard lock(mutex_);
   const uint64_t id = next_id_++;
-  entries_[id] = Entry{context, idle, total, now + total, now, std::move(what), {}, nullptr, false};
+  Entry entry{context, idle, total, now + total, now, std::move(what), {}, nullptr, false, {}};
+  entry.transfer.rate = rate;
+  entries_[id] = std::move(entry);
   return std::unique_ptr<Ticket>(new Ticket(*this, id));
 }
 
@@ -96,7 +129,8 @@ std::unique_ptr<StreamWatchdog::Ticket> StreamWatchdog::watch_writes(
                        std::move(what),
                        {},
                        std::move(write_started),
-                       false};
+                       false,
+                       {}};
   return std::unique_ptr<Ticket>(new Ticket(*this, id));
 }
 
@@ -112,12 +146,28 @@ void StreamWatchdog::loop() {
         const int64_t started = entry.write_started();
         busy_since = started == 0 ? now : absl::FromUnixNanos(started);
       }
+      Entry::Transfer& transfer = entry.transfer;
       if (now - busy_since > entry.idle) {
         entry.cancelled_because =
             absl::StrCat(entry.what, " stalled for more than ", absl::FormatDuration(entry.idle));
       } else if (now > entry.deadline) {
         entry.cancelled_because = absl::StrCat(entry.what, " ran past its deadline of ",
                                                absl::FormatDuration(entry.total));
+      } else if (transfer.rate.bytes_per_second > 0 && transfer.started &&
+                 now - transfer.window_start >= transfer.rate.window) {
+        // Window by window, not on average since the start: a fast start
+        // must not pay for a trickle after it.
+        const double seconds = absl::ToDoubleSeconds(now - transfer.window_start);
+        const uint64_t moved = transfer.bytes - transfer.window_bytes;
+        if (moved >= transfer.rate.bytes_per_second * seconds) {
+          transfer.window_start = now;
+          transfer.window_bytes = transfer.bytes;
+          continue;
+        }
+        entry.cancelled_because = absl::StrFormat(
+            "%s too slow: %.1f KiB/s over the last %s, under the minimum of %.1f KiB/s", entry.what,
+            moved / 1024.0 / seconds, absl::FormatDuration(transfer.rate.window),
+            transfer.rate.bytes_per_second / 1024.0);
       } else {
         continue;
       }

@@ -1,8 +1,9 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-// What one client can hold of the server: streams open at once, per client
-// and in all, and how long a stream may stall. A stalled stream (an upload
-// whose next chunk does not come, a fetch or watch whose reader stopped
-// reading) is cancelled, which frees its thread and its upload slot.
+// What one client can hold of the server: streams and uploads at once, per
+// client, per host and in all, how long a stream may stall and how slowly it
+// may transfer. A stalled stream (an upload whose next chunk does not come,
+// a fetch or watch whose reader stopped reading) or one too slow is
+// cancelled, which frees its thread and its upload slot.
 #pragma once
 
 #include <grpcpp/grpcpp.h>
@@ -25,12 +26,20 @@ namespace labelmesh::server {
 // The client part of a gRPC peer ("ipv4:10.0.0.7:53211" -> "ipv4:10.0.0.7").
 std::string peer_host(const std::string& peer);
 
-// Counts the streams each client (peer host) and all clients hold open.
+// Counts what each client, each host and all clients hold at once: open
+// streams, or uploads in progress. The caller names the client and the host
+// it counts under (client_identity.h, share_keys).
 class StreamCounts {
  public:
-  StreamCounts(int per_client, int total) : per_client_(per_client), total_(total) {}
+  struct Limits {
+    int per_client;
+    int per_host;
+    int total;
+  };
+  // `what` names the resource in refusals: "streams", "uploads".
+  StreamCounts(Limits limits, std::string what) : limits_(limits), what_(std::move(what)) {}
 
-  // Holds one stream's place until destroyed.
+  // Holds one place until destroyed.
   class Slot {
    public:
     ~Slot();
@@ -39,25 +48,37 @@ class StreamCounts {
 
    private:
     friend class StreamCounts;
-    Slot(StreamCounts& counts, std::string host) : counts_(counts), host_(std::move(host)) {}
+    Slot(StreamCounts& counts, std::string client, std::string host)
+        : counts_(counts), client_(std::move(client)), host_(std::move(host)) {}
     StreamCounts& counts_;
+    std::string client_;
     std::string host_;
   };
 
-  // RESOURCE_EXHAUSTED when the client or the server holds the most streams.
-  absl::StatusOr<std::unique_ptr<Slot>> open(const std::string& peer);
+  // RESOURCE_EXHAUSTED when the server, the client or its host holds the most.
+  absl::StatusOr<std::unique_ptr<Slot>> open(const std::string& client, const std::string& host);
 
  private:
-  const int per_client_;
-  const int total_;
+  const Limits limits_;
+  const std::string what_;
   std::mutex mutex_;
+  // Only keys with a place held: a key is erased when its count drops to 0.
+  std::map<std::string, int> by_client_;
   std::map<std::string, int> by_host_;
   int open_ = 0;
 };
 
-// Cancels streams that stall longer than their idle timeout or run past
-// their deadline. One thread checks every registered stream a few times a
-// second.
+// The least a transfer must move, in every window of its own once its
+// bytes have started: a client that trickles bytes keeps a stream from
+// stalling, not from being too slow.
+struct TransferRate {
+  uint64_t bytes_per_second = 0;  // 0: no minimum
+  absl::Duration window = absl::Seconds(30);
+};
+
+// Cancels streams that stall longer than their idle timeout, run past their
+// deadline or transfer under their minimum rate. One thread checks every registered stream a few
+// times a second.
 class StreamWatchdog {
  public:
   StreamWatchdog();
@@ -70,6 +91,11 @@ class StreamWatchdog {
     Ticket(const Ticket&) = delete;
     Ticket& operator=(const Ticket&) = delete;
     void touch();
+    // Progress that moved bytes, `transferred` in all so far. The first one
+    // starts the rate windows, from the touch before it (the request).
+    void touch(uint64_t transferred);
+    // The bytes are all in: no minimum rate from now on.
+    void end_transfer();
     // Why the watchdog cancelled the stream; empty if it did not.
     std::string cancelled_because() const;
 
@@ -81,9 +107,10 @@ class StreamWatchdog {
   };
 
   // `idle`: longest time between touches; `total`: longest the stream may
-  // live (absl::InfiniteDuration() for none). `what` names it in the reason.
+  // live (absl::InfiniteDuration() for none); `rate`: the least it must
+  // move. `what` names it in the reason.
   std::unique_ptr<Ticket> watch(grpc::ServerContextBase* context, absl::Duration idle,
-                                absl::Duration total, std::string what);
+                                absl::Duration total, std::string what, TransferRate rate = {});
   // For a stream that is idle by design between its messages (a callback
   // watch): stalled when `write_started()` is set (a write is outstanding,
   // nanoseconds since the epoch) and older than `idle`. Called with the
@@ -103,6 +130,15 @@ class StreamWatchdog {
     std::function<int64_t()> write_started;
     // The watchdog is cancelling this stream with its lock released.
     bool cancelling = false;
+    struct Transfer {
+      TransferRate rate;
+      // Set by the first touch with bytes.
+      bool started = false;
+      // The current window, and the bytes moved before it and in all.
+      absl::Time window_start;
+      uint64_t window_bytes = 0;
+      uint64_t bytes = 0;
+    } transfer;
   };
   void loop();
 
