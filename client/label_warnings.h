@@ -9,7 +9,8 @@
 
 namespace labelmesh::client {
 
-// Nothing when the report has no warnings.
+// Nothing when the report has no warnings. Also says which labels touch in
+// a volume mesh made label by label (their meshes overlap there).
 void print_label_warnings(std::string_view command, const v1::Report& report);
 
 }  // namespace labelmesh::client

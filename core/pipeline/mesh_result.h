@@ -22,6 +22,7 @@
 #include "core/volume/label_description.h"
 #include "core/volume/label_statistics.h"
 #include "core/volume/label_volume.h"
+#include "core/volume/touching_labels.h"
 
 namespace labelmesh {
 
@@ -98,6 +99,9 @@ struct MeshResult {
   std::vector<StageTiming> stages;
   // Every label delivered outside its tolerance or not at all.
   std::vector<LabelWarning> warnings;
+  // Tetrahedra and mixed meshes: selected labels whose voxels share faces,
+  // whose separate meshes therefore overlap along their interface.
+  std::vector<volume::TouchingLabels> touching_labels;
   // The label volume as read, kept when a scene format writes it.
   std::shared_ptr<const volume::LabelVolume> label_image;
   // Files of the whole job (SceneFormat), relative to the output directory.

@@ -24,6 +24,7 @@
 #include "core/volume/label_table.h"
 #include "core/volume/read_label_volume.h"
 #include "core/volume/repeated_planes.h"
+#include "core/volume/touching_labels.h"
 
 namespace labelmesh {
 namespace {
@@ -502,6 +503,13 @@ absl::StatusOr<MeshResult> run_on_volume(const std::string& path,
   // Refused before the volume meshes, which would take long for nothing.
   if (auto s = refuse_warnings_if_strict(path, result, params); !s.ok()) return s;
 
+  if (tetrahedra || params.volume == VolumeMethod::kMixed || params.volume == VolumeMethod::kHex) {
+    // Labels are meshed one by one: where they touch, their meshes overlap.
+    for (size_t layer = 0; layer < layers.size(); ++layer) {
+      auto touching = volume::touching_labels(layers[layer], *labels);
+      result.touching_labels.insert(result.touching_labels.end(), touching.begin(), touching.end());
+    }
+  }
   if (tetrahedra) {
     if (auto s = add_volume_mesh(params, volume->geometry, context, result); !s.ok()) return s;
   }

@@ -325,6 +325,14 @@ v1::Report make_report(const MeshResult& result, const MeshParams& params) {
   }
   if (result.volume) *report.mutable_volume() = make_volume_summary(*result.volume);
   if (result.mixed) *report.mutable_volume() = make_mixed_summary(*result.mixed);
+  if (report.has_volume()) {
+    for (const auto& pair : result.touching_labels) {
+      auto* entry = report.mutable_volume()->add_touching_labels();
+      entry->set_first(pair.first);
+      entry->set_second(pair.second);
+      entry->set_voxel_faces(pair.faces);
+    }
+  }
   for (const auto& warning : result.warnings) {
     auto* entry = report.add_warnings();
     entry->set_label(warning.label);

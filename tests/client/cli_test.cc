@@ -297,6 +297,9 @@ TEST(Cli, StrictFailsWhenAVolumeMeshIsNotDelivered) {
   const std::string mesh = "mesh " + input + " --volume hex --hex-size 2 --formats vtu";
   const CliRun lenient = run_cli(mesh + " --out " + (dir / "lenient").string() + " 2>&1");
   EXPECT_EQ(lenient.exit_code, 0) << lenient.output;
+  // Shell 2 touches ball 1 and shell 3: separate meshes, said on stderr.
+  EXPECT_NE(lenient.output.find("2 pair(s) of labels touch"), std::string::npos) << lenient.output;
+  EXPECT_NE(lenient.output.find("labels 1 and 2:"), std::string::npos) << lenient.output;
   const CliRun strict = run_cli(mesh + " --strict --out " + (dir / "strict").string() + " 2>&1");
   EXPECT_EQ(strict.exit_code, 4) << strict.output;
   EXPECT_NE(strict.output.find("no volume mesh"), std::string::npos) << strict.output;
