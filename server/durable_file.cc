@@ -7,15 +7,42 @@
 #include <cerrno>
 #include <cstring>
 
+#include <algorithm>
+
 #include "absl/strings/str_cat.h"
+#include "spdlog/spdlog.h"
 
 namespace labelmesh::server {
 
+std::string spool_relative(std::string_view text) {
+  std::string out;
+  size_t at = 0;
+  while (at < text.size()) {
+    const size_t end = std::min(text.find(' ', at), text.size());
+    std::string_view word = text.substr(at, end - at);
+    if (!word.empty() && word.front() == '/') {
+      size_t keep = std::string_view::npos;
+      for (std::string_view part : {"/jobs/", "/uploads/", "/quarantine/"})
+        if (const size_t found = word.rfind(part);
+            found != std::string_view::npos && (keep == std::string_view::npos || found > keep))
+          keep = found;
+      word =
+          keep != std::string_view::npos ? word.substr(keep + 1) : word.substr(word.rfind('/') + 1);
+    }
+    out.append(word);
+    if (end < text.size()) out.push_back(' ');
+    at = end + 1;
+  }
+  return out;
+}
+
 absl::Status spool_io_error(const std::string& what, int error_number) {
+  spdlog::warn("spool: {}: {}", what, std::strerror(error_number));
+  const std::string shown = spool_relative(what);
   if (error_number == ENOSPC || error_number == EDQUOT || error_number == EFBIG)
     return absl::ResourceExhaustedError(
-        absl::StrCat("spool disk full: ", what, ": ", std::strerror(error_number)));
-  return absl::InternalError(absl::StrCat("spool: ", what, ": ", std::strerror(error_number)));
+        absl::StrCat("spool disk full: ", shown, ": ", std::strerror(error_number)));
+  return absl::InternalError(absl::StrCat("spool: ", shown, ": ", std::strerror(error_number)));
 }
 
 FileWriter::~FileWriter() {

@@ -12,7 +12,13 @@ namespace labelmesh::server {
 
 // RESOURCE_EXHAUSTED "spool disk full: ..." for ENOSPC, EDQUOT and EFBIG,
 // INTERNAL "spool: ..." otherwise; `what` says which file and what was done.
+// The status, which clients may see, names files only from their jobs/,
+// uploads/ or quarantine/ folder on (spool_relative); the log names them whole.
 absl::Status spool_io_error(const std::string& what, int error_number);
+
+// `text` with every absolute path in it cut to the part a client may see:
+// from its jobs/, uploads/ or quarantine/ component on, else its file name.
+std::string spool_relative(std::string_view text);
 
 class FileWriter {
  public:

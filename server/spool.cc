@@ -22,7 +22,8 @@ namespace {
 constexpr const char* kRecordName = "job.pb";
 
 absl::Status io_error(const std::string& what, const std::error_code& error) {
-  return absl::InternalError(absl::StrCat("spool: ", what, ": ", error.message()));
+  spdlog::warn("spool: {}: {}", what, error.message());
+  return absl::InternalError(absl::StrCat("spool: ", spool_relative(what), ": ", error.message()));
 }
 
 }  // namespace

@@ -13,6 +13,7 @@
 #include <fstream>
 
 #include "absl/strings/match.h"
+#include "server/durable_file.h"
 #include "support/test_files.h"
 
 namespace labelmesh {
@@ -127,6 +128,26 @@ TEST(Spool, EachAttemptHasItsOwnOutputDirectory) {
   ASSERT_TRUE(artifacts.ok()) << artifacts.status();
   ASSERT_EQ(artifacts->size(), 1u);
   EXPECT_EQ((*artifacts)[0].name(), "report.json");
+}
+
+// What a client sees of a spool failure names files from the spool's own
+// folders on, never where the spool lives on the server.
+TEST(SpoolErrors, ClientsSeePathsOnlyFromTheSpoolsFoldersOn) {
+  EXPECT_EQ(server::spool_relative("cannot write /srv/spool/uploads/ab12.nii.gz"),
+            "cannot write uploads/ab12.nii.gz");
+  EXPECT_EQ(server::spool_relative("cannot create /mnt/shared/jobs/ab/out-1 now"),
+            "cannot create jobs/ab/out-1 now");
+  EXPECT_EQ(server::spool_relative("cannot read the free space of /var/lib/labelmesh"),
+            "cannot read the free space of labelmesh");
+  EXPECT_EQ(server::spool_relative("no path here"), "no path here");
+  const absl::Status full = server::spool_io_error("cannot write /srv/spool/jobs/x/job.pb", ENOSPC);
+  EXPECT_EQ(full.code(), absl::StatusCode::kResourceExhausted);
+  EXPECT_TRUE(absl::StartsWith(full.message(), "spool disk full: cannot write jobs/x/job.pb"))
+      << full;
+  EXPECT_FALSE(absl::StrContains(full.message(), "/srv")) << full;
+  const absl::Status other = server::spool_io_error("cannot sync /srv/spool/uploads/u", EIO);
+  EXPECT_EQ(other.code(), absl::StatusCode::kInternal);
+  EXPECT_FALSE(absl::StrContains(other.message(), "/srv")) << other;
 }
 
 }  // namespace
