@@ -185,8 +185,7 @@ absl::StatusOr<vtkSmartPointer<vtkDataArray>> to_label_array(const std::string& 
 absl::StatusOr<LabelVolume> read_label_volume(const std::string& path, const ReadLimits& limits,
                                               const RunContext& context) {
   if (auto s = context.check_stop(); !s.ok()) return s;
-  if (format_of_file(path) == ImageFormat::kDicomSeg)
-    return read_dicom_seg(path, limits, context);
+  if (format_of_file(path) == ImageFormat::kDicomSeg) return read_dicom_seg(path, limits, context);
   auto header = check_volume_header(path, limits);
   if (!header.ok()) return header.status();
   context.report("read", 0.1);
