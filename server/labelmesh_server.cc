@@ -217,8 +217,9 @@ void LabelmeshServer::housekeeping_loop() {
     if (cluster_store_) {
       cluster_store_->check_follows();
       if (auto stored = cluster_->queue->stored(); stored.ok()) metrics_->set_queue_depth(*stored);
-      // No upload outlives the transfer deadline: older ones were cut off.
-      (void)cluster_store_->remove_abandoned_uploads(2 * config_.transfer_deadline);
+      // A living upload changes at least every stream idle timeout; one that
+      // has not changed for longer belonged to a frontend that was killed.
+      (void)cluster_store_->remove_abandoned_uploads(config_.abandoned_upload_age);
     }
     update_health();
     lock.lock();

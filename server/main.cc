@@ -109,6 +109,10 @@ void add_server_flags(CLI::App& app, ServerConfig& c) {
   env(add_duration(app, "--transfer-rate-window", c.transfer_rate_window,
                    "The window --min-transfer-rate is measured over"),
       "LABELMESHD_TRANSFER_RATE_WINDOW");
+  env(add_duration(app, "--abandoned-upload-age", c.abandoned_upload_age,
+                   "A cluster frontend deletes shared uploads unchanged this long "
+                   "(left by a killed frontend)"),
+      "LABELMESHD_ABANDONED_UPLOAD_AGE");
   env(app.add_option("--spool-reserve-bytes", c.spool_reserve_bytes,
                      "Free spool disk space kept for running jobs; uploads into it are refused")
           ->capture_default_str(),

@@ -22,6 +22,9 @@ namespace {
 constexpr size_t kChunkBytes = 1 << 20;
 // Longest a worker may take to read an upload the server cannot decode.
 constexpr std::chrono::milliseconds kVolumeCheckTime{120'000};
+// How often a living upload's modification time is renewed while nothing is
+// written to it; half the shortest --abandoned-upload-age.
+constexpr std::chrono::seconds kUploadMarkInterval{10};
 
 grpc::Status invalid(const std::string& message) {
   return to_grpc(absl::InvalidArgumentError(message));
@@ -70,7 +73,10 @@ class RequestClaim {
   bool claimed_ = false;
 };
 
-// Deletes the upload file unless it was handed to a job.
+// Deletes the upload file unless it was handed to a job. While the upload
+// lives its modification time stays recent, also through checks that write
+// nothing, so that frontends sweeping a shared upload folder can tell it
+// from one a killed frontend left behind.
 class UploadFile {
  public:
   explicit UploadFile(std::string path) : path_(std::move(path)) {}
@@ -80,10 +86,18 @@ class UploadFile {
   }
   const std::string& path() const { return path_; }
   void keep() { kept_ = true; }
+  void mark_alive() {
+    const auto now = std::filesystem::file_time_type::clock::now();
+    if (now - marked_ < kUploadMarkInterval) return;
+    std::error_code ignored;
+    std::filesystem::last_write_time(path_, now, ignored);
+    marked_ = now;
+  }
 
  private:
   std::string path_;
   bool kept_ = false;
+  std::filesystem::file_time_type marked_ = std::filesystem::file_time_type::clock::now();
 };
 
 }  // namespace
@@ -320,6 +334,7 @@ grpc::Status MeshingService::submit(grpc::ServerContext& context,
   UploadFile upload(store_.upload_path(job_id, extension));
   if (auto status = receive_upload(reader, spec, upload.path(), *ticket, reason); !status.ok())
     return status;
+  upload.mark_alive();
   auto geometry = check_uploaded_volume(upload.path(), voxel_limit, config_.worker_memory_bytes);
   if (!geometry.ok()) {
     reason = "bad_volume";
@@ -334,6 +349,7 @@ grpc::Status MeshingService::submit(grpc::ServerContext& context,
   if (extension == ".vti" || extension == ".dcm") {
     auto keep_going = [&] {
       ticket->touch();
+      upload.mark_alive();
       return !context.IsCancelled();
     };
     std::unique_lock reading(volume_reader_, std::defer_lock);

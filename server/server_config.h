@@ -72,6 +72,10 @@ struct ServerConfig {
   // otherwise hold a slot until the transfer deadline. 0: no minimum.
   uint64_t min_transfer_rate = uint64_t{64} << 10;
   absl::Duration transfer_rate_window = absl::Seconds(30);
+  // A cluster frontend deletes files in the shared upload folder that have
+  // not changed for this long: a killed frontend's partial uploads. Living
+  // uploads change at least every --stream-idle-timeout.
+  absl::Duration abandoned_upload_age = absl::Minutes(5);
   // Largest gRPC message either way; upload and fetch chunks are 1 MiB.
   int max_message_bytes = 4 << 20;
 

@@ -22,8 +22,9 @@ import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
-from cluster_harness import (CALL_SECONDS, READY_SECONDS, CheckFailed, Cluster, Processes, check,
-                             free_port, kinds, requests, spec_for, submit, wait_for, watch)
+from cluster_harness import (ABANDONED_UPLOAD_AGE, CALL_SECONDS, READY_SECONDS, CheckFailed,
+                             Cluster, Processes, check, free_port, kinds, requests, spec_for,
+                             submit, wait_for, watch)
 
 
 def artifact_digests(pb, stub, job_id):
@@ -186,7 +187,10 @@ def drill_kill_frontend_mid_upload(cluster, pb, options_pb, big):
     thread = threading.Thread(target=upload)
     thread.start()
     check(reached.wait(CALL_SECONDS), "the upload did not start")
+    uploads = os.path.join(cluster.artifacts, "uploads")
+    wait_for(lambda: os.listdir(uploads), "the partial upload", CALL_SECONDS)
     cluster.processes.stop("frontend-1", signal.SIGKILL)
+    killed_at = time.monotonic()
     release.set()
     thread.join()
     check(failure == [cluster.grpc.StatusCode.UNAVAILABLE], f"the cut upload ended {failure}")
@@ -199,8 +203,24 @@ def drill_kill_frontend_mid_upload(cluster, pb, options_pb, big):
     check(kinds(events)[-1] == "finished", f"the retried job ended {kinds(events)}")
     listed = [job.job_id for job in stub.ListJobs(pb.ListJobsRequest(page_size=1000)).jobs]
     check(listed.count(retried.job_id) == 1, "the retried request is listed more than once")
+    left = os.listdir(uploads)
+    check(len(left) == 1, f"the killed frontend's partial upload: {left}")
     cluster.start_node("frontend-1", "frontend")
     print("kill -9 of a frontend mid-upload: the retry through the other made one job")
+    return killed_at
+
+
+def drill_abandoned_upload_swept(cluster, killed_at):
+    """The partial upload goes once unchanged for the abandoned-upload age, not before."""
+    uploads = os.path.join(cluster.artifacts, "uploads")
+    age = float(ABANDONED_UPLOAD_AGE.rstrip("s"))
+    deadline = killed_at + age + 15
+    while os.listdir(uploads) and time.monotonic() < deadline:
+        time.sleep(0.5)
+    swept_after = time.monotonic() - killed_at
+    check(not os.listdir(uploads), f"partial upload still there after {swept_after:.0f} s")
+    check(swept_after >= age - 1, f"partial upload swept after only {swept_after:.0f} s")
+    print(f"the killed frontend's partial upload was swept {swept_after:.0f} s after the kill")
 
 
 def drill_nats_restart(cluster, pb, options_pb, small):
@@ -286,8 +306,9 @@ def main():
             drill_cancel_across(cluster, pb, options_pb, big)
             drill_kill_worker(cluster, pb, options_pb, big)
             drill_frozen_worker(cluster, pb, options_pb, big)
-            drill_kill_frontend_mid_upload(cluster, pb, options_pb, big)
+            killed_at = drill_kill_frontend_mid_upload(cluster, pb, options_pb, big)
             drill_nats_restart(cluster, pb, options_pb, volumes[0])
+            drill_abandoned_upload_swept(cluster, killed_at)
             for name in ["frontend-1", "frontend-2", "worker-1", "worker-2"]:
                 code = cluster.processes.stop(name)
                 check(code == 0, f"{name} exit code after SIGTERM: {code}")

@@ -16,6 +16,7 @@ READY_SECONDS = 30
 JOB_SECONDS = 300  # bounds a hang; small phantoms take seconds
 CALL_SECONDS = 30
 ACK_WAIT = "3s"  # a silent worker loses its job after this
+ABANDONED_UPLOAD_AGE = "20s"  # a killed frontend's partial upload is swept after this
 
 
 class CheckFailed(Exception):
@@ -107,7 +108,8 @@ class Cluster:
                 "--nats-url", self.nats_url, "--artifact-dir", self.artifacts,
                 "--spool-dir", os.path.join(self.tmp, name), "--workers", str(workers),
                 "--cluster-ack-wait", ACK_WAIT, "--spool-reserve-bytes", str(16 << 20),
-                "--shutdown-grace", "20s"]
+                "--shutdown-grace", "20s", "--stream-idle-timeout", "10s",
+                "--abandoned-upload-age", ABANDONED_UPLOAD_AGE]
         process = self.processes.start(name, argv)
         self.wait_serving(name, process)
 

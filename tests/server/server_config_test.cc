@@ -62,6 +62,20 @@ TEST(ServerConfigRules, NonLoopbackMetricsNeedAllowAnonymous) {
   EXPECT_TRUE(server::validate_config(config).ok());
 }
 
+TEST(ServerConfigRules, AbandonedUploadsOutliveEveryPauseOfALivingUpload) {
+  server::ServerConfig config;
+  EXPECT_TRUE(server::validate_config(config).ok());
+  config.stream_idle_timeout = absl::Minutes(3);  // a living upload may pause 3 minutes
+  auto status = server::validate_config(config);
+  EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_NE(status.message().find("--abandoned-upload-age"), std::string::npos) << status;
+  config.abandoned_upload_age = absl::Minutes(6);
+  EXPECT_TRUE(server::validate_config(config).ok());
+  config.stream_idle_timeout = absl::Seconds(5);
+  config.abandoned_upload_age = absl::Seconds(19);
+  EXPECT_FALSE(server::validate_config(config).ok());
+}
+
 TEST(ClientsFile, ListsNamedTokensAndRefusesWhatIsAmbiguous) {
   const auto dir = scratch_dir("ClientsFile");
   const auto path = dir / "clients";
