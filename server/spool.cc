@@ -174,12 +174,21 @@ absl::StatusOr<std::vector<v1::Artifact>> Spool::collect_artifacts(const std::st
 absl::StatusOr<std::vector<v1::Artifact>> list_artifacts(const std::string& dir) {
   std::vector<v1::Artifact> artifacts;
   const fs::path out = dir;
+  // Without exceptions: a stale attempt's folder can be removed while it is
+  // listed, and that is an error for the attempt, not a crash of the worker.
   std::error_code error;
-  for (const auto& entry : fs::recursive_directory_iterator(out, error)) {
-    if (!entry.is_regular_file()) continue;
+  for (fs::recursive_directory_iterator it(out, error), end; !error && it != end;
+       it.increment(error)) {
+    const fs::directory_entry& entry = *it;
+    if (!entry.is_regular_file(error)) {
+      if (error) break;
+      continue;
+    }
+    const uintmax_t size = entry.file_size(error);
+    if (error) break;
     v1::Artifact artifact;
-    artifact.set_name(fs::relative(entry.path(), out).string());
-    artifact.set_size_bytes(entry.file_size());
+    artifact.set_name(entry.path().lexically_relative(out).string());
+    artifact.set_size_bytes(size);
     auto digest = digest::sha256_file(entry.path().string());
     if (!digest.ok()) return digest.status();
     artifact.set_sha256(*digest);

@@ -130,6 +130,20 @@ TEST(Spool, EachAttemptHasItsOwnOutputDirectory) {
   EXPECT_EQ((*artifacts)[0].name(), "report.json");
 }
 
+// A folder that changes while it is listed (a stale attempt's, removed under
+// it) gives an error, not an exception that ends the worker. A link to
+// itself fails the same way, every time.
+TEST(Spool, AnEntryThatCannotBeReadIsAnErrorNotACrash) {
+  const fs::path out = scratch_dir("SpoolUnreadableEntry");
+  testing::write_file(out / "report.json", "{}");
+  fs::create_symlink(out / "loop", out / "loop");
+  auto artifacts = server::list_artifacts(out.string());
+  EXPECT_FALSE(artifacts.ok());
+  EXPECT_TRUE(absl::StrContains(artifacts.status().message(), "cannot list the results"))
+      << artifacts.status();
+  EXPECT_FALSE(server::list_artifacts((out / "gone").string()).ok());
+}
+
 // What a client sees of a spool failure names files from the spool's own
 // folders on, never where the spool lives on the server.
 TEST(SpoolErrors, ClientsSeePathsOnlyFromTheSpoolsFoldersOn) {
