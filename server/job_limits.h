@@ -4,6 +4,7 @@
 // results may come to. The same for a local worker pool and a cluster worker.
 #pragma once
 
+#include <chrono>
 #include <cstdint>
 #include <vector>
 
@@ -16,6 +17,8 @@ namespace labelmesh::server {
 
 // Less room than this over the reserve and a job does not start.
 inline constexpr uint64_t kLeastOutputRoom = uint64_t{1} << 20;
+// How often workers waiting for room on a full spool disk look again.
+inline constexpr std::chrono::seconds kRoomPollInterval{1};
 
 // The largest file a job starting now may write, given the free bytes where
 // it writes: its output limit, or the free space over the reserve if that is

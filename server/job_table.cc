@@ -302,6 +302,36 @@ void JobTable::requeue_interrupted(const std::string& job_id) {
   spdlog::info("job {} interrupted by shutdown; it runs again at the next start", job_id);
 }
 
+void JobTable::give_back(const std::string& job_id) {
+  std::lock_guard lock(mutex_);
+  Entry* entry = find(job_id);
+  if (entry == nullptr || entry->record.job().state() != v1::JOB_STATE_RUNNING) return;
+  if (running_ > 0) --running_;
+  if (entry->remove_when_ended) {
+    update_gauges();
+    remove_if_requested(job_id);
+    return;
+  }
+  v1::Job& job = *entry->record.mutable_job();
+  job.set_state(v1::JOB_STATE_QUEUED);
+  job.set_attempts(job.attempts() - 1);
+  job.set_started_at(0);
+  job.clear_stage();
+  (void)persist(entry->record);
+  queue_.push_front(job_id);
+  v1::JobEvent event;
+  event.mutable_queued()->set_position(0);  // next
+  add_event(*entry, std::move(event));
+  update_gauges();
+  queue_changed_.notify_one();
+  spdlog::info("job {} given back to the queue: no room for its results", job_id);
+}
+
+bool JobTable::dispatching() const {
+  std::lock_guard lock(mutex_);
+  return dispatching_ && !closed_;
+}
+
 v1::Job JobTable::view(const std::string& job_id, const v1::Job& stored) const {
   v1::Job job = with_timestamps(stored);
   if (job.state() == v1::JOB_STATE_QUEUED) job.set_queue_position(position_of(job_id));

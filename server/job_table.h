@@ -49,6 +49,11 @@ class JobTable final : public JobStore {
   void mark_cancelled(const std::string& job_id);
   // A running job stopped by shutdown: queued again on disk for the next start.
   void requeue_interrupted(const std::string& job_id);
+  // A running job its worker could not start (no room for results): first in
+  // the queue again, its attempt not counted.
+  void give_back(const std::string& job_id);
+  // False once dispatch stopped or the table closed: no job will be handed out.
+  bool dispatching() const;
 
   absl::StatusOr<v1::Job> get(const std::string& job_id) const override;
   absl::StatusOr<std::string> owner(const std::string& job_id) const override;

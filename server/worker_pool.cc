@@ -22,7 +22,10 @@ void WorkerPool::start() {
 }
 
 void WorkerPool::run_thread() {
-  while (auto record = table_.take_next()) {
+  for (;;) {
+    wait_for_room();
+    auto record = table_.take_next();
+    if (!record) break;
     {
       std::lock_guard lock(mutex_);
       ++busy_;
@@ -31,6 +34,20 @@ void WorkerPool::run_thread() {
     std::lock_guard lock(mutex_);
     --busy_;
     idle_.notify_all();
+  }
+}
+
+void WorkerPool::wait_for_room() {
+  bool said = false;
+  while (table_.dispatching()) {
+    auto room = output_room(spool_.free_bytes(), config_);
+    if (room.ok()) {
+      if (said) spdlog::info("spool disk has room again; taking jobs");
+      return;
+    }
+    if (!said) spdlog::warn("{}; queued jobs wait", std::string(room.status().message()));
+    said = true;
+    std::this_thread::sleep_for(kRoomPollInterval);
   }
 }
 
@@ -43,7 +60,8 @@ void WorkerPool::run_job(const v1::JobRecord& record) {
   }
   auto room = output_room(spool_.free_bytes(), config_);
   if (!room.ok()) {
-    table_.fail(id, static_cast<int>(room.status().code()), std::string(room.status().message()));
+    // The disk filled after wait_for_room: the job waits, it has not failed.
+    table_.give_back(id);
     return;
   }
   WorkerRun run;

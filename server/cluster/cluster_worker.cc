@@ -39,8 +39,8 @@ absl::StatusOr<bool> ClusterWorker::run_one() {
   }
   const JobOutcome outcome = running.get();
   if (outcome.state == v1::JOB_STATE_QUEUED) {
-    // This worker is stopping: the next one takes the job at once, without
-    // it counting as a failed delivery.
+    // Given back (this worker is stopping, or has no room for results): the
+    // next worker takes the job, without it counting as a failed delivery.
     auto requeued = jobs_.requeue(*claim);
     // Taken over meanwhile: the other attempt has it.
     if (!requeued.ok() && requeued.code() != absl::StatusCode::kAborted) return requeued;

@@ -87,6 +87,7 @@ void ClusterWorkerRole::run_slot(cluster::ClusterConnection& connection) {
       });
   bool failing = false;
   while (!stopping_.load()) {
+    if (!wait_for_room()) break;
     auto handled = worker.run_one();
     if (handled.ok() == failing) {
       // NATS away (or back): the slot says so once, and health follows.
@@ -103,6 +104,23 @@ void ClusterWorkerRole::run_slot(cluster::ClusterConnection& connection) {
   if (failing) --failing_slots_;
 }
 
+bool ClusterWorkerRole::wait_for_room() {
+  bool said = false;
+  while (!stopping_.load()) {
+    auto room = output_room(files_.free_bytes(), config_);
+    if (room.ok()) {
+      if (said) spdlog::info("shared disk has room again; taking jobs");
+      return true;
+    }
+    if (!said)
+      spdlog::warn("{}; this worker takes no job until there is room",
+                   std::string(room.status().message()));
+    said = true;
+    std::this_thread::sleep_for(kRoomPollInterval);
+  }
+  return false;
+}
+
 cluster::JobOutcome ClusterWorkerRole::run_job(cluster::ClusterConnection& connection,
                                                const v1::JobRecord& record,
                                                const cluster::Claim& claim,
@@ -112,7 +130,15 @@ cluster::JobOutcome ClusterWorkerRole::run_job(cluster::ClusterConnection& conne
   const std::string out = files_.attempt_dir(id, claim.attempt);
   if (auto status = fresh_directory(out); !status.ok()) return failed(status);
   auto room = output_room(files_.free_bytes(), config_);
-  if (!room.ok()) return failed(room.status());
+  if (!room.ok()) {
+    // The disk filled after wait_for_room: the job waits, it has not failed.
+    spdlog::warn("job {}: {}; it goes back to the queue", id, std::string(room.status().message()));
+    std::error_code ignored;
+    fs::remove_all(out, ignored);
+    cluster::JobOutcome given_back;
+    given_back.state = v1::JOB_STATE_QUEUED;
+    return given_back;
+  }
   const std::string job_dir = files_.job_dir(id);
   WorkerRun run;
   run.executable = executable_;

@@ -439,6 +439,39 @@ TEST_F(ClusterRolesTest, AWorkerRunsAJobFromTheSharedDirectoryAndServesOnlyHealt
   (*worker)->shutdown();
 }
 
+TEST_F(ClusterRolesTest, AWorkerWithNoRoomForResultsLeavesJobsQueued) {
+  const fs::path volume = testing::write_phantom(dir_, volume::PhantomShape::kSphere);
+  const std::string id = store_->new_job_id_for("ann", "");
+  const std::string upload = store_->upload_path(id, ".nii.gz");
+  fs::copy_file(volume, upload);
+  v1::JobRecord record;
+  record.mutable_job()->set_job_id(id);
+  record.mutable_job()->set_owner("ann");
+  record.mutable_job()->set_created_at(server::unix_now());
+  record.set_input_extension(".nii.gz");
+  ASSERT_TRUE(store_->accept(record, upload).ok());
+
+  auto full_config = role_config(dir_, "worker", nats_->url());
+  full_config.spool_reserve_bytes = uint64_t{1} << 60;  // More than any disk has free.
+  auto full = server::LabelmeshServer::start(full_config);
+  ASSERT_TRUE(full.ok()) << full.status();
+  std::this_thread::sleep_for(std::chrono::seconds(3));
+  v1::Job job = store_->get(id).value();
+  EXPECT_EQ(job.state(), v1::JOB_STATE_QUEUED) << job.error().message();
+  EXPECT_EQ(job.attempts(), 0u);
+  (*full)->shutdown();
+
+  auto worker = server::LabelmeshServer::start(role_config(dir_, "worker", nats_->url()));
+  ASSERT_TRUE(worker.ok()) << worker.status();
+  for (int i = 0; i < 1200 && !server::has_ended(job.state()); ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    job = store_->get(id).value();
+  }
+  EXPECT_EQ(job.state(), v1::JOB_STATE_SUCCEEDED) << job.error().message();
+  EXPECT_EQ(job.attempts(), 1u);
+  (*worker)->shutdown();
+}
+
 TEST(ClusterRoleConfig, FrontendsAndWorkersNeedNatsAndTheSharedDirectory) {
   server::ServerConfig config;
   config.role = "frontend";

@@ -9,6 +9,7 @@
 #include <csignal>
 #include <filesystem>
 #include <fstream>
+#include <thread>
 
 #include "absl/strings/match.h"
 #include "core/volume/phantom.h"
@@ -154,6 +155,41 @@ TEST_F(FullDiskTest, NoAcceptedJobIsLostWhenTheDiskFills) {
   }
   EXPECT_EQ(entries_in(spool_ / "quarantine"), 0u);
   again.shutdown();
+}
+
+// A queued job meets a disk with no room for its results: it waits in the
+// queue, its attempts not counted, and runs once there is room.
+TEST_F(FullDiskTest, QueuedJobsWaitForRoomInsteadOfFailing) {
+  auto config = ServiceHarness::config_for(spool_);
+  config.workers = 0;
+  std::string id;
+  {
+    ServiceHarness service(config);
+    v1::SubmitReply reply;
+    ASSERT_TRUE(service.submit(input_, testing::repaired_options(), &reply).ok());
+    id = reply.job_id();
+    service.shutdown();
+  }
+  config.workers = 1;
+  {
+    config.spool_reserve_bytes = uint64_t{1} << 60;  // More than any disk has free.
+    ServiceHarness full(config);
+    std::this_thread::sleep_for(std::chrono::seconds(3));
+    const v1::Job waiting = full.get(id);
+    EXPECT_EQ(waiting.state(), v1::JOB_STATE_QUEUED) << waiting.error().message();
+    EXPECT_EQ(waiting.attempts(), 0u);
+    EXPECT_EQ(waiting.queue_position(), 0u);  // next
+    full.shutdown();
+  }
+  config.spool_reserve_bytes = 0;
+  ServiceHarness room(config);
+  const auto events = room.watch(id);
+  ASSERT_FALSE(events.empty());
+  EXPECT_TRUE(events.back().has_finished());
+  const v1::Job done = room.get(id);
+  EXPECT_EQ(done.state(), v1::JOB_STATE_SUCCEEDED) << done.error().message();
+  EXPECT_EQ(done.attempts(), 1u);
+  room.shutdown();
 }
 
 }  // namespace
