@@ -11,7 +11,7 @@
 #include "core/pipeline/report.h"
 #include "google/protobuf/util/json_util.h"
 #include "labelmesh/v1/service.grpc.pb.h"
-#include "server/sha256.h"
+#include "core/digest/sha256.h"
 
 namespace labelmesh::client {
 namespace {

@@ -23,7 +23,7 @@
 #include "core/pipeline/report.h"
 #include "core/volume/volume_header.h"
 #include "labelmesh/v1/service.grpc.pb.h"
-#include "server/sha256.h"
+#include "core/digest/sha256.h"
 
 namespace labelmesh::client {
 namespace {

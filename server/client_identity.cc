@@ -10,7 +10,7 @@
 #include "absl/strings/ascii.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_split.h"
-#include "server/sha256.h"
+#include "core/digest/sha256.h"
 #include "server/stream_limits.h"
 
 namespace labelmesh::server {

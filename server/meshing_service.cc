@@ -9,7 +9,7 @@
 #include "core/pipeline/job_options.h"
 #include "server/durable_file.h"
 #include "server/error_details.h"
-#include "server/sha256.h"
+#include "core/digest/sha256.h"
 #include "server/spool.h"
 #include "server/upload_checks.h"
 #include "server/watch_reactor.h"

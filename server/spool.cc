@@ -12,7 +12,7 @@
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 #include "server/durable_file.h"
-#include "server/sha256.h"
+#include "core/digest/sha256.h"
 #include "spdlog/spdlog.h"
 
 namespace labelmesh::server {

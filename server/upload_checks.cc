@@ -8,7 +8,7 @@
 #include "absl/strings/str_replace.h"
 #include "core/pipeline/job_options.h"
 #include "core/volume/volume_header.h"
-#include "server/sha256.h"
+#include "core/digest/sha256.h"
 
 namespace labelmesh::server {
 

@@ -6,7 +6,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "server/durable_file.h"
-#include "server/sha256.h"
+#include "core/digest/sha256.h"
 #include "server/spool.h"
 #include "spdlog/spdlog.h"
 

@@ -9,7 +9,7 @@
 
 #include "absl/strings/match.h"
 #include "server/metrics.h"
-#include "server/sha256.h"
+#include "core/digest/sha256.h"
 #include "support/service_harness.h"
 
 namespace labelmesh {

@@ -18,7 +18,7 @@
 #include "core/volume/write_label_volume.h"
 #include "labelmesh/v1/service.grpc.pb.h"
 #include "server/labelmesh_server.h"
-#include "server/sha256.h"
+#include "core/digest/sha256.h"
 #include "support/test_files.h"
 
 namespace labelmesh::testing {

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-#include "server/sha256.h"
+#include "core/digest/sha256.h"
 
 #include <openssl/crypto.h>
 #include <openssl/evp.h>
