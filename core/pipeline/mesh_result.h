@@ -39,6 +39,9 @@ struct VolumeSummary {
   // Images the labels were read into: more than 1 when overlapping segments
   // were kept apart (volume::ReadLimits::separate_overlapping).
   uint32_t layers = 1;
+  // The file read, without its folder, and the SHA-256 of its bytes.
+  std::string file_name;
+  std::string sha256;
 };
 
 // Which connected pieces of a label a surface covers.

@@ -7,10 +7,12 @@
 
 #include <algorithm>
 #include <atomic>
+#include <filesystem>
 #include <limits>
 #include <mutex>
 #include <thread>
 
+#include "core/digest/sha256.h"
 #include "core/pipeline/label_conforming_mesh.h"
 #include "core/pipeline/label_net_surfaces.h"
 #include "core/pipeline/label_queue.h"
@@ -387,13 +389,20 @@ absl::StatusOr<MeshResult> run_stages(const std::string& path, const MeshParams&
                                       const RunContext& context) {
   MeshResult result;
   absl::StatusOr<volume::LabelVolume> volume;
+  absl::StatusOr<std::string> digest;
   {
     StageTimer timer(result.stages, "read");
     context.report("read", 0);
     volume = volume::read_label_volume(path, params.limits, context);
+    if (volume.ok()) digest = digest::sha256_file(path);
   }
   if (!volume.ok()) return volume.status();
-  return run_on_volume(path, std::move(volume), params, context, std::move(result));
+  auto meshed = run_on_volume(path, std::move(volume), params, context, std::move(result));
+  if (meshed.ok()) {
+    meshed->input.file_name = std::filesystem::path(path).filename().string();
+    if (digest.ok()) meshed->input.sha256 = *digest;
+  }
+  return meshed;
 }
 
 // Under --strict, any warning (a label outside tolerance, a surface or a

@@ -6,6 +6,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "absl/time/clock.h"
+#include "absl/time/time.h"
 #include "core/pipeline/build_info.h"
 #include "core/pipeline/job_options.h"
 #include "core/util/text.h"
@@ -289,6 +291,8 @@ v1::InputSummary make_input_summary(const VolumeSummary& summary) {
   }
   input.set_background_voxels(summary.statistics.background_voxels);
   input.set_layers(summary.layers);
+  input.set_file_name(summary.file_name);
+  input.set_sha256(summary.sha256);
   for (int axis = 0; axis < 3; ++axis) {
     input.add_repeated_planes(static_cast<uint32_t>(summary.repeated_planes[axis]));
     input.add_drawn_spacing(g.spacing[axis] * summary.repeated_planes[axis]);
@@ -301,6 +305,7 @@ v1::Report make_report(const MeshResult& result, const MeshParams& params) {
   *report.mutable_build() = build_info();
   *report.mutable_options() = make_options(params);
   *report.mutable_input() = make_input_summary(result.input);
+  report.set_created_at(absl::FormatTime("%Y-%m-%dT%H:%M:%SZ", absl::Now(), absl::UTCTimeZone()));
   for (const auto& surface : result.surfaces) {
     const auto& s = surface.statistics;
     auto* entry = report.add_surfaces();

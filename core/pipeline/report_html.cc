@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <vector>
 
+#include "absl/strings/escaping.h"
 #include "core/pipeline/report.h"
 #include "core/util/text.h"
 
@@ -26,6 +27,9 @@ td.num { text-align: right; font-variant-numeric: tabular-nums; }
 .error { color: #b00020; }
 figure { margin: 1em 0; }
 figcaption { font-weight: bold; margin-bottom: 0.3em; }
+div.labels { display: flex; flex-wrap: wrap; gap: 0.5em; }
+figure.label { margin: 0; width: 128px; }
+figure.label figcaption { font-weight: normal; font-size: 0.8em; }
 )";
 
 std::string fixed(double value, int decimals) { return format_fixed(value, decimals); }
@@ -159,7 +163,34 @@ std::string input_section(const v1::Report& report) {
              triple(input.drawn_spacing(), 4), "</td></tr>\n", "<tr><th>Origin (mm)</th><td>",
              triple(input.origin(), 3), "</td></tr>\n",
              "<tr><th>Background voxels</th><td class=\"num\">", input.background_voxels(),
-             "</td></tr>\n</table>\n");
+             "</td></tr>\n", "<tr><th>File</th><td>",
+             input.file_name().empty() ? std::string(kNone) : html_escape(input.file_name()),
+             "</td></tr>\n<tr><th>SHA-256</th><td><code>",
+             input.sha256().empty() ? std::string(kNone) : html_escape(input.sha256()),
+             "</code></td></tr>\n</table>\n");
+}
+
+std::string png_image(const std::string& png, std::string_view alt) {
+  return cat("<img src=\"data:image/png;base64,", absl::Base64Escape(png), "\" alt=\"",
+             html_escape(alt), "\">");
+}
+
+// Every surface from three sides, then each label alone from the front.
+std::string pictures_section(const v1::Report& report, const SurfacePictures& pictures) {
+  if (pictures.overview_png.empty()) return "";
+  std::string html =
+      cat("<h2>Surfaces</h2>\n<figure>\n",
+          png_image(pictures.overview_png,
+                    "every delivered surface from the front, the left and above"),
+          "\n<figcaption>From the front (the patient's left on the right), from the patient's left "
+          "(anterior on the left) and from above (anterior up).</figcaption>\n</figure>\n"
+          "<div class=\"labels\">\n");
+  for (const auto& [label, png] : pictures.label_png) {
+    const std::string name = label_name(report, label);
+    html += cat("<figure class=\"label\">", png_image(png, name), "<figcaption>",
+                html_escape(shorten(name, 28)), "</figcaption></figure>\n");
+  }
+  return html + "</div>\n";
 }
 
 std::string name_cell(const v1::LabelSummary& label) {
@@ -285,7 +316,47 @@ std::string mixed_volume_section(const v1::VolumeMeshSummary& v) {
   return html + svg_chart(category_chart(v.categories(), false));
 }
 
+// One tetrahedral mesh of every label: its quality, its interfaces and
+// conformity check, and each label's volume against its voxels.
+std::string conforming_volume_section(const v1::VolumeMeshSummary& v) {
+  const auto& c = v.conforming_figures();
+  const auto& check = v.conformity_check();
+  std::string html = cat("<h2>Volume mesh (conforming: one mesh of every label)</h2>\n<table>\n",
+                         row("Nodes", cat(v.nodes())), row("Tetrahedra", cat(v.tetrahedra())),
+                         row("Quality Q, min", fixed(v.tetra_quality_min(), 3)),
+                         row("Quality Q, mean", fixed(v.tetra_quality_mean(), 3)),
+                         row("Dihedral angle, min (&deg;)", fixed(v.min_dihedral_deg(), 2)),
+                         row("Dihedral angle, max (&deg;)", fixed(v.max_dihedral_deg(), 2)),
+                         row("Inverted cells", cat(v.inverted())),
+                         row("Interfaces (label pairs, the outside included)", cat(c.interfaces())),
+                         row("Interface faces", cat(c.interface_faces())),
+                         row("Outer faces", cat(c.outer_faces())),
+                         row("Interfaces' distance to the voxel boundary, max (mm)",
+                             fixed(c.interface_offset_max_mm(), 3)),
+                         row("Volume gap between labels (%)", fixed(100 * c.volume_gap(), 4)),
+                         row("Non-conforming faces", cat(check.nonconforming_faces())),
+                         row("Duplicate points", cat(check.duplicate_points())),
+                         row("Open boundary edges", cat(check.open_boundary_edges())),
+                         row("Cavities left empty", cat(c.outside_regions())), "</table>\n");
+  if (c.labels_size() > 0) {
+    html +=
+        "<h3>Labels in the mesh</h3>\n<table>\n<tr><th>Label</th><th>Voxels</th>"
+        "<th>Voxel volume (mm&sup3;)</th><th>Mesh volume (mm&sup3;)</th><th>Tetrahedra</th>"
+        "<th>Volume change (%)</th></tr>\n";
+    for (const auto& label : c.labels()) {
+      html += cat("<tr><td class=\"num\">", label.label(), "</td><td class=\"num\">",
+                  label.voxels(), "</td><td class=\"num\">", fixed(label.voxel_volume_mm3(), 1),
+                  "</td><td class=\"num\">", fixed(label.mesh_volume_mm3(), 1),
+                  "</td><td class=\"num\">", label.tetrahedra(), "</td><td class=\"num\">",
+                  fixed(100 * label.volume_change(), 2), "</td></tr>\n");
+    }
+    html += "</table>\n";
+  }
+  return html + svg_chart(category_chart(v.categories(), true));
+}
+
 std::string volume_section(const v1::VolumeMeshSummary& v) {
+  if (v.mesher() == "conforming") return conforming_volume_section(v);
   if (v.mesher() != "tetgen") return mixed_volume_section(v);
   return cat("<h2>Volume mesh (", html_escape(v.mesher()), ")</h2>\n<table>\n",
              row("Nodes", cat(v.nodes())), row("Tetrahedra", cat(v.tetrahedra())),
@@ -327,17 +398,24 @@ std::string html_escape(std::string_view text) {
   return out;
 }
 
-std::string report_html(const v1::Report& report) {
+std::string report_html(const v1::Report& report, const SurfacePictures& pictures) {
   const std::string version = html_escape(report.labelmesh_version());
   const std::string& convention = report.input().convention();
-  std::string out = cat("<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n",
-                        "<title>labelmesh report</title>\n<style>", kStyle,
-                        "</style>\n</head>\n<body>\n<h1>labelmesh report</h1>\n",
-                        "<p>Made by labelmesh ", version, ". Coordinates are ",
-                        html_escape(convention.empty() ? kPatientConvention : convention),
-                        " millimetres, in the input's physical space.</p>\n");
+  const std::string made =
+      report.created_at().empty() ? "" : cat(" on ", html_escape(report.created_at()));
+  const std::string title =
+      report.input().file_name().empty()
+          ? std::string("labelmesh report")
+          : cat("labelmesh report: ", html_escape(report.input().file_name()));
+  std::string out =
+      cat("<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n", "<title>",
+          title, "</title>\n<style>", kStyle, "</style>\n</head>\n<body>\n<h1>", title, "</h1>\n",
+          "<p>Made by labelmesh ", version, made, ". Coordinates are ",
+          html_escape(convention.empty() ? kPatientConvention : convention),
+          " millimetres, in the input's physical space.</p>\n");
   out += input_section(report);
   out += label_table(report);
+  out += pictures_section(report, pictures);
   if (const Chart angles = surface_angle_chart(report); !angles.bars.empty())
     out += cat("<h2>Surface quality</h2>\n", svg_chart(angles));
   if (report.has_volume()) out += volume_section(report.volume());

@@ -2,6 +2,7 @@
 #include "core/pipeline/write_results.h"
 
 #include <algorithm>
+#include <array>
 #include <filesystem>
 #include <fstream>
 
@@ -9,6 +10,7 @@
 #include "core/pipeline/output_names.h"
 #include "core/pipeline/report.h"
 #include "core/pipeline/report_html.h"
+#include "core/pipeline/surface_picture.h"
 #include "core/surface/write_surface.h"
 #include "core/util/exception_status.h"
 #include "core/util/stage_timer.h"
@@ -27,6 +29,30 @@ std::string label_name(int32_t label, const volume::LabelDescriptions& descripti
 }
 
 // The whole job's files: every output surface in one scene, the label volume.
+// The delivered surfaces in their label's colour, or, when the input gave
+// none, in one of a few colours told apart easily.
+std::vector<ColouredSurface> coloured_surfaces(const MeshResult& result) {
+  static constexpr std::array<std::array<uint8_t, 3>, 8> kPalette{{{228, 26, 28},
+                                                                   {55, 126, 184},
+                                                                   {77, 175, 74},
+                                                                   {152, 78, 163},
+                                                                   {255, 127, 0},
+                                                                   {166, 86, 40},
+                                                                   {247, 129, 191},
+                                                                   {153, 153, 153}}};
+  std::vector<ColouredSurface> surfaces;
+  for (const auto& surface : result.surfaces) {
+    if (!surface.is_output || surface.mesh.triangles.empty()) continue;
+    ColouredSurface coloured{surface.label, &surface.mesh, kPalette[surfaces.size() % 8]};
+    for (const auto& description : result.input.descriptions) {
+      if (description.label == surface.label && description.colour)
+        coloured.rgb = *description.colour;
+    }
+    surfaces.push_back(coloured);
+  }
+  return surfaces;
+}
+
 absl::Status write_scene(MeshResult& result, const MeshParams& params, const std::string& out_dir) {
   result.scene_files.clear();
   for (auto format : params.scene_formats) {
@@ -146,6 +172,11 @@ absl::Status write_all(MeshResult& result, const MeshParams& params, const std::
         result.volume->files.push_back("volume.ele");
     }
   }
+  SurfacePictures pictures;
+  {
+    StageTimer timer(result.stages, "report_pictures");
+    pictures = make_surface_pictures(coloured_surfaces(result));
+  }
   const v1::Report report = make_report(result, params);
   const auto report_path = (std::filesystem::path(out_dir) / "report.json").string();
   std::ofstream out(report_path);
@@ -153,7 +184,7 @@ absl::Status write_all(MeshResult& result, const MeshParams& params, const std::
   if (!out) return absl::InternalError(cat(report_path, ": could not write the report"));
   const auto html_path = (std::filesystem::path(out_dir) / "report.html").string();
   std::ofstream html(html_path);
-  html << report_html(report);
+  html << report_html(report, pictures);
   if (!html) return absl::InternalError(cat(html_path, ": could not write the report"));
   return absl::OkStatus();
 }

@@ -81,7 +81,7 @@ TEST(Cli, MeshWritesSurfacesAndReport) {
   std::vector<std::string> stages;
   for (const auto& stage : report.stages()) stages.push_back(stage.name());
   EXPECT_EQ(stages, (std::vector<std::string>{"read", "label_statistics", "marching_cubes",
-                                              "surface_statistics", "write"}));
+                                              "surface_statistics", "write", "report_pictures"}));
   // The raw JSON keeps the proto field names.
   EXPECT_NE(slurp(dir / "out" / "report.json").find("\"min_angle_deg\""), std::string::npos);
 }

@@ -14,9 +14,17 @@
 #include <string>
 #include <string_view>
 
+#include <vtkImageData.h>
+#include <vtkNew.h>
+#include <vtkPNGReader.h>
+
+#include <array>
+
 #include "absl/strings/ascii.h"
 #include "absl/strings/match.h"
+#include "core/digest/sha256.h"
 #include "core/pipeline/pipeline.h"
+#include "core/pipeline/surface_picture.h"
 #include "core/pipeline/write_results.h"
 #include "core/util/text.h"
 #include "core/volume/phantom.h"
@@ -109,6 +117,17 @@ v1::Report sample_report_with_volume() {
   return report;
 }
 
+// A cube of half-size `half` mm around `centre`, as 12 triangles.
+surface::TriangleMesh box_mesh(std::array<double, 3> centre, double half) {
+  surface::TriangleMesh mesh;
+  for (int i = 0; i < 8; ++i)
+    mesh.points.push_back({centre[0] + (i & 1 ? half : -half), centre[1] + (i & 2 ? half : -half),
+                           centre[2] + (i & 4 ? half : -half)});
+  mesh.triangles = {{0, 2, 1}, {1, 2, 3}, {4, 5, 6}, {5, 7, 6}, {0, 1, 4}, {1, 5, 4},
+                    {2, 6, 3}, {3, 6, 7}, {0, 4, 2}, {2, 4, 6}, {1, 3, 5}, {3, 7, 5}};
+  return mesh;
+}
+
 size_t count(const std::string& text, const std::string& part) {
   size_t n = 0;
   for (size_t at = text.find(part); at != std::string::npos; at = text.find(part, at + 1)) ++n;
@@ -182,18 +201,82 @@ TEST(ReportHtml, ShowsAMixedMeshAndItsLabelsLeftOut) {
   EXPECT_FALSE(absl::StrContains(html, "Steiner points"));
 }
 
+// A conforming mesh is one tetrahedral mesh: its page shows tetrahedron
+// quality, the interfaces and their check and each label's volume, never
+// the hexahedral figures.
+TEST(ReportHtml, ShowsAConformingMeshsInterfacesAndLabelVolumes) {
+  v1::Report report = sample_report();
+  auto* v = report.mutable_volume();
+  v->set_mesher("conforming");
+  v->set_nodes(52110);
+  v->set_tetrahedra(280431);
+  v->set_tetra_quality_min(0.1234);
+  v->set_min_dihedral_deg(15.25);
+  v->mutable_conformity_check()->set_nonconforming_faces(0);
+  v->mutable_conformity_check()->set_duplicate_points(0);
+  auto* c = v->mutable_conforming_figures();
+  c->set_interfaces(7);
+  c->set_interface_faces(18345);
+  c->set_outer_faces(9021);
+  c->set_interface_offset_max_mm(0.4321);
+  c->set_volume_gap(2.5e-7);
+  c->set_outside_regions(2);
+  auto* label = c->add_labels();
+  label->set_label(1);
+  label->set_voxels(12345);
+  label->set_voxel_volume_mm3(17360.16);
+  label->set_mesh_volume_mm3(17298.73);
+  label->set_tetrahedra(150321);
+  label->set_volume_change(-0.003539);
+  v->mutable_categories()->set_good(280000);
+  const std::string html = report_html(report);
+  for (const char* figure : {"Volume mesh (conforming: one mesh of every label)", ">52110<",
+                             ">280431<", ">0.123<", ">15.25<", "Interface faces", ">18345<",
+                             ">9021<", ">0.432<", ">0.0000<", ">2<", "Labels in the mesh",
+                             ">17298.7<", ">150321<", ">-0.35<", "Tetrahedra per quality category"})
+    EXPECT_TRUE(absl::StrContains(html, figure)) << figure;
+  for (const char* hexahedral : {"Jacobian ratio", "Hexahedra", "Cube edge"})
+    EXPECT_FALSE(absl::StrContains(html, hexahedral)) << hexahedral;
+}
+
+TEST(ReportHtml, NamesTheInputItsDigestAndWhenItWasMade) {
+  v1::Report report = sample_report();
+  report.mutable_input()->set_file_name(cat("scan ", kHostileName, ".nii.gz"));
+  report.mutable_input()->set_sha256(std::string(64, 'a'));
+  report.set_created_at("2026-01-31T12:00:00Z");
+  const std::string html = report_html(report);
+  EXPECT_TRUE(absl::StrContains(html, cat("<title>labelmesh report: scan ", kEscapedHostileName)));
+  EXPECT_TRUE(absl::StrContains(html, cat("<td>scan ", kEscapedHostileName, ".nii.gz</td>")));
+  EXPECT_TRUE(absl::StrContains(html, cat("<code>", std::string(64, 'a'), "</code>")));
+  EXPECT_TRUE(absl::StrContains(html, "Made by labelmesh 0.1.0 on 2026-01-31T12:00:00Z."));
+  EXPECT_FALSE(absl::StrContains(absl::AsciiStrToLower(html), "<script"));
+}
+
 TEST(ReportHtml, EscapesHostileNames) {
   const std::string html = report_html(sample_report());
   EXPECT_TRUE(absl::StrContains(html, kEscapedHostileName));
   EXPECT_FALSE(absl::StrContains(absl::AsciiStrToLower(html), "<script"));
 }
 
+// Two boxes, pictured as report.html shows them.
+SurfacePictures box_pictures() {
+  static const surface::TriangleMesh left = box_mesh({40, 0, 0}, 15);
+  static const surface::TriangleMesh right = box_mesh({-40, 0, 0}, 10);
+  return make_surface_pictures({{1, &left, {221, 130, 101}}, {2, &right, {55, 126, 184}}});
+}
+
 TEST(ReportHtml, NeedsNothingFromTheNetwork) {
-  std::string html = report_html(sample_report_with_volume());
+  const SurfacePictures pictures = box_pictures();
+  std::string html = report_html(sample_report_with_volume(), pictures);
   // The SVG namespace is a name, never fetched.
   const std::string svg_namespace = "http://www.w3.org/2000/svg";
   for (size_t at; (at = html.find(svg_namespace)) != std::string::npos;)
     html.erase(at, svg_namespace.size());
+  // Pictures are inline PNG: one overview and one per label.
+  const std::string inline_png = "<img src=\"data:image/png;base64,";
+  EXPECT_EQ(count(html, inline_png), 1 + pictures.label_png.size());
+  for (size_t at; (at = html.find(inline_png)) != std::string::npos;)
+    html.erase(at, html.find('"', at + inline_png.size()) + 1 - at);
   for (const char* remote :
        {"http://", "https://", "//", "<link", "<img", "src=", "url(", "@import"})
     EXPECT_FALSE(absl::StrContains(html, remote)) << remote;
@@ -230,11 +313,19 @@ TEST(ReportHtml, WrittenBesideReportJson) {
   ASSERT_TRUE(write_results(*result, params, (dir / "out").string(), {}).ok());
   ASSERT_TRUE(fs::exists(dir / "out" / "report.json"));
   const std::string html = testing::read_bytes(dir / "out" / "report.html");
+  size_t delivered = 0;
   for (const auto& surface : result->surfaces) {
     if (!surface.is_output) continue;
+    ++delivered;
     EXPECT_TRUE(absl::StrContains(html, cat(">", surface.statistics.triangles, "<")));
   }
   EXPECT_EQ(count(html, "<svg"), 1u);
+  // The input named with its digest, and every delivered surface pictured.
+  EXPECT_TRUE(absl::StrContains(html, "<td>sphere.nii.gz</td>"));
+  const auto digest = digest::sha256_file((dir / "sphere.nii.gz").string());
+  ASSERT_TRUE(digest.ok());
+  EXPECT_TRUE(absl::StrContains(html, cat("<code>", *digest, "</code>")));
+  EXPECT_EQ(count(html, "data:image/png;base64,"), 1 + delivered);
 }
 
 // Runs headless Chromium on `url` with `arguments`, in a fresh profile and
@@ -256,7 +347,7 @@ TEST(ReportHtml, RendersInHeadlessChromium) {
       << "chromium is not installed; scripts/install-deps.sh installs it";
   const fs::path dir = testing::scratch_dir("report_html_chromium");
   const fs::path page = dir / "report.html";
-  testing::write_file(page, report_html(sample_report_with_volume()));
+  testing::write_file(page, report_html(sample_report_with_volume(), box_pictures()));
   const std::string url = cat("file://", page.string());
 
   const fs::path dom_file = dir / "dom.html";
@@ -279,6 +370,24 @@ TEST(ReportHtml, RendersInHeadlessChromium) {
   EXPECT_TRUE(absl::StartsWith(testing::read_bytes(png), "\x89PNG"));
   // A blank page of this size is about 12 KB.
   EXPECT_GT(fs::file_size(png), 30'000u);
+  // The boxes' pictures were decoded and drawn: pixels of the liver's
+  // colour, lit, where the page has no other of it but a small swatch.
+  vtkNew<vtkPNGReader> reader;
+  reader->SetFileName(png.c_str());
+  reader->Update();
+  vtkImageData* image = reader->GetOutput();
+  int dims[3];
+  image->GetDimensions(dims);
+  size_t liver_pixels = 0;
+  for (int y = 0; y < dims[1]; ++y) {
+    for (int x = 0; x < dims[0]; ++x) {
+      const int r = int(image->GetScalarComponentAsDouble(x, y, 0, 0));
+      const int g = int(image->GetScalarComponentAsDouble(x, y, 0, 1));
+      const int b = int(image->GetScalarComponentAsDouble(x, y, 0, 2));
+      liver_pixels += r == 221 && g == 130 && b == 101;
+    }
+  }
+  EXPECT_GT(liver_pixels, 5'000u);
 }
 
 }  // namespace
