@@ -177,13 +177,14 @@ void add_pipeline_flags(CLI::App& command, PipelineFlags& flags) {
                    "triangles, -Y)");
   command
       .add_option("--formats", flags.formats,
-                  "Files to write: surfaces per label (stl, ply, obj, off, vtp); all surfaces in "
+                  "Files to write: surfaces per label (stl, ply, obj, off, vtp; dcm: DICOM "
+                  "Encapsulated STL in a DICOM SEG input's study); all surfaces in "
                   "one scene (vtm); the label volume beside the meshes (vti, mha); and, with "
                   "--volume, one volume mesh (vtu, msh, mesh, inp, node, xdmf); default stl,vtp; "
                   "with --volume and no volume format listed, vtu")
       ->delimiter(',')
-      ->check(CLI::IsMember({"stl", "ply", "obj", "off", "vtp", "vtm", "vti", "mha", "vtu", "msh",
-                             "mesh", "inp", "node", "xdmf"}));
+      ->check(CLI::IsMember({"stl", "ply", "obj", "off", "vtp", "dcm", "vtm", "vti", "mha", "vtu",
+                             "msh", "mesh", "inp", "node", "xdmf"}));
   command
       .add_option("--coordinates", flags.coordinates,
                   "Frame of the coordinates in the mesh files: lps (DICOM's patient frame) or "

@@ -22,6 +22,8 @@ packages=(
   python3-yaml  # reads deploy/'s Kubernetes and Compose files in their test
   # finite-element tools that must accept our volume meshes
   calculix-ccx gmsh
+  # DICOM tools and a PACS that must accept our DICOM surfaces
+  dcmtk orthanc
   # service tests: TLS certificates
   openssl
   # report.html rendered headless in its test

@@ -60,6 +60,8 @@ constexpr int kMaxLabelNames = 10000;
 constexpr size_t kMaxLabelNameBytes = 128;
 // Each format at most once, but a client may repeat itself a little.
 constexpr int kMaxFormatEntries = 32;
+// The format name of MeshParams::dicom_surfaces.
+constexpr std::string_view kDicomSurfaceFormat = "dcm";
 
 absl::Status check_millimetres(std::string_view field, double value) {
   if (std::isfinite(value) && value > 0 && value <= kMaxLengthMm) return absl::OkStatus();
@@ -369,6 +371,7 @@ v1::MeshOptions make_options(const MeshParams& params) {
 
   for (auto format : params.formats)
     options.add_formats(std::string(surface::surface_format_name(format)));
+  if (params.dicom_surfaces) options.add_formats(std::string(kDicomSurfaceFormat));
   if (params.volume != VolumeMethod::kNone) {
     options.set_volume(params.volume == VolumeMethod::kMixed        ? v1::VOLUME_METHOD_MIXED
                        : params.volume == VolumeMethod::kHex        ? v1::VOLUME_METHOD_HEX
@@ -444,6 +447,7 @@ absl::StatusOr<MeshParams> params_from_options(const v1::MeshOptions& options) {
     // One list for both kinds: each name is either a surface or a volume
     // format, kept once in the order first given.
     params.formats.clear();
+    params.dicom_surfaces = false;
     std::vector<volume_mesh::VolumeFormat> volume_formats;
     std::vector<SceneFormat> scene_formats;
     auto add_once = [](auto& list, auto format) {
@@ -456,11 +460,13 @@ absl::StatusOr<MeshParams> params_from_options(const v1::MeshOptions& options) {
         add_once(volume_formats, *volume_format);
       } else if (auto scene_format = scene_format_from_name(name)) {
         add_once(scene_formats, *scene_format);
+      } else if (name == kDicomSurfaceFormat) {
+        params.dicom_surfaces = true;
       } else {
-        return absl::InvalidArgumentError(
-            cat("formats: '", name,
-                "' is not one of stl, ply, obj, off, vtp (surfaces), vtm, vti, mha (scene), vtu, "
-                "msh, mesh, inp, node, xdmf (volumes)"));
+        return absl::InvalidArgumentError(cat(
+            "formats: '", name,
+            "' is not one of stl, ply, obj, off, vtp, dcm (surfaces), vtm, vti, mha (scene), vtu, "
+            "msh, mesh, inp, node, xdmf (volumes)"));
       }
     }
     if (!volume_formats.empty()) {

@@ -167,6 +167,10 @@ struct MeshParams {
   // Surface files to write per label.
   std::vector<surface::SurfaceFormat> formats{surface::SurfaceFormat::kStl,
                                               surface::SurfaceFormat::kVtp};
+  // Format "dcm": each surface also as a DICOM Encapsulated STL object in
+  // the input DICOM SEG's patient, study and frame of reference, in a new
+  // series. DICOM SEG inputs only.
+  bool dicom_surfaces = false;
   VolumeMethod volume = VolumeMethod::kNone;
   // kMixed: the hexahedra's edge, mm; 0 for three voxels (the cube root of
   // the voxel volume).

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "core/dicom/dicom_source.h"
 #include "core/pipeline/label_mixed_meshes.h"
 #include "core/pipeline/label_tet_meshes.h"
 #include "core/pipeline/surface_fidelity.h"
@@ -42,6 +43,9 @@ struct VolumeSummary {
   // The file read, without its folder, and the SHA-256 of its bytes.
   std::string file_name;
   std::string sha256;
+  // A DICOM SEG input's patient, study and frame of reference, when DICOM
+  // output was asked for.
+  std::optional<dicom::DicomSource> dicom;
 };
 
 // Which connected pieces of a label a surface covers.

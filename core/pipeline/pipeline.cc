@@ -12,6 +12,7 @@
 #include <mutex>
 #include <thread>
 
+#include "core/dicom/dicom_source.h"
 #include "core/digest/sha256.h"
 #include "core/pipeline/label_conforming_mesh.h"
 #include "core/pipeline/label_net_surfaces.h"
@@ -397,10 +398,24 @@ absl::StatusOr<MeshResult> run_stages(const std::string& path, const MeshParams&
     if (volume.ok()) digest = digest::sha256_file(path);
   }
   if (!volume.ok()) return volume.status();
+  std::optional<dicom::DicomSource> dicom;
+  if (params.dicom_surfaces) {
+    if (volume->format != volume::ImageFormat::kDicomSeg) {
+      return absl::InvalidArgumentError(
+          cat(path,
+              ": formats: dcm (DICOM Encapsulated STL) needs a DICOM SEG input to take "
+              "the patient, study and frame of reference from; this file is ",
+              volume::format_name(volume->format)));
+    }
+    auto source = dicom::read_dicom_source(path);
+    if (!source.ok()) return source.status();
+    dicom = std::move(*source);
+  }
   auto meshed = run_on_volume(path, std::move(volume), params, context, std::move(result));
   if (meshed.ok()) {
     meshed->input.file_name = std::filesystem::path(path).filename().string();
     if (digest.ok()) meshed->input.sha256 = *digest;
+    meshed->input.dicom = std::move(dicom);
   }
   return meshed;
 }

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "core/dicom/encapsulated_stl.h"
 #include "core/mixed_mesh/write_mixed_mesh.h"
 #include "core/pipeline/output_names.h"
 #include "core/pipeline/report.h"
@@ -51,6 +52,44 @@ std::vector<ColouredSurface> coloured_surfaces(const MeshResult& result) {
     surfaces.push_back(coloured);
   }
   return surfaces;
+}
+
+// Each delivered surface as DICOM Encapsulated STL, one new series for the
+// run, in the patient frame (LPS) whatever the other files' frame: DICOM's
+// frame of reference is the patient's.
+absl::Status write_dicom_surfaces(MeshResult& result, const MeshParams& params,
+                                  const std::string& out_dir) {
+  if (!params.dicom_surfaces) return absl::OkStatus();
+  if (!result.input.dicom)
+    return absl::InvalidArgumentError("formats: dcm needs a DICOM SEG input");
+  const dicom::DicomSeries series = dicom::new_surface_series();
+  int32_t instance = 0;
+  for (auto& surface : result.surfaces) {
+    if (!surface.is_output) continue;
+    const std::string name =
+        cat(surface_file_stem(surface.label, result.input.descriptions), ".dcm");
+    const auto path = std::filesystem::path(out_dir) / name;
+    const std::string title = label_name(surface.label, result.input.descriptions);
+    // VTK writes the STL; its bytes go into the DICOM object.
+    const auto stl_path = std::filesystem::path(out_dir) / cat(name, ".stl.part");
+    if (auto s =
+            surface::write_surface(surface.mesh, stl_path.string(), surface::SurfaceFormat::kStl,
+                                   {surface.label, title, CoordinateFrame::kLps});
+        !s.ok())
+      return s;
+    std::ifstream in(stl_path, std::ios::binary);
+    const std::string stl((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    in.close();
+    std::error_code ignored;
+    std::filesystem::remove(stl_path, ignored);
+    if (auto s = dicom::write_encapsulated_stl(
+            stl, path.string(), *result.input.dicom, series, ++instance,
+            title.empty() ? cat("label ", surface.label) : title);
+        !s.ok())
+      return s;
+    surface.files.push_back(name);
+  }
+  return absl::OkStatus();
 }
 
 absl::Status write_scene(MeshResult& result, const MeshParams& params, const std::string& out_dir) {
@@ -123,6 +162,7 @@ absl::Status write_all(MeshResult& result, const MeshParams& params, const std::
       }
       context.report("write", double(++done) / double(outputs));
     }
+    if (auto s = write_dicom_surfaces(result, params, out_dir); !s.ok()) return s;
   }
   if (!params.scene_formats.empty()) {
     StageTimer timer(result.stages, "write_scene");

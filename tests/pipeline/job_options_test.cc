@@ -180,6 +180,25 @@ TEST(JobOptions, RepeatedLabelsAndFormatsAreKeptOnceInOrder) {
   EXPECT_EQ(make_options(*params).formats_size(), 2);
 }
 
+TEST(JobOptions, DicomSurfacesAreAFormatBesideTheSurfaceFiles) {
+  v1::MeshOptions options;
+  for (const char* format : {"dcm", "stl", "dcm"}) options.add_formats(format);
+  auto params = params_from_options(options);
+  ASSERT_TRUE(params.ok()) << params.status();
+  EXPECT_TRUE(params->dicom_surfaces);
+  EXPECT_EQ(params->formats, std::vector<surface::SurfaceFormat>{surface::SurfaceFormat::kStl});
+  const auto again = params_from_options(make_options(*params));
+  ASSERT_TRUE(again.ok()) << again.status();
+  EXPECT_TRUE(again->dicom_surfaces);
+  EXPECT_EQ(make_options(*again).formats_size(), 2);
+  // Another list of formats, without dcm, asks for none.
+  options.clear_formats();
+  options.add_formats("vtp");
+  params = params_from_options(options);
+  ASSERT_TRUE(params.ok()) << params.status();
+  EXPECT_FALSE(params->dicom_surfaces);
+}
+
 TEST(JobOptions, SizingInMillimetresIsCheckedAgainstTheGrid) {
   volume::ImageGeometry geometry;
   geometry.spacing = {3, 3, 3};

@@ -183,6 +183,16 @@ TEST(Pipeline, BadRequestsGetTheirOwnCodesNamingTheCause) {
   EXPECT_EQ(result.status().code(), absl::StatusCode::kFailedPrecondition);
   EXPECT_TRUE(absl::StrContains(result.status().message(), "only background"));
 
+  // DICOM surfaces take their patient and study from a DICOM SEG input.
+  MeshParams dicom = repaired_params();
+  dicom.dicom_surfaces = true;
+  result = run_pipeline(sphere, dicom, {});
+  ASSERT_FALSE(result.ok());
+  EXPECT_EQ(result.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_TRUE(absl::StrContains(result.status().message(), "needs a DICOM SEG input"))
+      << result.status();
+  EXPECT_TRUE(absl::StrContains(result.status().message(), sphere)) << result.status();
+
   const std::atomic<bool> stop{true};
   RunContext stopped;
   stopped.stop = &stop;
