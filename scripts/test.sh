@@ -3,7 +3,10 @@
 # The test command: installs dependencies, builds (Release with assertions
 # on), and runs the whole suite with ctest. Idempotent.
 # Usage: scripts/test.sh            the suite
-#        scripts/test.sh --sanitize the suite under AddressSanitizer + UBSan
+#        scripts/test.sh --sanitize the tests labelled "sanitize" (input readers and
+#                                   header checks, job options, the service, the
+#                                   cluster, worker lifetimes, fuzz corpora,
+#                                   threaded helpers) under AddressSanitizer + UBSan
 set -euo pipefail
 cd "$(dirname "$0")/.."
 preset=dev

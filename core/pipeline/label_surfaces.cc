@@ -142,8 +142,8 @@ constexpr double kMaskSigmaVoxels = 0.4;
 // around a point are symmetric between inside and outside (a checkerboard of
 // voxels meeting along edges, say), the smoothed mask has a saddle at exactly
 // one half whatever the smoothing, and the mesher refines around that pinch
-// without end (the DICOM slab's label 33 at 0.5; at 0.495, 1.5 s and volume
-// -1.0 %). Just under one half such a saddle is inside, and the surface
+// without end (the DICOM slab's label 33 at 0.5; at 0.495 it meshes promptly,
+// volume -1.0 %). Just under one half such a saddle is inside, and the surface
 // passes it as a neck.
 constexpr double kMaskLevel = 0.495;
 
@@ -272,9 +272,9 @@ absl::Status add_label_surfaces(const volume::LabelVolume& volume,
   repaired.stage = "repaired";
   repaired.components = pieces->counts;
   repaired.repair.emplace();
-  // The Marching Cubes side of the distance check (liver: 0.8 s) is built on
-  // the second core while the surface mesher keeps one busy; without Poisson,
-  // beside the repair.
+  // The Marching Cubes side of the distance check, costly on large surfaces,
+  // is built on the second core while the surface mesher keeps one busy;
+  // without Poisson, beside the repair.
   const bool to_poisson = params.surface == SurfaceMethod::kPoisson;
   std::unique_ptr<surface::DistanceReference> marching_cubes_reference;
   double reference_seconds = 0;
@@ -331,7 +331,7 @@ absl::Status add_label_surfaces(const volume::LabelVolume& volume,
           !params.guard.fall_back || thickness_voxels >= params.poisson.min_thickness_voxels;
     }
     // The repaired surface's figures on the second core while this one
-    // smooths the pieces for Poisson (liver: 0.2 s beside 0.2 s).
+    // smooths the pieces for Poisson (the two take about as long as each other).
     if (prepared.ok() && try_poisson) side_by_side(measure_repaired, smooth);
     // Without Poisson, the Marching Cubes side of the distance check there.
     if (prepared.ok() && !try_poisson) side_by_side(measure_repaired, build_reference);

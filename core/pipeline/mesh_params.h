@@ -70,8 +70,8 @@ struct LabelSizing {
 
 struct PoissonOptions {
   double min_angle_deg = 30;
-  // 8 voxels and half a voxel give the liver about 26,000 triangles in about
-  // 3 s of meshing; halving both doubles fidelity to curvature, triples time.
+  // 8 voxels and half a voxel give the liver about 26,000 triangles; halving
+  // both doubles fidelity to curvature and triples the meshing time.
   double max_edge_voxels = 8;
   double max_distance_voxels = 0.5;
   // The same in mm; when set (> 0) they replace the voxel figures.
@@ -104,20 +104,20 @@ struct PoissonOptions {
   surface::NormalWeighting normals = surface::NormalWeighting::kUniform;
   // Grid: one point per voxel cube. Marching Cubes gives a little more than
   // that, and coarser cells let the surface drift (2 voxels doubles the
-  // sphere's radial error). Hierarchy clusters of 3 are 3.4 s faster on the
-  // liver at the same Hausdorff distance, but leave the sphere's vertices
+  // sphere's radial error). Hierarchy clusters of 3 are about a fifth faster on
+  // the liver at the same Hausdorff distance, but leave the sphere's vertices
   // 0.119 voxel RMS off, above the 0.1 target (docs/pipeline.md, "Point reduction").
   surface::PointReduction point_reduction = surface::PointReduction::kGrid;
   double point_cell_voxels = 1;
   // Point budget of the grid reduction per component: a larger surface gets a
-  // coarser cell. The solve costs about 40 us a point on one core, so this
-  // bounds a component's solve near 10 s whatever the organ's size. The liver (242 k points at 1
+  // coarser cell. The solve's time grows with its points, so this bounds a
+  // component's solve whatever the organ's size. The liver (242 k points at 1
   // voxel) stays under it; smaller budgets trade Hausdorff distance for time (docs/pipeline.md,
   // "Point reduction"). 0: no budget.
   uint64_t max_points = 250'000;
   // Components with more points than this are solved as two overlapping
-  // halves on two threads: the liver's solve takes 6 s instead of 11 (test
-  // build) for the same volume and mean distance (docs/pipeline.md, "Two halves").
+  // halves on two threads: the liver's solve takes about half as long as one
+  // solve, for the same volume and mean distance (docs/pipeline.md, "Two halves").
   // Below it one solve is quick anyway. 0: always one solve.
   uint64_t split_points = 150'000;
   uint32_t point_cluster_size = 3;

@@ -258,9 +258,9 @@ absl::StatusOr<TriangleMesh> mesh_level_set(const ScalarGrid& grid, const LevelS
   try {
     // Crossings to a twentieth of the distance bound (CGAL takes it relative
     // to the radius). TotalSegmentator's labels took at most 340
-    // evaluations per seed (and 340,000 more); an evaluation costs the mesher
-    // about 0.4 us, so the budget stops one that does not settle within a
-    // millisecond per seed, about five times what it needs.
+    // evaluations per seed (and 340,000 more), so the budget of 2,000 per seed
+    // (and 2,000,000 more) stops one that does not settle within about six
+    // times what the worst of them needed.
     const uint64_t budget = 2'000 * (on_level.size() + 1000);
     const LevelFunction function(&field, params.level, &context, budget);
     CGAL::Implicit_surface_3<MesherTraits, LevelFunction> implicit(

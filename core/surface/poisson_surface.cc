@@ -62,7 +62,7 @@ struct CancellableInsertion {
 
 // CGAL's constructor from oriented points, as solve() below calls it, but
 // without the points' average spacing, which CGAL computes (a search for each
-// point's 6 nearest neighbours: about 0.2 s a half on the liver) only for an
+// point's 6 nearest neighbours, costly on large surfaces) only for an
 // extra refinement pass that compute_implicit_function makes when given an
 // approximation ratio, and solve() gives none.
 template <>
@@ -238,8 +238,7 @@ absl::StatusOr<TriangleMesh> mesh_zero_level(const SolvedFunction& function, con
                   bisection_error * bisection_error};
   // The liver asks about one crossing search per input point, small thin
   // shapes up to 25 (against a floor of 10,000); ten per point and 10,000
-  // more leave a sound function room and stop a runaway one within a second
-  // or two.
+  // more leave a sound function room and stop a runaway one early.
   uint64_t crossings = 0;
   level.crossings = &crossings;
   level.max_crossings = 10 * (points.size() + 1000);

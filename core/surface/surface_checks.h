@@ -29,12 +29,12 @@ struct SurfaceDistance {
 };
 
 // One surface's side of surface_distance: its samples and a search tree over
-// its triangles. Building it for a large Marching Cubes surface takes a
-// third of a second, so the pipeline builds it beside other work.
+// its triangles. Building it for a large Marching Cubes surface is costly
+// enough that the pipeline builds it beside other work.
 class DistanceReference {
  public:
-  // Built in steps (the liver's: 0.2 to 0.4 s each): a stop request between
-  // them leaves it empty, measuring nothing.
+  // Built in steps of similar cost: a stop request between them leaves it
+  // empty, measuring nothing.
   DistanceReference(const TriangleMesh& mesh, double sample_spacing_mm,
                     const RunContext& context = {});
   ~DistanceReference();

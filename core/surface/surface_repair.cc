@@ -39,7 +39,7 @@ struct SharpCounts {
 // shows to be neither a needle nor a cap. CGAL's exact predicates fall back
 // to exact numbers whenever a comparison is close, and on Marching Cubes
 // surfaces (right angles, equal edges) nearly every face is: this keeps them
-// for the faces near a threshold (liver: 0.35 s of the repair).
+// for the faces near a threshold, sparing a good share of the repair's time.
 bool clearly_not_sharp(const Mesh& mesh, Mesh::Face_index f, double needle_ratio,
                        double cap_cosine) {
   constexpr double kMargin = 1e-9;
@@ -136,7 +136,7 @@ absl::StatusOr<TriangleMesh> repair(const TriangleMesh& input, const RepairParam
     if (!patch.empty()) ++counts.holes_filled;
   }
   // Nothing collapsed or filled leaves the triangles as counted (on Marching
-  // Cubes surfaces the usual case; a count is a third of a second on the liver).
+  // Cubes surfaces the usual case; a count is costly on large surfaces).
   const bool changed = sharp_before.needles + sharp_before.caps > 0 || !holes.empty();
   const SharpCounts sharp_after = changed ? count_sharp_triangles(mesh, params) : sharp_before;
   counts.needles_after = sharp_after.needles;

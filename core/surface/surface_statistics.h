@@ -39,7 +39,7 @@ SurfaceStatistics compute_surface_statistics(const TriangleMesh& mesh);
 // points, no directed edge is used twice (so every edge has at most two
 // triangles, wound oppositely), and the triangles around each point form a
 // single fan. CGAL's is_polygon_soup_a_polygon_mesh checks the same, but with
-// ordered sets: 1.3 s on the liver's 651 k triangles where this takes 0.2 s.
+// ordered sets: about six times slower on the liver's 651 k triangles.
 bool is_oriented_manifold(const TriangleMesh& mesh);
 
 // Signed volume enclosed by the surface (divergence theorem), mm^3.

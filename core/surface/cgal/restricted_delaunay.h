@@ -91,7 +91,7 @@ inline absl::StatusOr<TriangleMesh> complex_to_mesh(const Complex& complex,
   for (const auto& f : facets) triangles.push_back({index[f[0]], index[f[1]], index[f[2]]});
   // CGAL duplicates a point only where the soup is not a manifold: with
   // none duplicated it is a polygon mesh, and the second look at every
-  // polygon (0.1 s on the liver) is only needed when some were.
+  // polygon (noticeable on large surfaces) is only needed when some were.
   const bool manifold = PMP::orient_polygon_soup(points, triangles);
   if (!manifold && !PMP::is_polygon_soup_a_polygon_mesh(triangles))
     return absl::InternalError("the meshed surface is not a manifold");

@@ -31,15 +31,14 @@ using PoissonFunction = CGAL::Poisson_reconstruction_function<StopAwareKernel>;
 // Evaluates the solved implicit function for the surface mesher. Each value
 // means locating the point in the solve's triangulation, and CGAL walks there
 // from its previous answer; the mesher's queries jump across the surface, so
-// on the liver 3.3 M such walks took 3.7 of the 5 s of meshing. Here a long
-// jump starts from the cell first found in the query's cube of a grid of
-// about two million cubes (or, the first time there, of a grid four times
-// coarser), a short one from the last answer, and the oracle's second
-// question about a segment's ends (it asks for their sign, then for their
-// value and cell) is answered from the last four answers. Every answer
-// depends only on the order of the queries, so
-// meshing stays deterministic. Polls for a stop every few thousand
-// evaluations.
+// on the liver 3.3 M such walks took about three quarters of the meshing
+// time. Here a long jump starts from the cell first found in the query's
+// cube of a grid of about two million cubes (or, the first time there, of a
+// grid four times coarser), a short one from the last answer, and the
+// oracle's second question about a segment's ends (it asks for their sign,
+// then for their value and cell) is answered from the last four answers.
+// Every answer depends only on the order of the queries, so meshing stays
+// deterministic. Polls for a stop every few thousand evaluations.
 class HintedEvaluator {
  public:
   using FT = Kernel::FT;

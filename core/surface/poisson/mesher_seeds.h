@@ -21,9 +21,9 @@ namespace labelmesh::surface::poisson {
 // point inside and refines from there, one point at a time: each insertion
 // asks the oracle about every new Voronoi edge, and on the liver most of
 // those questions come while the mesh is still coarse. Started instead from
-// points about a final edge apart, it asks far fewer (liver: meshing 4.1-4.7 s
-// down to about 2.8 s on a slow day). The points are the solve's oriented
-// points thinned greedily, in their own order, so that no two kept ones are
+// points about a final edge apart, it asks far fewer (on the liver, about a
+// third less meshing time). The points are the solve's oriented points
+// thinned greedily, in their own order, so that no two kept ones are
 // nearer than `spacing`; each is then moved along its normal, up to `reach`
 // either way, to where the function crosses zero (a point with no crossing
 // there is left out). In Hilbert order, so that inserting them walks little.

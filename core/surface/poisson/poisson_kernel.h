@@ -37,8 +37,8 @@ class SolveScope {
 };
 
 // Throws Cancelled on one call in 4,096 if this thread's run was asked to
-// stop: the polls cost nothing measurable, and 4,096 calls take well under a
-// millisecond.
+// stop: the polls cost nothing measurable, and 4,096 calls pass quickly
+// enough that a stop still takes effect at once.
 inline void poll_for_stop() {
   static thread_local uint32_t calls = 0;
   if ((++calls & 4095) == 0 && solving_run != nullptr && solving_run->stop_requested())
@@ -48,8 +48,8 @@ inline void poll_for_stop() {
 // Epick, whose squared-distance functor also polls for a stop. CGAL's
 // Delaunay refinement inside the Poisson solve has no callback, but it tests
 // every new cell's edge lengths with this functor, so a stop ends the
-// refinement at once instead of after it (up to a second on the liver). The
-// points and every other type and functor are Epick's own.
+// refinement at once instead of after it (a noticeable delay on large
+// surfaces). The points and every other type and functor are Epick's own.
 struct StopAwareKernel : CGAL::Epick {
   struct Compute_squared_distance_3 : CGAL::Epick::Compute_squared_distance_3 {
     template <typename... Args>

@@ -117,14 +117,14 @@ static_assert(CGAL::internal::Has_timestamp<CGAL::Poisson_reconstruction_functio
 // each edge is weighed once, which also makes the matrix exactly symmetric.
 // Where CGAL's weights are well defined its entries and this one's differ by
 // rounding only (on the liver, 2e-14 of the largest); see the face area
-// below for where they are not. Liver, per half: 1.85 s of assembly down to
-// 1.45 s.
+// below for where they are not. On the liver this takes about a fifth off
+// the assembly.
 //
 // The unknowns are numbered along a Hilbert curve, and the cells (with their
 // circumcentres) in the order the walk first meets them, where CGAL numbers
 // both in memory order, which scatters neighbours after the solve's batches
-// of insertion and refinement. Liver, per half: assembly 1.8 s down to
-// 1.15 s, conjugate gradient 1.0 s down to 0.8-0.95 s, on a slow day.
+// of insertion and refinement. On the liver this takes about a third off the
+// assembly and up to a fifth off the conjugate gradient.
 //
 // CGAL also fills a cache of barycentric coordinates here, 80 bytes a cell
 // (100 MiB a half on the liver), for its own operator() and special_func.
