@@ -6,10 +6,10 @@
 
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
+#include "core/digest/sha256.h"
 #include "core/pipeline/job_options.h"
 #include "server/durable_file.h"
 #include "server/error_details.h"
-#include "core/digest/sha256.h"
 #include "server/spool.h"
 #include "server/upload_checks.h"
 #include "server/watch_reactor.h"
@@ -331,6 +331,13 @@ grpc::Status MeshingService::submit(grpc::ServerContext& context,
 
   const std::string job_id = store_.new_job_id_for(identity.name, spec.request_id());
   const std::string extension = *upload_extension(spec.file_name());
+  // DICOM surfaces take their patient and study from a DICOM SEG: refused
+  // before the upload rather than by the worker.
+  if (params.dicom_surfaces && extension != ".dcm") {
+    reason = "bad_request";
+    return invalid(
+        absl::StrCat("spec.options.formats: dcm needs a DICOM SEG upload (.dcm), not ", extension));
+  }
   UploadFile upload(store_.upload_path(job_id, extension));
   if (auto status = receive_upload(reader, spec, upload.path(), *ticket, reason); !status.ok())
     return status;

@@ -416,6 +416,13 @@ TEST_F(MeshingServiceTest, UploadsThatCouldOnlyFailLaterAreRefusedAtSubmit) {
   EXPECT_TRUE(absl::StrContains(status.error_message(), "upload: compressed voxel data"))
       << status.error_message();
 
+  v1::MeshOptions dicom = repaired_options();
+  dicom.add_formats("dcm");
+  status = roomy.submit(sphere, dicom, &reply);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_TRUE(absl::StrContains(status.error_message(), "dcm needs a DICOM SEG upload"))
+      << status.error_message();
+
   v1::MeshOptions fine = repaired_options();
   fine.set_max_edge_mm(0.01);
   status = roomy.submit(sphere, fine, &reply);
