@@ -306,6 +306,12 @@ void JobTable::give_back(const std::string& job_id) {
   std::lock_guard lock(mutex_);
   Entry* entry = find(job_id);
   if (entry == nullptr || entry->record.job().state() != v1::JOB_STATE_RUNNING) return;
+  // A cancel (or delete) that came while it was taken ends it now.
+  if (entry->cancel_requested) {
+    (void)end_cancelled(*entry, Unsaved::kApply);
+    remove_if_requested(job_id);
+    return;
+  }
   if (running_ > 0) --running_;
   if (entry->remove_when_ended) {
     update_gauges();

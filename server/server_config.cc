@@ -71,7 +71,9 @@ absl::Status validate_config(const ServerConfig& c) {
     return bad("transfer-deadline", "must be positive");
   if (c.transfer_rate_window < absl::Seconds(1))
     return bad("transfer-rate-window", "must be at least 1s");
-  if (c.abandoned_upload_age < std::max(absl::Seconds(20), 2 * c.stream_idle_timeout))
+  // Only cluster frontends sweep the shared upload folder.
+  if (c.role == "frontend" &&
+      c.abandoned_upload_age < std::max(absl::Seconds(20), 2 * c.stream_idle_timeout))
     return bad("abandoned-upload-age", "must be at least 20s and twice --stream-idle-timeout");
   if (c.max_message_bytes < (2 << 20)) {
     return bad("max-message-bytes", "must be at least 2 MiB (chunks are 1 MiB)");

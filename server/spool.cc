@@ -11,8 +11,8 @@
 
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
-#include "server/durable_file.h"
 #include "core/digest/sha256.h"
+#include "server/durable_file.h"
 #include "spdlog/spdlog.h"
 
 namespace labelmesh::server {

@@ -6,9 +6,9 @@
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_replace.h"
+#include "core/digest/sha256.h"
 #include "core/pipeline/job_options.h"
 #include "core/volume/volume_header.h"
-#include "core/digest/sha256.h"
 
 namespace labelmesh::server {
 

@@ -41,7 +41,8 @@ void WorkerPool::wait_for_room() {
   bool said = false;
   while (table_.dispatching()) {
     auto room = output_room(spool_.free_bytes(), config_);
-    if (room.ok()) {
+    // Other errors (the spool unreadable) fail the job that meets them.
+    if (room.ok() || room.status().code() != absl::StatusCode::kResourceExhausted) {
       if (said) spdlog::info("spool disk has room again; taking jobs");
       return;
     }
@@ -59,9 +60,13 @@ void WorkerPool::run_job(const v1::JobRecord& record) {
     return;
   }
   auto room = output_room(spool_.free_bytes(), config_);
-  if (!room.ok()) {
+  if (!room.ok() && room.status().code() == absl::StatusCode::kResourceExhausted) {
     // The disk filled after wait_for_room: the job waits, it has not failed.
     table_.give_back(id);
+    return;
+  }
+  if (!room.ok()) {
+    table_.fail(id, static_cast<int>(room.status().code()), std::string(room.status().message()));
     return;
   }
   WorkerRun run;

@@ -7,6 +7,7 @@
 #include <dcmtk/dcmdata/dcitem.h>
 #include <dcmtk/dcmdata/dcuid.h>
 
+#include <algorithm>
 #include <vector>
 
 #include "absl/strings/str_cat.h"
@@ -47,6 +48,14 @@ absl::Status write_encapsulated_stl(const std::string& stl, const std::string& p
   Writer writer{dataset};
   for (const auto& [tag, value] : source.attributes)
     writer.put(DcmTagKey(Uint16(tag >> 16), Uint16(tag & 0xFFFF)), value);
+  // Label names are UTF-8: with one outside ASCII the object's text becomes
+  // UTF-8 (ISO_IR 192), the copied values converted; where DCMTK cannot
+  // convert them the title falls back to ASCII.
+  std::string document_title = title;
+  const bool ascii = std::all_of(title.begin(), title.end(),
+                                 [](char c) { return static_cast<unsigned char>(c) < 0x80; });
+  if (!ascii && writer.status.good() && dataset.convertToUTF8().bad())
+    document_title = absl::StrCat("label ", instance_number);
   writer.put(DCM_SOPClassUID, UID_EncapsulatedSTLStorage)
       .put(DCM_SOPInstanceUID, new_uid())
       .put(DCM_Modality, "M3D")
@@ -60,12 +69,14 @@ absl::Status write_encapsulated_stl(const std::string& stl, const std::string& p
       .put(DCM_InstanceNumber, std::to_string(instance_number))
       .put(DCM_ContentDate, series.date)
       .put(DCM_ContentTime, series.time)
+      .put(DCM_TimezoneOffsetFromUTC, "+0000")
       .put(DCM_AcquisitionDateTime, "")
       .put(DCM_BurnedInAnnotation, "NO")
-      .put(DCM_DocumentTitle, title)
+      .put(DCM_DocumentTitle, document_title)
       .put(DCM_MIMETypeOfEncapsulatedDocument, "model/stl");
   if (!dataset.tagExists(DCM_PositionReferenceIndicator))
     writer.put(DCM_PositionReferenceIndicator, "");
+  if (writer.status.good()) writer.status = dataset.insertEmptyElement(DCM_ConceptNameCodeSequence);
   DcmItem* units = nullptr;
   if (writer.status.good())
     writer.status = dataset.findOrCreateSequenceItem(DCM_MeasurementUnitsCodeSequence, units, 0);

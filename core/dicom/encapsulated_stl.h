@@ -24,9 +24,9 @@ DicomSeries new_surface_series();
 
 // Writes `stl` (binary STL bytes, coordinates in the patient frame, mm) to
 // `path` as Encapsulated STL: the source's patient, study and frame of
-// reference, the series, modality M3D, units mm (UCUM), `title` as the
-// document title, and a reference to the source instance. Errors name the
-// file.
+// reference, the series, modality M3D, units mm (UCUM), `title` (UTF-8) as
+// the document title, and a reference to the source instance. Dates and
+// times are UTC and say so. Errors name the file.
 absl::Status write_encapsulated_stl(const std::string& stl, const std::string& path,
                                     const DicomSource& source, const DicomSeries& series,
                                     int32_t instance_number, const std::string& title);

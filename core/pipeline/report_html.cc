@@ -181,9 +181,10 @@ std::string pictures_section(const v1::Report& report, const SurfacePictures& pi
   std::string html =
       cat("<h2>Surfaces</h2>\n<figure>\n",
           png_image(pictures.overview_png,
-                    "every delivered surface from the front, the left and above"),
+                    "every delivered surface from the front, the left and the feet"),
           "\n<figcaption>From the front (the patient's left on the right), from the patient's left "
-          "(anterior on the left) and from above (anterior up).</figcaption>\n</figure>\n"
+          "(anterior on the left) and from the feet (anterior up, the patient's left on the right, "
+          "as axial images are shown).</figcaption>\n</figure>\n"
           "<div class=\"labels\">\n");
   for (const auto& [label, png] : pictures.label_png) {
     const std::string name = label_name(report, label);

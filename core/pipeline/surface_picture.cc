@@ -30,8 +30,8 @@ Camera camera_of(PictureView view) {
       return {{1, 0, 0}, {0, 0, 1}, {0, -1, 0}};
     case PictureView::kLeft:
       return {{0, 1, 0}, {0, 0, 1}, {1, 0, 0}};
-    case PictureView::kSuperior:
-      return {{1, 0, 0}, {0, -1, 0}, {0, 0, 1}};
+    case PictureView::kInferior:
+      return {{1, 0, 0}, {0, -1, 0}, {0, 0, -1}};
   }
   return {};
 }
@@ -219,7 +219,7 @@ SurfacePictures make_surface_pictures(const std::vector<ColouredSurface>& surfac
         views[1] = draw_surfaces(surfaces, PictureView::kLeft, kOverviewSize);
       },
       [&] {
-        views[2] = draw_surfaces(surfaces, PictureView::kSuperior, kOverviewSize);
+        views[2] = draw_surfaces(surfaces, PictureView::kInferior, kOverviewSize);
         for (const auto& surface : surfaces)
           pictures.label_png[surface.label] =
               png_bytes(draw_surfaces({surface}, PictureView::kAnterior, kLabelSize));

@@ -16,9 +16,9 @@ namespace labelmesh {
 
 // Directions a picture is seen from, in the patient's frame (LPS): from the
 // front (superior up, the patient's left on the right), from the patient's
-// left (superior up, anterior on the left), and from above (anterior up,
-// the patient's left on the right).
-enum class PictureView { kAnterior, kLeft, kSuperior };
+// left (superior up, anterior on the left), and from the feet (anterior up,
+// the patient's left on the right, as axial images are shown).
+enum class PictureView { kAnterior, kLeft, kInferior };
 
 struct ColouredSurface {
   int32_t label = 0;
@@ -45,7 +45,7 @@ Picture in_a_row(const std::vector<Picture>& pictures);
 // PNG file bytes of the picture (VTK's PNG writer).
 std::string png_bytes(const Picture& picture);
 
-// What report.html shows: every surface from the front, the left and above,
+// What report.html shows: every surface from the front, the left and the feet,
 // and each label alone from the front, as PNG bytes.
 struct SurfacePictures {
   std::string overview_png;

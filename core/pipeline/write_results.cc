@@ -79,9 +79,11 @@ absl::Status write_dicom_surfaces(MeshResult& result, const MeshParams& params,
       return s;
     std::ifstream in(stl_path, std::ios::binary);
     const std::string stl((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const bool read = !in.bad() && stl.size() >= 84;  // header and triangle count
     in.close();
     std::error_code ignored;
     std::filesystem::remove(stl_path, ignored);
+    if (!read) return absl::InternalError(cat(stl_path.string(), ": cannot read the STL back"));
     if (auto s = dicom::write_encapsulated_stl(
             stl, path.string(), *result.input.dicom, series, ++instance,
             title.empty() ? cat("label ", surface.label) : title);

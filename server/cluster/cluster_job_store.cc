@@ -5,8 +5,8 @@
 #include <filesystem>
 
 #include "absl/strings/str_cat.h"
-#include "server/durable_file.h"
 #include "core/digest/sha256.h"
+#include "server/durable_file.h"
 #include "server/spool.h"
 #include "spdlog/spdlog.h"
 
@@ -347,8 +347,11 @@ size_t ClusterJobStore::remove_abandoned_uploads(absl::Duration age) const {
   const auto cutoff = fs::file_time_type::clock::now() - absl::ToChronoSeconds(age);
   size_t removed = 0;
   std::error_code error;
-  for (const auto& entry : fs::directory_iterator(files_.root() + "/uploads", error)) {
+  // Without exceptions: a shared folder can fail a read (ESTALE on NFS).
+  for (fs::directory_iterator it(files_.root() + "/uploads", error), end; !error && it != end;
+       it.increment(error)) {
     std::error_code ignored;
+    const auto& entry = *it;
     if (entry.is_regular_file(ignored) && entry.last_write_time(ignored) < cutoff &&
         fs::remove(entry.path(), ignored))
       ++removed;

@@ -108,7 +108,8 @@ bool ClusterWorkerRole::wait_for_room() {
   bool said = false;
   while (!stopping_.load()) {
     auto room = output_room(files_.free_bytes(), config_);
-    if (room.ok()) {
+    // Other errors (the folder unreadable) fail the job that meets them.
+    if (room.ok() || room.status().code() != absl::StatusCode::kResourceExhausted) {
       if (said) spdlog::info("shared disk has room again; taking jobs");
       return true;
     }
@@ -130,7 +131,15 @@ cluster::JobOutcome ClusterWorkerRole::run_job(cluster::ClusterConnection& conne
   const std::string out = files_.attempt_dir(id, claim.attempt);
   if (auto status = fresh_directory(out); !status.ok()) return failed(status);
   auto room = output_room(files_.free_bytes(), config_);
-  if (!room.ok()) {
+  if (!room.ok() && room.status().code() == absl::StatusCode::kResourceExhausted) {
+    // A cancel or delete that came meanwhile ends the job instead.
+    if (auto now = connection.jobs->get(id);
+        now.ok() && (now->cancel_requested() || now->deleted())) {
+      cluster::JobOutcome result =
+          failed(static_cast<int>(absl::StatusCode::kCancelled), "cancelled by a client");
+      result.state = v1::JOB_STATE_CANCELLED;
+      return result;
+    }
     // The disk filled after wait_for_room: the job waits, it has not failed.
     spdlog::warn("job {}: {}; it goes back to the queue", id, std::string(room.status().message()));
     std::error_code ignored;
@@ -139,6 +148,7 @@ cluster::JobOutcome ClusterWorkerRole::run_job(cluster::ClusterConnection& conne
     given_back.state = v1::JOB_STATE_QUEUED;
     return given_back;
   }
+  if (!room.ok()) return failed(room.status());
   const std::string job_dir = files_.job_dir(id);
   WorkerRun run;
   run.executable = executable_;

@@ -66,11 +66,11 @@ TEST(SurfacePicture, EachViewShowsThePatientsSidesWhereDoctorsLookForThem) {
   const Picture side = draw_surfaces(surfaces, PictureView::kLeft, 200);
   EXPECT_GT(count_colour(side, kRed, true).first, 500u);
   EXPECT_EQ(count_colour(side, kRed, true).second, 0u);
-  // From above, anterior is up.
-  const Picture above = draw_surfaces(surfaces, PictureView::kSuperior, 200);
-  EXPECT_GT(count_colour(above, kRed, false).first, 500u);
-  EXPECT_EQ(count_colour(above, kRed, false).second, 0u);
-  EXPECT_GT(count_colour(above, kBlue, false).second, 500u);
+  // From the feet, anterior is up.
+  const Picture feet = draw_surfaces(surfaces, PictureView::kInferior, 200);
+  EXPECT_GT(count_colour(feet, kRed, false).first, 500u);
+  EXPECT_EQ(count_colour(feet, kRed, false).second, 0u);
+  EXPECT_GT(count_colour(feet, kBlue, false).second, 500u);
 }
 
 TEST(SurfacePicture, TheNearerSurfaceHidesTheFartherOne) {
@@ -79,11 +79,22 @@ TEST(SurfacePicture, TheNearerSurfaceHidesTheFartherOne) {
   const Picture front = draw_surfaces({{1, &large_back, kBlue}, {2, &small_front, kRed}},
                                       PictureView::kAnterior, 200);
   EXPECT_EQ(pixel(front, 100, 100), kRed);
-  // From behind it would be hidden; from above both show, the large one more.
-  const Picture above = draw_surfaces({{1, &large_back, kBlue}, {2, &small_front, kRed}},
-                                      PictureView::kSuperior, 200);
-  const auto red = count_colour(above, kRed, false), blue = count_colour(above, kBlue, false);
+  // From the feet both show, the large one more.
+  const Picture feet = draw_surfaces({{1, &large_back, kBlue}, {2, &small_front, kRed}},
+                                     PictureView::kInferior, 200);
+  const auto red = count_colour(feet, kRed, false), blue = count_colour(feet, kBlue, false);
   EXPECT_GT(blue.first + blue.second, 8 * (red.first + red.second));
+}
+
+TEST(SurfacePicture, FromTheFeetTheInferiorSurfaceIsInFront) {
+  // A small red box below (inferior, smaller z) a large blue one: seen from
+  // the feet the red one hides the middle of the blue one.
+  const auto lower = box({0, 0, -40}, {5, 5, 5});
+  const auto upper = box({0, 0, 40}, {20, 20, 20});
+  const Picture feet =
+      draw_surfaces({{1, &upper, kBlue}, {2, &lower, kRed}}, PictureView::kInferior, 200);
+  EXPECT_EQ(pixel(feet, 100, 100), kRed);
+  EXPECT_EQ(pixel(feet, 30, 100), kBlue);
 }
 
 TEST(SurfacePicture, ABoxCoversTheAreaItsShapeAndTheMarginGive) {

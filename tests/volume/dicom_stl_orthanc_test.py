@@ -60,14 +60,15 @@ class Orthanc:
         self.process = subprocess.Popen(["Orthanc", str(root / "orthanc.json")],
                                         stdout=self.log, stderr=subprocess.STDOUT)
         deadline = time.monotonic() + 60
-        while time.monotonic() < deadline:
-            check(self.process.poll() is None, f"Orthanc exited: {self.process.returncode}")
+        while time.monotonic() < deadline and self.process.poll() is None:
             try:
                 self.get("/system")
                 return
             except OSError:
                 time.sleep(0.2)
-        raise AssertionError("Orthanc did not answer within 60 s")
+        code = self.process.poll()
+        self.stop()
+        raise AssertionError(f"Orthanc did not answer within 60 s (exit status {code})")
 
     def request(self, path, data=None):
         request = urllib.request.Request(f"http://127.0.0.1:{self.http}{path}", data=data)
