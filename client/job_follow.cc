@@ -8,10 +8,10 @@
 #include "absl/strings/str_cat.h"
 #include "client/exit_codes.h"
 #include "client/terminal_progress.h"
+#include "core/digest/sha256.h"
 #include "core/pipeline/report.h"
 #include "google/protobuf/util/json_util.h"
 #include "labelmesh/v1/service.grpc.pb.h"
-#include "core/digest/sha256.h"
 
 namespace labelmesh::client {
 namespace {

@@ -19,11 +19,11 @@
 #include "client/pipeline_options.h"
 #include "client/report_table.h"
 #include "client/server_connection.h"
+#include "core/digest/sha256.h"
 #include "core/pipeline/job_options.h"
 #include "core/pipeline/report.h"
 #include "core/volume/volume_header.h"
 #include "labelmesh/v1/service.grpc.pb.h"
-#include "core/digest/sha256.h"
 
 namespace labelmesh::client {
 namespace {

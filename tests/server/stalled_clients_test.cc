@@ -8,8 +8,8 @@
 #include <thread>
 
 #include "absl/strings/match.h"
-#include "server/metrics.h"
 #include "core/digest/sha256.h"
+#include "server/metrics.h"
 #include "support/service_harness.h"
 
 namespace labelmesh {

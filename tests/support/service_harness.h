@@ -14,11 +14,11 @@
 
 #include <gtest/gtest.h>
 
+#include "core/digest/sha256.h"
 #include "core/volume/phantom.h"
 #include "core/volume/write_label_volume.h"
 #include "labelmesh/v1/service.grpc.pb.h"
 #include "server/labelmesh_server.h"
-#include "core/digest/sha256.h"
 #include "support/test_files.h"
 
 namespace labelmesh::testing {
