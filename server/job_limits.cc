@@ -5,6 +5,7 @@
 #include <thread>
 
 #include "absl/strings/str_cat.h"
+#include "spdlog/spdlog.h"
 
 namespace labelmesh::server {
 
@@ -21,6 +22,22 @@ absl::StatusOr<uint64_t> output_room(const absl::StatusOr<uint64_t>& free_bytes,
   }
   return config.max_job_output_bytes > 0 ? std::min(config.max_job_output_bytes, over_reserve)
                                          : over_reserve;
+}
+
+bool wait_for_output_room(const std::function<absl::StatusOr<uint64_t>()>& free_bytes,
+                          const ServerConfig& config, const std::function<bool()>& keep_waiting) {
+  bool said = false;
+  while (keep_waiting()) {
+    auto room = output_room(free_bytes(), config);
+    if (room.ok() || !is_disk_full(room.status())) {
+      if (said) spdlog::info("the disk has room again; taking jobs");
+      return true;
+    }
+    if (!said) spdlog::warn("{}; queued jobs wait for room", std::string(room.status().message()));
+    said = true;
+    std::this_thread::sleep_for(kRoomPollInterval);
+  }
+  return false;
 }
 
 absl::StatusOr<std::vector<v1::Artifact>> within_output_limit(std::vector<v1::Artifact> artifacts,

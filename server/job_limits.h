@@ -6,6 +6,7 @@
 
 #include <chrono>
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include "absl/status/statusor.h"
@@ -25,6 +26,19 @@ inline constexpr std::chrono::seconds kRoomPollInterval{1};
 // less. RESOURCE_EXHAUSTED when under kLeastOutputRoom is left.
 absl::StatusOr<uint64_t> output_room(const absl::StatusOr<uint64_t>& free_bytes,
                                      const ServerConfig& config);
+
+// Whether output_room's error is a disk with no room over the reserve (the
+// job can wait), not another error (which fails it).
+inline bool is_disk_full(const absl::Status& status) {
+  return status.code() == absl::StatusCode::kResourceExhausted;
+}
+
+// Returns true once `free_bytes` leaves room for a job's results (or fails
+// otherwise: the job then meets that error), looking again every
+// kRoomPollInterval and logging once while the disk is full; false when
+// `keep_waiting` says stop first.
+bool wait_for_output_room(const std::function<absl::StatusOr<uint64_t>()>& free_bytes,
+                          const ServerConfig& config, const std::function<bool()>& keep_waiting);
 
 // The results, or RESOURCE_EXHAUSTED if together they are over the output
 // limit.

@@ -23,7 +23,9 @@ void WorkerPool::start() {
 
 void WorkerPool::run_thread() {
   for (;;) {
-    wait_for_room();
+    // A job taken on a full disk would fail, where it can wait in the queue.
+    wait_for_output_room([this] { return spool_.free_bytes(); }, config_,
+                         [this] { return table_.dispatching(); });
     auto record = table_.take_next();
     if (!record) break;
     {
@@ -37,21 +39,6 @@ void WorkerPool::run_thread() {
   }
 }
 
-void WorkerPool::wait_for_room() {
-  bool said = false;
-  while (table_.dispatching()) {
-    auto room = output_room(spool_.free_bytes(), config_);
-    // Other errors (the spool unreadable) fail the job that meets them.
-    if (room.ok() || room.status().code() != absl::StatusCode::kResourceExhausted) {
-      if (said) spdlog::info("spool disk has room again; taking jobs");
-      return;
-    }
-    if (!said) spdlog::warn("{}; queued jobs wait", std::string(room.status().message()));
-    said = true;
-    std::this_thread::sleep_for(kRoomPollInterval);
-  }
-}
-
 void WorkerPool::run_job(const v1::JobRecord& record) {
   const std::string id = record.job().job_id();
   const uint32_t attempt = record.job().attempts();
@@ -60,8 +47,8 @@ void WorkerPool::run_job(const v1::JobRecord& record) {
     return;
   }
   auto room = output_room(spool_.free_bytes(), config_);
-  if (!room.ok() && room.status().code() == absl::StatusCode::kResourceExhausted) {
-    // The disk filled after wait_for_room: the job waits, it has not failed.
+  if (!room.ok() && is_disk_full(room.status())) {
+    // The disk filled after wait_for_output_room: the job waits, it has not failed.
     table_.give_back(id);
     return;
   }

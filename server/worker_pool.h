@@ -31,9 +31,6 @@ class WorkerPool {
 
  private:
   void run_thread();
-  // Returns once the spool has room for a job's results, or dispatch stopped:
-  // a job taken on a full disk would fail, where it can wait.
-  void wait_for_room();
   void run_job(const v1::JobRecord& record);
 
   JobTable& table_;

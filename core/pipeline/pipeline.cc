@@ -28,6 +28,7 @@
 #include "core/volume/read_label_volume.h"
 #include "core/volume/repeated_planes.h"
 #include "core/volume/touching_labels.h"
+#include "core/volume/volume_header.h"
 
 namespace labelmesh {
 namespace {
@@ -388,6 +389,19 @@ absl::StatusOr<MeshResult> run_on_volume(const std::string& path,
 
 absl::StatusOr<MeshResult> run_stages(const std::string& path, const MeshParams& params,
                                       const RunContext& context) {
+  // DICOM surfaces need a DICOM SEG's patient and study: refused before
+  // the volume is read.
+  std::optional<dicom::DicomSource> dicom;
+  if (params.dicom_surfaces) {
+    const auto format = volume::format_of_file(path);
+    if (format && *format != volume::ImageFormat::kDicomSeg) {
+      return absl::InvalidArgumentError(
+          cat(path,
+              ": formats: dcm (DICOM Encapsulated STL) needs a DICOM SEG input to take "
+              "the patient, study and frame of reference from; this file is ",
+              volume::format_name(*format)));
+    }
+  }
   MeshResult result;
   absl::StatusOr<volume::LabelVolume> volume;
   absl::StatusOr<std::string> digest;
@@ -398,15 +412,7 @@ absl::StatusOr<MeshResult> run_stages(const std::string& path, const MeshParams&
     if (volume.ok()) digest = digest::sha256_file(path);
   }
   if (!volume.ok()) return volume.status();
-  std::optional<dicom::DicomSource> dicom;
   if (params.dicom_surfaces) {
-    if (volume->format != volume::ImageFormat::kDicomSeg) {
-      return absl::InvalidArgumentError(
-          cat(path,
-              ": formats: dcm (DICOM Encapsulated STL) needs a DICOM SEG input to take "
-              "the patient, study and frame of reference from; this file is ",
-              volume::format_name(volume->format)));
-    }
     auto source = dicom::read_dicom_source(path);
     if (!source.ok()) return source.status();
     dicom = std::move(*source);

@@ -11,13 +11,13 @@
 #include <limits>
 
 #include "core/util/side_by_side.h"
+#include "core/util/vec3.h"
 
 namespace labelmesh {
 namespace {
 
-using Vec = std::array<double, 3>;
-
-double dot(const Vec& a, const Vec& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+using geometry::dot;
+using Vec = geometry::Vec3;
 
 // Screen right, screen up and the direction towards the viewer, in LPS.
 struct Camera {
@@ -109,12 +109,9 @@ void fill_triangle(Canvas& canvas, const std::array<Vec, 3>& v, const std::array
 // either side of a triangle lit alike.
 std::array<uint8_t, 3> shade(const std::array<uint8_t, 3>& rgb, const std::array<Vec, 3>& corners,
                              const Vec& toward_viewer) {
-  const Vec a{corners[1][0] - corners[0][0], corners[1][1] - corners[0][1],
-              corners[1][2] - corners[0][2]};
-  const Vec b{corners[2][0] - corners[0][0], corners[2][1] - corners[0][1],
-              corners[2][2] - corners[0][2]};
-  const Vec n{a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
-  const double length = std::sqrt(dot(n, n));
+  const Vec n =
+      geometry::cross(geometry::sub(corners[1], corners[0]), geometry::sub(corners[2], corners[0]));
+  const double length = geometry::norm(n);
   const double facing = length > 0 ? std::abs(dot(n, toward_viewer)) / length : 0;
   const double light = 0.3 + 0.7 * facing;
   return {uint8_t(rgb[0] * light), uint8_t(rgb[1] * light), uint8_t(rgb[2] * light)};

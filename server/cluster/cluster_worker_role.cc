@@ -87,7 +87,9 @@ void ClusterWorkerRole::run_slot(cluster::ClusterConnection& connection) {
       });
   bool failing = false;
   while (!stopping_.load()) {
-    if (!wait_for_room()) break;
+    if (!wait_for_output_room([this] { return files_.free_bytes(); }, config_,
+                              [this] { return !stopping_.load(); }))
+      break;
     auto handled = worker.run_one();
     if (handled.ok() == failing) {
       // NATS away (or back): the slot says so once, and health follows.
@@ -104,24 +106,6 @@ void ClusterWorkerRole::run_slot(cluster::ClusterConnection& connection) {
   if (failing) --failing_slots_;
 }
 
-bool ClusterWorkerRole::wait_for_room() {
-  bool said = false;
-  while (!stopping_.load()) {
-    auto room = output_room(files_.free_bytes(), config_);
-    // Other errors (the folder unreadable) fail the job that meets them.
-    if (room.ok() || room.status().code() != absl::StatusCode::kResourceExhausted) {
-      if (said) spdlog::info("shared disk has room again; taking jobs");
-      return true;
-    }
-    if (!said)
-      spdlog::warn("{}; this worker takes no job until there is room",
-                   std::string(room.status().message()));
-    said = true;
-    std::this_thread::sleep_for(kRoomPollInterval);
-  }
-  return false;
-}
-
 cluster::JobOutcome ClusterWorkerRole::run_job(cluster::ClusterConnection& connection,
                                                const v1::JobRecord& record,
                                                const cluster::Claim& claim,
@@ -131,7 +115,7 @@ cluster::JobOutcome ClusterWorkerRole::run_job(cluster::ClusterConnection& conne
   const std::string out = files_.attempt_dir(id, claim.attempt);
   if (auto status = fresh_directory(out); !status.ok()) return failed(status);
   auto room = output_room(files_.free_bytes(), config_);
-  if (!room.ok() && room.status().code() == absl::StatusCode::kResourceExhausted) {
+  if (!room.ok() && is_disk_full(room.status())) {
     // A cancel or delete that came meanwhile ends the job instead.
     if (auto now = connection.jobs->get(id);
         now.ok() && (now->cancel_requested() || now->deleted())) {
@@ -140,7 +124,7 @@ cluster::JobOutcome ClusterWorkerRole::run_job(cluster::ClusterConnection& conne
       result.state = v1::JOB_STATE_CANCELLED;
       return result;
     }
-    // The disk filled after wait_for_room: the job waits, it has not failed.
+    // The disk filled after wait_for_output_room: the job waits, it has not failed.
     spdlog::warn("job {}: {}; it goes back to the queue", id, std::string(room.status().message()));
     std::error_code ignored;
     fs::remove_all(out, ignored);

@@ -40,10 +40,6 @@ class ClusterWorkerRole {
   ClusterWorkerRole(const ServerConfig& config, const cluster::SharedArtifacts& files,
                     Metrics& metrics);
   void run_slot(cluster::ClusterConnection& connection);
-  // Returns once the shared disk has room for a job's results (true), or the
-  // role stops (false): a job taken on a full disk would fail, where it can
-  // wait in the queue.
-  bool wait_for_room();
   cluster::JobOutcome run_job(cluster::ClusterConnection& connection, const v1::JobRecord& record,
                               const cluster::Claim& claim, const std::atomic<bool>& cancelled);
   // Once the job's end is recorded: the other attempts' files go, and the

@@ -93,6 +93,31 @@ class ClusterRolesTest : public ::testing::Test {
     ASSERT_TRUE(connection_->jobs->finish(claim, state, result).ok());
   }
 
+  // A sphere phantom accepted as a frontend would, for a real worker to run.
+  std::string accept_sphere() {
+    const fs::path volume = testing::write_phantom(dir_, volume::PhantomShape::kSphere);
+    const std::string id = store_->new_job_id_for("ann", "");
+    const std::string upload = store_->upload_path(id, ".nii.gz");
+    fs::copy_file(volume, upload);
+    v1::JobRecord record;
+    record.mutable_job()->set_job_id(id);
+    record.mutable_job()->set_owner("ann");
+    record.mutable_job()->set_created_at(server::unix_now());
+    record.set_input_extension(".nii.gz");
+    EXPECT_TRUE(store_->accept(record, upload).ok());
+    return id;
+  }
+
+  // The job once it has ended, or as it is after two minutes.
+  v1::Job wait_until_ended(const std::string& id) {
+    v1::Job job = store_->get(id).value();
+    for (int i = 0; i < 1200 && !server::has_ended(job.state()); ++i) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(100));
+      job = store_->get(id).value();
+    }
+    return job;
+  }
+
   fs::path job_dir(const std::string& id) { return dir_ / "artifacts" / "jobs" / id; }
 
   fs::path dir_;
@@ -390,26 +415,10 @@ TEST_F(ClusterRolesTest, ASubmitWhileNatsIsDownIsUnavailableAtOnce) {
 }
 
 TEST_F(ClusterRolesTest, AWorkerRunsAJobFromTheSharedDirectoryAndServesOnlyHealth) {
-  // A sphere phantom accepted as a frontend would, run by a real worker.
-  const fs::path volume = testing::write_phantom(dir_, volume::PhantomShape::kSphere);
-  const std::string id = store_->new_job_id_for("ann", "");
-  const std::string upload = store_->upload_path(id, ".nii.gz");
-  fs::copy_file(volume, upload);
-  v1::JobRecord record;
-  record.mutable_job()->set_job_id(id);
-  record.mutable_job()->set_owner("ann");
-  record.mutable_job()->set_created_at(server::unix_now());
-  record.set_input_extension(".nii.gz");
-  ASSERT_TRUE(store_->accept(record, upload).ok());
-
+  const std::string id = accept_sphere();
   auto worker = server::LabelmeshServer::start(role_config(dir_, "worker", nats_->url()));
   ASSERT_TRUE(worker.ok()) << worker.status();
-  v1::Job job;
-  for (int i = 0; i < 1200; ++i) {
-    job = store_->get(id).value();
-    if (server::has_ended(job.state())) break;
-    std::this_thread::sleep_for(std::chrono::milliseconds(100));
-  }
+  const v1::Job job = wait_until_ended(id);
   ASSERT_EQ(job.state(), v1::JOB_STATE_SUCCEEDED) << job.error().message();
   EXPECT_EQ(job.attempts(), 1u);
   const auto artifacts = store_->artifacts(id).value();
@@ -440,16 +449,7 @@ TEST_F(ClusterRolesTest, AWorkerRunsAJobFromTheSharedDirectoryAndServesOnlyHealt
 }
 
 TEST_F(ClusterRolesTest, AWorkerWithNoRoomForResultsLeavesJobsQueued) {
-  const fs::path volume = testing::write_phantom(dir_, volume::PhantomShape::kSphere);
-  const std::string id = store_->new_job_id_for("ann", "");
-  const std::string upload = store_->upload_path(id, ".nii.gz");
-  fs::copy_file(volume, upload);
-  v1::JobRecord record;
-  record.mutable_job()->set_job_id(id);
-  record.mutable_job()->set_owner("ann");
-  record.mutable_job()->set_created_at(server::unix_now());
-  record.set_input_extension(".nii.gz");
-  ASSERT_TRUE(store_->accept(record, upload).ok());
+  const std::string id = accept_sphere();
 
   auto full_config = role_config(dir_, "worker", nats_->url());
   full_config.spool_reserve_bytes = uint64_t{1} << 60;  // More than any disk has free.
@@ -463,10 +463,7 @@ TEST_F(ClusterRolesTest, AWorkerWithNoRoomForResultsLeavesJobsQueued) {
 
   auto worker = server::LabelmeshServer::start(role_config(dir_, "worker", nats_->url()));
   ASSERT_TRUE(worker.ok()) << worker.status();
-  for (int i = 0; i < 1200 && !server::has_ended(job.state()); ++i) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(100));
-    job = store_->get(id).value();
-  }
+  job = wait_until_ended(id);
   EXPECT_EQ(job.state(), v1::JOB_STATE_SUCCEEDED) << job.error().message();
   EXPECT_EQ(job.attempts(), 1u);
   (*worker)->shutdown();
