@@ -7,5 +7,6 @@ cd "$(dirname "$0")/.."
 # Timed as shipped: -O3 with assertions off, as the release build the demo and
 # the Dockerfile use (the test build keeps CGAL's assertions on).
 bash scripts/build.sh bench
+bash scripts/build.sh bench labelmesh_bench
 build/bench/tests/labelmesh_bench "$@"
 LABELMESH_BIN=build/bench bash scripts/bench-service.sh

@@ -12,22 +12,17 @@
 #include "core/volume/label_statistics.h"
 #include "core/volume/phantom.h"
 #include "core/volume/phantom_grid.h"
+#include "support/label_volumes.h"
 
 namespace labelmesh::conforming {
 namespace {
 
-constexpr std::array<double, 9> kIdentity{1, 0, 0, 0, 1, 0, 0, 0, 1};
-
-std::map<int32_t, double> label_volumes(const volume::LabelVolume& volume) {
-  std::map<int32_t, double> volumes;
-  for (const auto& label : volume::compute_label_statistics(volume).labels)
-    volumes[label.label] = static_cast<double>(label.voxels) * volume.geometry.voxel_volume();
-  return volumes;
-}
+using testing::label_volumes;
 
 // A box of 6 x 4 x 3 voxels (label 2) inside a 10 x 10 x 10 grid.
 volume::LabelVolume box() {
-  const auto grid = volume::centred_grid({10, 10, 10}, {1, 1, 1}, kIdentity, {0, 0, 0});
+  const auto grid =
+      volume::centred_grid({10, 10, 10}, {1, 1, 1}, testing::kIdentityDirection, {0, 0, 0});
   return volume::rasterise(grid, [&](const std::array<double, 3>& p) {
     const auto i = grid.to_index(p);
     const bool inside = std::lround(i[0]) >= 2 && std::lround(i[0]) < 8 && std::lround(i[1]) >= 3 &&

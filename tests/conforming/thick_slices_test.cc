@@ -12,11 +12,12 @@
 #include "core/volume/label_statistics.h"
 #include "core/volume/phantom_grid.h"
 #include "core/volume/voxel_access.h"
+#include "support/label_volumes.h"
 
 namespace labelmesh::conforming {
 namespace {
 
-constexpr std::array<double, 9> kIdentity{1, 0, 0, 0, 1, 0, 0, 0, 1};
+using testing::label_volumes;
 const std::array<double, 3> kCentre{10, -20, 30};
 constexpr double kInner = 8, kOuter = 16;  // mm
 
@@ -33,7 +34,8 @@ volume::LabelVolume thick_nested_balls(int thick_axis = 2) {
   spacing[thick_axis] = 3;
   std::array<int64_t, 3> dims{};
   for (int a = 0; a < 3; ++a) dims[a] = static_cast<int64_t>(std::ceil(36 / spacing[a])) + 1;
-  return volume::rasterise(volume::centred_grid(dims, spacing, kIdentity, kCentre), nested_label);
+  return volume::rasterise(
+      volume::centred_grid(dims, spacing, testing::kIdentityDirection, kCentre), nested_label);
 }
 
 std::vector<int32_t> labels_of(const volume::LabelVolume& volume) {
@@ -47,13 +49,6 @@ volume::LabelVolume interpolated(const volume::LabelVolume& thick, const ThickSl
   auto fine = interpolate_thick_slices(thick, {}, cut, RunContext{});
   EXPECT_TRUE(fine.ok()) << fine.status();
   return fine.ok() ? std::move(*fine) : volume::LabelVolume{};
-}
-
-std::map<int32_t, double> label_volumes(const volume::LabelVolume& volume) {
-  std::map<int32_t, double> volumes;
-  for (const auto& label : volume::compute_label_statistics(volume).labels)
-    volumes[label.label] = static_cast<double>(label.voxels) * volume.geometry.voxel_volume();
-  return volumes;
 }
 
 TEST(ThickSlices, FindsTheThickAxisAndHowFineToCutIt) {
@@ -90,7 +85,8 @@ TEST(ThickSlices, RefuseACutThatIsNotOne) {
 // it between slices; the bias brings its volume back.
 TEST(ThickSlices, ALabelOnOneSliceKeepsItsVolume) {
   const std::array<double, 3> spacing{0.6, 0.6, 2.4};
-  const auto grid = volume::centred_grid({40, 40, 5}, spacing, kIdentity, kCentre);
+  const auto grid =
+      volume::centred_grid({40, 40, 5}, spacing, testing::kIdentityDirection, kCentre);
   const auto thick = volume::rasterise(grid, [&](const std::array<double, 3>& p) {
     const auto index = grid.to_index(p);
     const bool on_slice = std::lround(index[2]) == 2;

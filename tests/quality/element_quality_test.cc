@@ -7,6 +7,7 @@
 #include <vector>
 
 #include <gtest/gtest.h>
+#include "support/perturbed_cell.h"
 
 namespace labelmesh::quality {
 namespace {
@@ -39,15 +40,6 @@ Pyramid ideal_pyramid() {
 template <typename Cell>
 Cell mirrored_z(Cell cell) {
   for (Point& point : cell) point[2] = -point[2];
-  return cell;
-}
-
-template <typename Cell>
-Cell perturbed(Cell cell, std::mt19937& rng, double amplitude) {
-  std::uniform_real_distribution<double> noise(-amplitude, amplitude);
-  for (Point& point : cell) {
-    for (double& x : point) x += noise(rng);
-  }
   return cell;
 }
 
@@ -321,20 +313,20 @@ TEST(InvarianceTest, SimilarityTransformsLeaveQualityUnchanged) {
   for (int trial = 0; trial < 100; ++trial) {
     const RandomSimilarity move(rng);
 
-    const Tet tet = perturbed(regular_tet(), rng, 0.25);
+    const Tet tet = testing::perturbed(regular_tet(), rng, 0.25);
     expect_relatively_near(tetra_quality(tet), tetra_quality(move(tet)), kTolerance);
     const auto [lo, hi] = tetra_dihedral_range_deg(tet);
     const auto [moved_lo, moved_hi] = tetra_dihedral_range_deg(move(tet));
     expect_relatively_near(lo, moved_lo, kTolerance);
     expect_relatively_near(hi, moved_hi, kTolerance);
 
-    const Hex hex = perturbed(unit_cube(), rng, 0.3);
+    const Hex hex = testing::perturbed(unit_cube(), rng, 0.3);
     expect_relatively_near(hexahedron_jacobian_ratio(hex), hexahedron_jacobian_ratio(move(hex)),
                            kTolerance);
-    const Wedge wedge = perturbed(right_prism_equilateral(), rng, 0.3);
+    const Wedge wedge = testing::perturbed(right_prism_equilateral(), rng, 0.3);
     expect_relatively_near(wedge_jacobian_ratio(wedge), wedge_jacobian_ratio(move(wedge)),
                            kTolerance);
-    const Pyramid pyramid = perturbed(ideal_pyramid(), rng, 0.3);
+    const Pyramid pyramid = testing::perturbed(ideal_pyramid(), rng, 0.3);
     expect_relatively_near(pyramid_jacobian_ratio(pyramid), pyramid_jacobian_ratio(move(pyramid)),
                            kTolerance);
     expect_relatively_near(pyramid_signed_aspect_ratio(pyramid),
@@ -346,10 +338,10 @@ TEST(InvarianceTest, SimilarityTransformsLeaveQualityUnchanged) {
 TEST(InvarianceTest, MildlyPerturbedCellsStayPositive) {
   std::mt19937 rng(7);
   for (int trial = 0; trial < 200; ++trial) {
-    EXPECT_GT(tetra_quality(perturbed(regular_tet(), rng, 0.1)), 0.0);
-    EXPECT_GT(hexahedron_jacobian_ratio(perturbed(unit_cube(), rng, 0.1)), 0.0);
-    EXPECT_GT(wedge_jacobian_ratio(perturbed(right_prism_equilateral(), rng, 0.1)), 0.0);
-    const Pyramid pyramid = perturbed(ideal_pyramid(), rng, 0.1);
+    EXPECT_GT(tetra_quality(testing::perturbed(regular_tet(), rng, 0.1)), 0.0);
+    EXPECT_GT(hexahedron_jacobian_ratio(testing::perturbed(unit_cube(), rng, 0.1)), 0.0);
+    EXPECT_GT(wedge_jacobian_ratio(testing::perturbed(right_prism_equilateral(), rng, 0.1)), 0.0);
+    const Pyramid pyramid = testing::perturbed(ideal_pyramid(), rng, 0.1);
     EXPECT_GT(pyramid_jacobian_ratio(pyramid), 0.0);
     EXPECT_GT(pyramid_signed_aspect_ratio(pyramid), 0.0);
   }

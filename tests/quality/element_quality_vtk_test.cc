@@ -25,6 +25,7 @@
 #include <vtkPyramid.h>
 #include <vtkTetra.h>
 #include <vtkWedge.h>
+#include "support/perturbed_cell.h"
 
 namespace labelmesh::quality {
 namespace {
@@ -34,15 +35,6 @@ constexpr int kTrials = 200;
 
 void expect_relatively_near(double expected, double actual) {
   EXPECT_NEAR(expected, actual, kRelativeTolerance * std::abs(expected));
-}
-
-template <typename Cell>
-Cell perturbed(Cell cell, std::mt19937& rng, double amplitude) {
-  std::uniform_real_distribution<double> noise(-amplitude, amplitude);
-  for (Point& point : cell) {
-    for (double& x : point) x += noise(rng);
-  }
-  return cell;
 }
 
 // Copies our points into a VTK cell of the same node ordering.
@@ -58,8 +50,8 @@ void set_points(VtkCell* vtk_cell, const Cell& cell) {
 // anywhere in a 100 mm box.
 Tet random_tet(std::mt19937& rng) {
   const double h = std::sqrt(3.0);
-  Tet tet = perturbed(Tet{{{0, 0, 0}, {2, 0, 0}, {1, h, 0}, {1, h / 3, 2 * std::sqrt(2.0 / 3.0)}}},
-                      rng, 0.3);
+  Tet tet = testing::perturbed(
+      Tet{{{0, 0, 0}, {2, 0, 0}, {1, h, 0}, {1, h / 3, 2 * std::sqrt(2.0 / 3.0)}}}, rng, 0.3);
   std::uniform_real_distribution<double> offset(-50.0, 50.0);
   const Point shift = {offset(rng), offset(rng), offset(rng)};
   for (Point& point : tet) point = geometry::add(point, shift);
@@ -199,7 +191,7 @@ TEST(ElementQualityVtkTest, HexCornerJacobiansAreVtksIsoparametricOnes) {
   const Hex cube = {
       {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}}};
   for (int trial = 0; trial < kTrials; ++trial) {
-    const Hex hex = perturbed(cube, rng, 0.15);
+    const Hex hex = testing::perturbed(cube, rng, 0.15);
     const auto ours = hexahedron_corner_jacobians(hex);
     const auto vtk = vtk_node_jacobians<vtkHexahedron>(hex);
     for (int i = 0; i < 8; ++i) expect_relatively_near(vtk[i], ours[i]);
@@ -216,7 +208,7 @@ TEST(ElementQualityVtkTest, WedgeCornerJacobiansAreVtksNegated) {
   const Wedge prism = {{{0, 0, 0}, {0.5, h, 0}, {1, 0, 0}, {0, 0, 1}, {0.5, h, 1}, {1, 0, 1}}};
   EXPECT_GT(volume_inside_vtk_faces<vtkWedge>(prism), 0.0);
   for (int trial = 0; trial < kTrials; ++trial) {
-    const Wedge wedge = perturbed(prism, rng, 0.1);
+    const Wedge wedge = testing::perturbed(prism, rng, 0.1);
     const auto ours = wedge_corner_jacobians(wedge);
     const auto vtk = vtk_node_jacobians<vtkWedge>(wedge);
     for (int i = 0; i < 6; ++i) expect_relatively_near(-vtk[i], ours[i]);
@@ -229,7 +221,7 @@ TEST(ElementQualityVtkTest, PyramidBaseJacobiansAreVtksIsoparametricOnes) {
   std::mt19937 rng(3);
   const Pyramid ideal = {{{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {0.5, 0.5, std::sqrt(0.5)}}};
   for (int trial = 0; trial < kTrials; ++trial) {
-    const Pyramid pyramid = perturbed(ideal, rng, 0.1);
+    const Pyramid pyramid = testing::perturbed(ideal, rng, 0.1);
     const auto ours = pyramid_corner_jacobians(pyramid);
     const auto vtk = vtk_node_jacobians<vtkPyramid>(pyramid);
     for (int i = 0; i < 4; ++i) expect_relatively_near(vtk[i], ours[i]);

@@ -16,6 +16,7 @@
 #include "grpc/health/v1/health.grpc.pb.h"
 #include "server/metrics.h"
 #include "support/service_harness.h"
+#include "support/test_files.h"
 
 namespace labelmesh {
 namespace {
@@ -31,13 +32,6 @@ bool serving(ServiceHarness& service) {
   grpc::health::v1::HealthCheckResponse reply;
   const grpc::Status status = stub->Check(&context, grpc::health::v1::HealthCheckRequest(), &reply);
   return status.ok() && reply.status() == grpc::health::v1::HealthCheckResponse::SERVING;
-}
-
-size_t entries_in(const fs::path& dir) {
-  size_t count = 0;
-  std::error_code error;
-  for ([[maybe_unused]] const auto& entry : fs::directory_iterator(dir, error)) ++count;
-  return count;
 }
 
 bool has_metric(ServiceHarness& service, const std::string& line) {
@@ -93,8 +87,8 @@ TEST_F(FullDiskTest, UnderTheReserveUploadsAreRefusedAndHealthIsNotServing) {
   EXPECT_EQ(refused.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
   EXPECT_TRUE(absl::StartsWith(refused.error_message(), "spool disk full"))
       << refused.error_message();
-  EXPECT_EQ(entries_in(spool_ / "jobs"), 0u);
-  EXPECT_EQ(entries_in(spool_ / "uploads"), 0u);
+  EXPECT_EQ(testing::entries_in(spool_ / "jobs"), 0u);
+  EXPECT_EQ(testing::entries_in(spool_ / "uploads"), 0u);
   EXPECT_TRUE(has_metric(service, "labelmesh_rejections_total{reason=\"disk_full\"} 1"));
   EXPECT_TRUE(has_metric(service, "labelmesh_spool_disk_pressure 1"));
 }
@@ -153,7 +147,7 @@ TEST_F(FullDiskTest, NoAcceptedJobIsLostWhenTheDiskFills) {
     ASSERT_TRUE(status.ok()) << id << " lost: " << status.error_message();
     EXPECT_EQ(job.state(), v1::JOB_STATE_QUEUED);
   }
-  EXPECT_EQ(entries_in(spool_ / "quarantine"), 0u);
+  EXPECT_EQ(testing::entries_in(spool_ / "quarantine"), 0u);
   again.shutdown();
 }
 

@@ -31,12 +31,6 @@ v1::JobRecord record_with(const std::string& job_id, v1::JobState state, size_t 
   return record;
 }
 
-size_t entries_in(const fs::path& dir) {
-  size_t count = 0;
-  for ([[maybe_unused]] const auto& entry : fs::directory_iterator(dir)) ++count;
-  return count;
-}
-
 // A small queued job's directory and record.
 bool save_queued(const server::Spool& spool, const std::string& id) {
   fs::create_directories(spool.job_dir(id));
@@ -97,8 +91,8 @@ TEST(Spool, UnreadableRecordsAreQuarantinedNotDeleted) {
   const auto records = spool->load_all();
   ASSERT_EQ(records.size(), 1u);
   EXPECT_EQ(records[0].job().job_id(), good);
-  EXPECT_EQ(entries_in(root / "quarantine"), 3u);
-  EXPECT_EQ(entries_in(root / "jobs"), 1u);
+  EXPECT_EQ(testing::entries_in(root / "quarantine"), 3u);
+  EXPECT_EQ(testing::entries_in(root / "jobs"), 1u);
   // What was set aside is whole.
   size_t inputs_kept = 0;
   for (const auto& entry : fs::directory_iterator(root / "quarantine"))
@@ -119,7 +113,7 @@ TEST(Spool, EachAttemptHasItsOwnOutputDirectory) {
   testing::write_file(fs::path(spool->output_dir(id, 1)) / "surface-label1.stl", "first");
   ASSERT_TRUE(spool->reset_output(id, 2).ok());
   EXPECT_FALSE(fs::exists(spool->output_dir(id, 1)));
-  EXPECT_EQ(entries_in(spool->output_dir(id, 2)), 0u);
+  EXPECT_EQ(testing::entries_in(spool->output_dir(id, 2)), 0u);
   // What the stale worker writes now lands in out-1, not among the results.
   fs::create_directories(spool->output_dir(id, 1));
   testing::write_file(fs::path(spool->output_dir(id, 1)) / "report.json", "stale");

@@ -58,6 +58,15 @@ inline void write_file(const std::filesystem::path& path, std::string_view bytes
   out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
 }
 
+// How many entries `dir` holds (0 when it cannot be read).
+inline size_t entries_in(const std::filesystem::path& dir) {
+  size_t count = 0;
+  std::error_code error;
+  for ([[maybe_unused]] const auto& entry : std::filesystem::directory_iterator(dir, error))
+    ++count;
+  return count;
+}
+
 // A minimal single-file NIfTI-1 image, built field by field so tests can
 // break any field. Little-endian, sform only by default.
 struct Nifti1Bytes {

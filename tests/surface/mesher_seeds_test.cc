@@ -21,7 +21,7 @@ using MesherSeedsTest = testing::SolvedTorusTest;
 constexpr double kSpacing = 2;  // mm; the torus's points are about 0.7 mm apart
 constexpr double kReach = 1;
 
-ZeroLevel level_of(const SolvedFunction& function) {
+ZeroLevel torus_level(const SolvedFunction& function) {
   return {&function, Kernel::Sphere_3(Point(10, 0, 0), 100 * 100), 1e-6};
 }
 
@@ -36,7 +36,7 @@ double nearest(const Point& p, const std::vector<Point>& among) {
 TEST_F(MesherSeedsTest, SeedsLieOnTheLevelAndSpreadOverIt) {
   HintedEvaluator evaluator(function_, context_);
   const SolvedFunction function(&evaluator);
-  const auto seeds = mesher_seeds(level_of(function), points_, kSpacing, kReach);
+  const auto seeds = mesher_seeds(torus_level(function), points_, kSpacing, kReach);
   // The torus's area (4 pi^2 * 10 * 4 = 1579 mm^2) over a disc of the
   // spacing's radius packs at most about 126 seeds; a greedy packing keeps
   // well over a third of that.
@@ -52,7 +52,7 @@ TEST_F(MesherSeedsTest, SeedsLieOnTheLevelAndSpreadOverIt) {
   // Deterministic: the same seeds again, from an evaluator with another past.
   HintedEvaluator other(function_, context_);
   const SolvedFunction again(&other);
-  EXPECT_EQ(mesher_seeds(level_of(again), points_, kSpacing, kReach), seeds);
+  EXPECT_EQ(mesher_seeds(torus_level(again), points_, kSpacing, kReach), seeds);
 }
 
 TEST_F(MesherSeedsTest, PointsFartherThanTheReachFromTheLevelGiveNone) {
@@ -62,8 +62,8 @@ TEST_F(MesherSeedsTest, PointsFartherThanTheReachFromTheLevelGiveNone) {
   // and within a 4 mm one.
   auto moved = points_;
   for (auto& [point, normal] : moved) point = point + 3 * normal;
-  EXPECT_TRUE(mesher_seeds(level_of(function), moved, kSpacing, kReach).empty());
-  const auto seeds = mesher_seeds(level_of(function), moved, kSpacing, 4);
+  EXPECT_TRUE(mesher_seeds(torus_level(function), moved, kSpacing, kReach).empty());
+  const auto seeds = mesher_seeds(torus_level(function), moved, kSpacing, 4);
   EXPECT_GT(seeds.size(), 60u);
   for (const Point& seed : seeds) EXPECT_LT(std::abs(function_(seed)), 1e-9 * scale_);
 }
@@ -76,7 +76,7 @@ TEST_F(MesherSeedsTest, AFarPointWidensTheCubesInsteadOfAllocatingBillions) {
   // box's volume alone 7 * 10^8 (3 GB of them).
   auto points = points_;
   points.emplace_back(Point(1e7, 1e7, 0), Vector(1, 0, 0));
-  const auto seeds = mesher_seeds(level_of(function), points, 0.01, kReach);
+  const auto seeds = mesher_seeds(torus_level(function), points, 0.01, kReach);
   // Thinned to 0.01 mm, every torus point near the level is its own seed.
   EXPECT_GT(seeds.size(), points_.size() / 2);
   for (const Point& seed : seeds) EXPECT_LT(std::abs(function_(seed)), 1e-9 * scale_);
@@ -85,7 +85,7 @@ TEST_F(MesherSeedsTest, AFarPointWidensTheCubesInsteadOfAllocatingBillions) {
 TEST_F(MesherSeedsTest, TheOracleStartsTheMesherFromTheSeeds) {
   HintedEvaluator evaluator(function_, context_);
   const SolvedFunction function(&evaluator);
-  ZeroLevel level = level_of(function);
+  ZeroLevel level = torus_level(function);
   const auto seeds = mesher_seeds(level, points_, kSpacing, kReach);
   level.seeds = &seeds;
   std::vector<Point> initial;
