@@ -11,6 +11,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_split.h"
 #include "core/digest/sha256.h"
+#include "core/util/status_macros.h"
 #include "server/stream_limits.h"
 
 namespace labelmesh::server {
@@ -198,7 +199,7 @@ absl::StatusOr<ClientIdentity> ClientAuthenticator::identify(
   if (identity.ok()) return identity;
   const std::string host = peer_host(context.peer());
   const absl::Time now = absl::Now();
-  if (auto status = backoff_.check(host, now); !status.ok()) return status;
+  LABELMESH_RETURN_IF_ERROR(backoff_.check(host, now));
   backoff_.failed(host, now);
   return identity.status();
 }

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 #include "server/durable_file.h"
 
+#include "core/util/status_macros.h"
+
 #include <fcntl.h>
 #include <unistd.h>
 
@@ -77,8 +79,8 @@ absl::Status FileWriter::finish() {
 
 absl::Status write_file_synced(const std::string& path, std::string_view bytes) {
   FileWriter file;
-  if (auto status = file.open(path); !status.ok()) return status;
-  if (auto status = file.append(bytes); !status.ok()) return status;
+  LABELMESH_RETURN_IF_ERROR(file.open(path));
+  LABELMESH_RETURN_IF_ERROR(file.append(bytes));
   return file.finish();
 }
 

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 #include "server/job_table.h"
 
+#include "core/util/status_macros.h"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -140,7 +142,7 @@ absl::StatusOr<uint32_t> JobTable::accept(v1::JobRecord record, const std::strin
   }
   const std::string id = record.job().job_id();
   record.mutable_job()->set_state(v1::JOB_STATE_QUEUED);
-  if (auto status = spool_.create_job(record, upload_path); !status.ok()) return status;
+  LABELMESH_RETURN_IF_ERROR(spool_.create_job(record, upload_path));
   Entry& entry = jobs_[id];
   entry.record = std::move(record);
   queue_.push_back(id);
@@ -261,9 +263,8 @@ absl::Status JobTable::end_cancelled(Entry& entry, Unsaved unsaved) {
   error.set_message("cancelled by a client");
   v1::JobEvent event;
   event.mutable_cancelled();
-  if (auto status = end_job(entry, v1::JOB_STATE_CANCELLED, std::move(event), unsaved, &error);
-      !status.ok())
-    return status;
+  LABELMESH_RETURN_IF_ERROR(
+      end_job(entry, v1::JOB_STATE_CANCELLED, std::move(event), unsaved, &error));
   spdlog::info("job {} cancelled", entry.record.job().job_id());
   return absl::OkStatus();
 }
@@ -409,7 +410,7 @@ absl::StatusOr<v1::JobState> JobTable::remove(const std::string& job_id) {
     // The record says so first, so that a restart meanwhile deletes it too.
     v1::JobRecord deleted = entry->record;
     deleted.set_deleted(true);
-    if (auto status = persist(deleted); !status.ok()) return status;
+    LABELMESH_RETURN_IF_ERROR(persist(deleted));
     entry->record = std::move(deleted);
     entry->cancel_requested = true;
     entry->remove_when_ended = true;
@@ -438,7 +439,7 @@ absl::StatusOr<v1::Job> JobTable::cancel(const std::string& job_id) {
     entry->cancel_requested = true;
   } else {
     // The client hears "cancelled" only once the record says so on disk.
-    if (auto status = end_cancelled(*entry, Unsaved::kRefuse); !status.ok()) return status;
+    LABELMESH_RETURN_IF_ERROR(end_cancelled(*entry, Unsaved::kRefuse));
     if (auto it = std::find(queue_.begin(), queue_.end(), job_id); it != queue_.end())
       queue_.erase(it);
     update_gauges();

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 #include "server/labelmesh_server.h"
 
+#include "core/util/status_macros.h"
+
 #include <grpcpp/ext/proto_server_reflection_plugin.h>
 #include <grpcpp/grpcpp.h>
 #include <grpcpp/health_check_service_interface.h>
@@ -71,8 +73,8 @@ class ReflectionOption : public grpc::ServerBuilderOption {
 }  // namespace
 
 absl::StatusOr<std::unique_ptr<LabelmeshServer>> LabelmeshServer::start(ServerConfig config) {
-  if (auto status = validate_config(config); !status.ok()) return status;
-  if (auto status = check_worker_version(worker_executable(config)); !status.ok()) return status;
+  LABELMESH_RETURN_IF_ERROR(validate_config(config));
+  LABELMESH_RETURN_IF_ERROR(check_worker_version(worker_executable(config)));
   std::unique_ptr<LabelmeshServer> server(new LabelmeshServer());
   server->config_ = std::move(config);
   const ServerConfig& c = server->config_;
@@ -85,10 +87,9 @@ absl::StatusOr<std::unique_ptr<LabelmeshServer>> LabelmeshServer::start(ServerCo
 
   server->metrics_ = std::make_unique<Metrics>(c.queue_capacity);
   if (!c.metrics_listen.empty()) {
-    if (auto status = server->metrics_->expose(c.metrics_listen); !status.ok()) return status;
+    LABELMESH_RETURN_IF_ERROR(server->metrics_->expose(c.metrics_listen));
   }
-  if (auto status = c.clustered() ? server->open_cluster() : server->open_spool(); !status.ok())
-    return status;
+  LABELMESH_RETURN_IF_ERROR(c.clustered() ? server->open_cluster() : server->open_spool());
   if (server->store_ != nullptr) {
     server->service_ = std::make_unique<MeshingService>(*server->store_, c, *server->metrics_,
                                                         *server->authenticator_, *server->audit_);

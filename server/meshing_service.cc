@@ -8,6 +8,7 @@
 #include "absl/strings/str_cat.h"
 #include "core/digest/sha256.h"
 #include "core/pipeline/job_options.h"
+#include "core/util/status_macros.h"
 #include "server/durable_file.h"
 #include "server/error_details.h"
 #include "server/spool.h"
@@ -146,7 +147,7 @@ absl::StatusOr<ClientIdentity> MeshingService::identify(const grpc::ServerContex
 
 grpc::Status MeshingService::authorize(const ClientIdentity& identity,
                                        const std::string& job_id) const {
-  if (auto status = check_job_id(job_id); !status.ok()) return status;
+  LABELMESH_RETURN_IF_ERROR(check_job_id(job_id));
   auto owner = store_.owner(job_id);
   // The store unreachable is not "no such job".
   if (!owner.ok() && owner.status().code() != absl::StatusCode::kNotFound)
@@ -339,8 +340,7 @@ grpc::Status MeshingService::submit(grpc::ServerContext& context,
         absl::StrCat("spec.options.formats: dcm needs a DICOM SEG upload (.dcm), not ", extension));
   }
   UploadFile upload(store_.upload_path(job_id, extension));
-  if (auto status = receive_upload(reader, spec, upload.path(), *ticket, reason); !status.ok())
-    return status;
+  LABELMESH_RETURN_IF_ERROR(receive_upload(reader, spec, upload.path(), *ticket, reason));
   upload.mark_alive();
   auto geometry = check_uploaded_volume(upload.path(), voxel_limit, config_.worker_memory_bytes);
   if (!geometry.ok()) {
@@ -426,7 +426,7 @@ grpc::Status MeshingService::GetJob(grpc::ServerContext* context, const v1::GetJ
                                     v1::Job* reply) {
   auto identity = identify(*context, "GetJob");
   if (!identity.ok()) return to_grpc(identity.status());
-  if (auto status = authorize(*identity, request->job_id()); !status.ok()) return status;
+  LABELMESH_RETURN_IF_ERROR(authorize(*identity, request->job_id()));
   auto job = store_.get(request->job_id());
   if (!job.ok()) return to_grpc(job.status());
   *reply = std::move(*job);
@@ -455,7 +455,7 @@ grpc::Status MeshingService::Cancel(grpc::ServerContext* context, const v1::Canc
                                     v1::Job* reply) {
   auto identity = identify(*context, "Cancel");
   if (!identity.ok()) return to_grpc(identity.status());
-  if (auto status = authorize(*identity, request->job_id()); !status.ok()) return status;
+  LABELMESH_RETURN_IF_ERROR(authorize(*identity, request->job_id()));
   auto job = store_.cancel(request->job_id());
   if (!job.ok()) return to_grpc(job.status());
   *reply = std::move(*job);
@@ -467,7 +467,7 @@ grpc::Status MeshingService::ListArtifacts(grpc::ServerContext* context,
                                            v1::ListArtifactsReply* reply) {
   auto identity = identify(*context, "ListArtifacts");
   if (!identity.ok()) return to_grpc(identity.status());
-  if (auto status = authorize(*identity, request->job_id()); !status.ok()) return status;
+  LABELMESH_RETURN_IF_ERROR(authorize(*identity, request->job_id()));
   auto artifacts = store_.artifacts(request->job_id());
   if (!artifacts.ok()) return to_grpc(artifacts.status());
   for (auto& artifact : *artifacts) *reply->add_artifacts() = std::move(artifact);
@@ -478,7 +478,7 @@ grpc::Status MeshingService::Fetch(grpc::ServerContext* context, const v1::Fetch
                                    grpc::ServerWriter<v1::FetchChunk>* writer) {
   auto identity = identify(*context, "Fetch");
   if (!identity.ok()) return to_grpc(identity.status());
-  if (auto status = authorize(*identity, request->job_id()); !status.ok()) return status;
+  LABELMESH_RETURN_IF_ERROR(authorize(*identity, request->job_id()));
   auto artifacts = store_.artifacts(request->job_id());
   if (!artifacts.ok()) return to_grpc(artifacts.status());
   // Only names the job recorded are served: nothing else in the spool is reachable.
@@ -519,7 +519,7 @@ grpc::Status MeshingService::DeleteJob(grpc::ServerContext* context,
                                        v1::DeleteJobReply* reply) {
   auto identity = identify(*context, "DeleteJob");
   if (!identity.ok()) return to_grpc(identity.status());
-  if (auto status = authorize(*identity, request->job_id()); !status.ok()) return status;
+  LABELMESH_RETURN_IF_ERROR(authorize(*identity, request->job_id()));
   auto state = store_.remove(request->job_id());
   if (!state.ok()) return to_grpc(state.status());
   audit_.record({.event = "deleted",

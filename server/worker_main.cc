@@ -26,6 +26,7 @@
 #include "core/pipeline/pipeline.h"
 #include "core/pipeline/report.h"
 #include "core/pipeline/write_results.h"
+#include "core/util/status_macros.h"
 #include "core/volume/read_label_volume.h"
 #include "server/event_pipe.h"
 #include "server/worker_process.h"
@@ -156,7 +157,7 @@ absl::Status run_job(const std::string& job_dir, const std::string& out_dir, int
   auto result =
       run_pipeline(absl::StrCat(job_dir, "/input", record.input_extension()), *params, context);
   if (!result.ok()) return result.status();
-  if (auto status = write_results(*result, *params, out_dir, context); !status.ok()) return status;
+  LABELMESH_RETURN_IF_ERROR(write_results(*result, *params, out_dir, context));
   events.finish_stage();
   v1::JobEvent finished;
   *finished.mutable_finished()->mutable_report() = make_report(*result, *params);

@@ -15,9 +15,10 @@ INCLUDE = re.compile(r'^\s*#\s*include\s*([<"])([^>"]+)[>"]')
 
 STAGES = ["volume", "surface", "volume_mesh", "quality", "mixed_mesh", "conforming", "dicom"]
 # What the serving process may include of core: the job checks (options,
-# volume headers) and the digest. labelmesh-worker (worker_main.cc) runs
-# the whole pipeline.
-SERVER_CORE = re.compile(r"^core/(digest/|pipeline/job_options\.h|pipeline/mesh_params\.h|"
+# volume headers), the digest and the status macros. labelmesh-worker
+# (worker_main.cc) runs the whole pipeline.
+SERVER_CORE = re.compile(r"^core/(digest/|util/status_macros\.h|pipeline/job_options\.h|"
+                         r"pipeline/mesh_params\.h|"
                          r"volume/(image_geometry|volume_header|header_checks)\.h)")
 HEAVY = re.compile(r"^(CGAL/|vtk|tetgen\.h)")
 

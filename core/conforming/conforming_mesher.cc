@@ -7,6 +7,7 @@
 #include <map>
 #include <optional>
 
+#include "core/util/status_macros.h"
 #include "core/util/text.h"
 #include "core/util/vec3.h"
 #include "core/volume/label_statistics.h"
@@ -30,7 +31,7 @@ std::vector<std::pair<int32_t, uint64_t>> voxel_counts(const volume::LabelVolume
 absl::Status remove_crossings(InterfaceSurface& surface, int max_rounds, const RunContext& context,
                               ConformingFigures& figures) {
   for (int round = 0;; ++round) {
-    if (auto status = context.check_stop(); !status.ok()) return status;
+    LABELMESH_RETURN_IF_ERROR(context.check_stop());
     auto crossing = crossing_points(surface);
     if (!crossing.ok()) return crossing.status();
     if (crossing->empty()) return absl::OkStatus();
@@ -127,7 +128,7 @@ absl::StatusOr<volume_mesh::TetMesh> mesh_conforming(const volume::LabelVolume& 
                                                      volume_mesh::ImproveFigures& improve) {
   const auto start = std::chrono::steady_clock::now();
   figures = ConformingFigures{};
-  if (auto status = volume_mesh::check_tetgen_params(params.tetgen); !status.ok()) return status;
+  LABELMESH_RETURN_IF_ERROR(volume_mesh::check_tetgen_params(params.tetgen));
   const auto voxels = voxel_counts(volume, labels);
   if (voxels.empty()) {
     return absl::InvalidArgumentError(

@@ -8,6 +8,7 @@
 
 #include "core/conforming/check_conforming_mesh.h"
 #include "core/quality/element_quality.h"
+#include "core/util/status_macros.h"
 #include "core/util/vec3.h"
 
 namespace labelmesh::conforming {
@@ -251,7 +252,7 @@ absl::Status slide_interface_points(TetMesh& mesh, size_t interface_points,
   figures.tetrahedra_below_before = below.size();
   Slider slider(mesh, interface_points, anchor, reach);
   for (int sweep = 0; sweep < params.max_sweeps && !below.empty(); ++sweep) {
-    if (auto status = context.check_stop(); !status.ok()) return status;
+    LABELMESH_RETURN_IF_ERROR(context.check_stop());
     std::vector<uint32_t> points;
     for (uint32_t t : below) {
       for (uint32_t p : mesh.tetrahedra[t]) {

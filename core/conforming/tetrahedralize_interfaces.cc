@@ -10,6 +10,7 @@
 #include <unordered_map>
 
 #include "core/util/disjoint_sets.h"
+#include "core/util/status_macros.h"
 #include "core/util/text.h"
 #include "core/util/vec3.h"
 #include "core/volume_mesh/tetgen_call.h"
@@ -182,11 +183,11 @@ absl::StatusOr<volume_mesh::TetMesh> labelled_mesh(const InterfaceSurface& surfa
 }  // namespace
 
 absl::StatusOr<std::vector<uint32_t>> crossing_points(const InterfaceSurface& surface) {
-  if (auto status = check_surface(surface); !status.ok()) return status;
+  LABELMESH_RETURN_IF_ERROR(check_surface(surface));
   tetgenio in;
   fill_triangle_plc(surface.points, surface.triangles, in);
   tetgenio check;
-  if (auto status = run_tetgen("pdzQ", in, check, kWhat); !status.ok()) return status;
+  LABELMESH_RETURN_IF_ERROR(run_tetgen("pdzQ", in, check, kWhat));
   std::vector<uint32_t> points;
   for (int f = 0; f < 3 * check.numberoftrifaces; ++f)
     points.push_back(static_cast<uint32_t>(check.trifacelist[f]));
@@ -201,9 +202,9 @@ absl::StatusOr<volume_mesh::TetMesh> tetrahedralize_interfaces(
   const auto start = std::chrono::steady_clock::now();
   figures = volume_mesh::TetgenFigures{};
   regions = LabelledRegions{};
-  if (auto status = volume_mesh::check_tetgen_params(params); !status.ok()) return status;
-  if (auto status = check_surface(surface); !status.ok()) return status;
-  if (auto status = context.check_stop(); !status.ok()) return status;
+  LABELMESH_RETURN_IF_ERROR(volume_mesh::check_tetgen_params(params));
+  LABELMESH_RETURN_IF_ERROR(check_surface(surface));
+  LABELMESH_RETURN_IF_ERROR(context.check_stop());
   context.report(kStage, 0);
   figures.input_points = surface.points.size();
   figures.input_triangles = surface.triangles.size();
@@ -215,8 +216,8 @@ absl::StatusOr<volume_mesh::TetMesh> tetrahedralize_interfaces(
     tetgenio out;
     // -n: neighbours, to find the regions; the faces TetGen lists are the constrained ones, marked.
     const std::string switches = volume_mesh::tetgen_quality_switches(params) + "nzQ";
-    if (auto status = run_tetgen(switches, in, out, kWhat); !status.ok()) return status;
-    if (auto status = context.check_stop(); !status.ok()) return status;
+    LABELMESH_RETURN_IF_ERROR(run_tetgen(switches, in, out, kWhat));
+    LABELMESH_RETURN_IF_ERROR(context.check_stop());
     result = labelled_mesh(surface, out, regions);
   } catch (const std::bad_alloc&) {
     result = absl::ResourceExhaustedError(cat("out of memory meshing ", kWhat));

@@ -10,6 +10,7 @@
 #include <limits>
 #include <memory>
 
+#include "core/util/status_macros.h"
 #include "core/util/text.h"
 #include "core/volume/voxel_access.h"
 
@@ -320,7 +321,7 @@ absl::StatusOr<volume::LabelVolume> interpolate_thick_slices(const volume::Label
   double best_error = std::numeric_limits<double>::infinity();
   std::vector<uint64_t> counts, boundary;
   for (int round = 0;; ++round) {
-    if (auto status = context.check_stop(); !status.ok()) return status;
+    LABELMESH_RETURN_IF_ERROR(context.check_stop());
     interpolator.fill(bias, out, counts, boundary);
     double error = 0;
     for (size_t l = 0; l < present.size(); ++l) {

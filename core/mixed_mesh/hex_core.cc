@@ -7,6 +7,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "core/util/status_macros.h"
 #include "core/util/text.h"
 
 namespace labelmesh::mixed_mesh {
@@ -151,7 +152,7 @@ class CoreBuilder {
     for (const auto& b : blocks) centres.push_back(b.centre);
     const auto block_depths = oracle_.depths(centres, params_.threads);
     core.depth_queries += centres.size();
-    if (auto s = context_.check_stop(); !s.ok()) return s;
+    LABELMESH_RETURN_IF_ERROR(context_.check_stop());
     // Depth is 1-Lipschitz: a block's centre bounds every cube in it.
     std::vector<int64_t> exact;
     for (size_t b = 0; b < blocks.size(); ++b) {
@@ -185,7 +186,7 @@ class CoreBuilder {
   absl::Status trim(HexCore& core) {
     static const std::array<bool, 256> manifold = manifold_table();
     for (;;) {
-      if (auto s = context_.check_stop(); !s.ok()) return s;
+      LABELMESH_RETURN_IF_ERROR(context_.check_stop());
       std::vector<int64_t> remove;
       auto take_shallowest = [&](const std::vector<int64_t>& cells) {
         int64_t shallowest = -1;
@@ -380,8 +381,8 @@ absl::StatusOr<HexCore> build_hex_core(const SurfaceOracle& oracle,
   core.grid_cells = static_cast<uint64_t>(grid.cells());
   if (grid.cells() == 0) return core;
   CoreBuilder builder(oracle, grid, params, context);
-  if (auto s = builder.classify(core); !s.ok()) return s;
-  if (auto s = builder.trim(core); !s.ok()) return s;
+  LABELMESH_RETURN_IF_ERROR(builder.classify(core));
+  LABELMESH_RETURN_IF_ERROR(builder.trim(core));
   builder.emit(label, core);
   builder.find_cavities(core);
   return core;

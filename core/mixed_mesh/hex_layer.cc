@@ -12,6 +12,7 @@
 #include "core/mixed_mesh/check_mixed_mesh.h"
 #include "core/mixed_mesh/mixed_faces.h"
 #include "core/quality/element_quality.h"
+#include "core/util/status_macros.h"
 #include "core/util/text.h"
 #include "core/util/vec3.h"
 
@@ -124,7 +125,7 @@ class LayerBuilder {
       }
       for (size_t v = 0; v < next.size(); ++v) normal[v] = unit(next[v]);
     }
-    if (auto s = context_.check_stop(); !s.ok()) return s;
+    LABELMESH_RETURN_IF_ERROR(context_.check_stop());
 
     // The outer nodes, where the rays leave the surface.
     outer_.resize(boundary_.size());
@@ -181,7 +182,7 @@ class LayerBuilder {
         }
         if (!moved) mesh_.points[node] = from;
       }
-      if (auto s = context_.check_stop(); !s.ok()) return s;
+      LABELMESH_RETURN_IF_ERROR(context_.check_stop());
     }
     return absl::OkStatus();
   }
@@ -197,7 +198,7 @@ class LayerBuilder {
       // A node is tried again only when it or a neighbour moved.
       std::vector<uint32_t> work = nodes_below(kComfortable);
       for (int sweep = 0; sweep < 12 && !work.empty(); ++sweep) {
-        if (auto s = context_.check_stop(); !s.ok()) return s;
+        LABELMESH_RETURN_IF_ERROR(context_.check_stop());
         std::vector<uint32_t> next;
         for (uint32_t node : work) {
           if (!improve(node, step)) continue;
@@ -215,7 +216,7 @@ class LayerBuilder {
       const std::vector<uint32_t> stuck = stuck_neighbourhood();
       if (stuck.empty()) break;
       for (double step : {0.1 * h, 0.05 * h, 0.025 * h, 0.0125 * h, 0.00625 * h}) {
-        if (auto s = context_.check_stop(); !s.ok()) return s;
+        LABELMESH_RETURN_IF_ERROR(context_.check_stop());
         for (int sweep = 0; sweep < 8; ++sweep) {
           bool moved = false;
           for (uint32_t node : stuck) moved |= improve(node, step, true);
@@ -483,10 +484,10 @@ absl::StatusOr<MixedMesh> add_hex_layer(const SurfaceOracle& oracle, double surf
                                         const RunContext& context, HexLayerFigures& figures) {
   if (core.size() == 0) return absl::FailedPreconditionError("the label has no hexahedral core");
   LayerBuilder builder(oracle, std::move(core), params, context);
-  if (auto s = builder.extrude(figures); !s.ok()) return s;
-  if (auto s = builder.search(); !s.ok()) return s;
+  LABELMESH_RETURN_IF_ERROR(builder.extrude(figures));
+  LABELMESH_RETURN_IF_ERROR(builder.search());
   if (params.split) builder.split(figures);
-  if (auto s = builder.verify(surface_volume_mm3, figures); !s.ok()) return s;
+  LABELMESH_RETURN_IF_ERROR(builder.verify(surface_volume_mm3, figures));
   return builder.take();
 }
 

@@ -24,6 +24,7 @@
 
 #include "core/mixed_mesh/mixed_faces.h"
 #include "core/util/coordinate_frame.h"
+#include "core/util/status_macros.h"
 #include "core/util/text.h"
 #include "core/util/text_file.h"
 #include "core/util/vtk_error_flag.h"
@@ -139,7 +140,7 @@ int gmsh_type(CellType type) {
 // No $ElementData: meshio's MSH 2.2 reader fails on element data over more than one cell type
 // (its issue #1257), and FE users read MSH with meshio; the VTU has the qualities.
 absl::Status write_msh(const MixedMesh& mesh, const VolumeFileInfo& info, const std::string& path) {
-  if (auto status = check_positive_labels(mesh.labels, path, "MSH"); !status.ok()) return status;
+  LABELMESH_RETURN_IF_ERROR(check_positive_labels(mesh.labels, path, "MSH"));
   TextFile file(path, "the volume mesh");
   write_msh_head(file, mesh.labels, mesh.points, info);
   file << "$Elements\n" << mesh.size() << '\n';
@@ -245,7 +246,7 @@ void write_abaqus_elements(TextFile& file, const MixedMesh& mesh, CellType type)
 // but meshio keeps only the last block's.
 absl::Status write_abaqus(const MixedMesh& mesh, const VolumeFileInfo& info,
                           const std::string& path) {
-  if (auto status = check_positive_labels(mesh.labels, path, "INP"); !status.ok()) return status;
+  LABELMESH_RETURN_IF_ERROR(check_positive_labels(mesh.labels, path, "INP"));
   const auto faces = label_boundary_faces(mesh);
   TextFile file(path, "the volume mesh");
   volume_mesh::write_abaqus_head(file, "mixed-element mesh", mesh.points, info);
@@ -284,11 +285,9 @@ absl::Status write_mixed_mesh(const MixedMesh& mesh, const MixedQuality& quality
   if (auto status = check_mixed_mesh(mesh); !status.ok()) {
     return absl::InvalidArgumentError(cat(path, ": ", std::string(status.message())));
   }
-  if (auto status = check_quality_size(mesh, quality.jacobian_ratio, "jacobian_ratio", path);
-      !status.ok())
-    return status;
-  if (auto status = check_quality_size(mesh, quality.quality, "quality", path); !status.ok())
-    return status;
+  LABELMESH_RETURN_IF_ERROR(
+      check_quality_size(mesh, quality.jacobian_ratio, "jacobian_ratio", path));
+  LABELMESH_RETURN_IF_ERROR(check_quality_size(mesh, quality.quality, "quality", path));
   switch (format) {
     case VolumeFormat::kVtu:
       return write_vtu(mesh, quality, info, path);

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/util/status_macros.h"
 #include "core/util/text.h"
 
 namespace labelmesh {
@@ -76,19 +77,18 @@ absl::Status read_guard_options(const v1::MeshOptions& options, GuardOptions& gu
   };
   if (options.has_volume_tolerance_percent()) {
     guard.volume_percent = options.volume_tolerance_percent();
-    if (auto s = percent("volume_tolerance_percent", guard.volume_percent); !s.ok()) return s;
+    LABELMESH_RETURN_IF_ERROR(percent("volume_tolerance_percent", guard.volume_percent));
   }
   if (options.has_small_volume_tolerance_percent()) {
     guard.small_volume_percent = options.small_volume_tolerance_percent();
-    if (auto s = percent("small_volume_tolerance_percent", guard.small_volume_percent); !s.ok())
-      return s;
+    LABELMESH_RETURN_IF_ERROR(
+        percent("small_volume_tolerance_percent", guard.small_volume_percent));
   }
   if (options.has_hausdorff_tolerance_mm()) {
     guard.hausdorff_mm = options.hausdorff_tolerance_mm();
     // 0 asks for the default (the drawn spacing).
     if (guard.hausdorff_mm != 0) {
-      if (auto s = check_millimetres("hausdorff_tolerance_mm", guard.hausdorff_mm); !s.ok())
-        return s;
+      LABELMESH_RETURN_IF_ERROR(check_millimetres("hausdorff_tolerance_mm", guard.hausdorff_mm));
     }
   }
   if (options.has_fall_back()) guard.fall_back = options.fall_back();
@@ -142,9 +142,8 @@ absl::Status read_poisson_options(const v1::MeshOptions& options, PoissonOptions
   }
   if (options.has_max_edge_voxels()) {
     poisson.max_edge_voxels = options.max_edge_voxels();
-    if (auto s = check_voxels("max_edge_voxels", poisson.max_edge_voxels, kFinestEdgeVoxels);
-        !s.ok())
-      return s;
+    LABELMESH_RETURN_IF_ERROR(
+        check_voxels("max_edge_voxels", poisson.max_edge_voxels, kFinestEdgeVoxels));
   }
   if (options.has_max_distance_voxels()) {
     poisson.max_distance_voxels = options.max_distance_voxels();
@@ -155,11 +154,11 @@ absl::Status read_poisson_options(const v1::MeshOptions& options, PoissonOptions
   }
   if (options.has_max_edge_mm()) {
     poisson.max_edge_mm = options.max_edge_mm();
-    if (auto s = check_millimetres("max_edge_mm", poisson.max_edge_mm); !s.ok()) return s;
+    LABELMESH_RETURN_IF_ERROR(check_millimetres("max_edge_mm", poisson.max_edge_mm));
   }
   if (options.has_max_distance_mm()) {
     poisson.max_distance_mm = options.max_distance_mm();
-    if (auto s = check_millimetres("max_distance_mm", poisson.max_distance_mm); !s.ok()) return s;
+    LABELMESH_RETURN_IF_ERROR(check_millimetres("max_distance_mm", poisson.max_distance_mm));
   }
   if (options.has_adapt_to_thickness()) poisson.adapt_to_thickness = options.adapt_to_thickness();
   if (options.has_poisson_min_thickness_voxels()) {
@@ -207,8 +206,7 @@ absl::Status read_poisson_options(const v1::MeshOptions& options, PoissonOptions
   if (options.has_point_cell_voxels()) {
     poisson.point_cell_voxels = options.point_cell_voxels();
     // max_points bounds what a fine cell keeps.
-    if (auto s = check_voxels("point_cell_voxels", poisson.point_cell_voxels, 0.01); !s.ok())
-      return s;
+    LABELMESH_RETURN_IF_ERROR(check_voxels("point_cell_voxels", poisson.point_cell_voxels, 0.01));
   }
   switch (options.normals()) {
     case v1::NORMAL_WEIGHTING_UNSPECIFIED:
@@ -230,12 +228,11 @@ absl::Status read_poisson_options(const v1::MeshOptions& options, PoissonOptions
   }
   if (options.has_max_points()) {
     poisson.max_points = options.max_points();
-    if (auto s = surface::check_point_count("max_points", poisson.max_points); !s.ok()) return s;
+    LABELMESH_RETURN_IF_ERROR(surface::check_point_count("max_points", poisson.max_points));
   }
   if (options.has_split_points()) {
     poisson.split_points = options.split_points();
-    if (auto s = surface::check_point_count("split_points", poisson.split_points); !s.ok())
-      return s;
+    LABELMESH_RETURN_IF_ERROR(surface::check_point_count("split_points", poisson.split_points));
   }
   switch (options.point_reduction()) {
     case v1::POINT_REDUCTION_UNSPECIFIED:
@@ -404,7 +401,7 @@ v1::MeshOptions make_options(const MeshParams& params) {
 
 absl::StatusOr<MeshParams> params_from_options(const v1::MeshOptions& options) {
   MeshParams params;
-  if (auto s = read_label_names(options, params.label_names); !s.ok()) return s;
+  LABELMESH_RETURN_IF_ERROR(read_label_names(options, params.label_names));
   if (options.labels_size() > kMaxLabels)
     return absl::InvalidArgumentError(
         cat("labels: ", options.labels_size(), " entries; at most ", kMaxLabels));
@@ -430,9 +427,9 @@ absl::StatusOr<MeshParams> params_from_options(const v1::MeshOptions& options) {
     default:
       return absl::InvalidArgumentError("surface: unknown surface method");
   }
-  if (auto s = read_poisson_options(options, params.poisson); !s.ok()) return s;
-  if (auto s = read_guard_options(options, params.guard); !s.ok()) return s;
-  if (auto s = read_volume_options(options, params); !s.ok()) return s;
+  LABELMESH_RETURN_IF_ERROR(read_poisson_options(options, params.poisson));
+  LABELMESH_RETURN_IF_ERROR(read_guard_options(options, params.guard));
+  LABELMESH_RETURN_IF_ERROR(read_volume_options(options, params));
   // Per-label tetrahedra and hexahedra want surfaces sized for elements, not
   // one node per voxel face: unless asked otherwise they mesh Poisson's.
   const bool element_sized = params.volume == VolumeMethod::kTetgen ||
@@ -524,13 +521,13 @@ absl::Status check_sizing_for_grid(const PoissonOptions& poisson,
                                           " voxel (", finest_voxels * voxel,
                                           " mm on this grid), which the voxels cannot tell apart"));
   };
-  if (auto s = at_least("max_edge_mm", poisson.max_edge_mm, kFinestEdgeVoxels); !s.ok()) return s;
-  if (auto s = at_least("max_distance_mm", poisson.max_distance_mm, kFinestDistanceVoxels); !s.ok())
-    return s;
+  LABELMESH_RETURN_IF_ERROR(at_least("max_edge_mm", poisson.max_edge_mm, kFinestEdgeVoxels));
+  LABELMESH_RETURN_IF_ERROR(
+      at_least("max_distance_mm", poisson.max_distance_mm, kFinestDistanceVoxels));
   for (const auto& sizing : poisson.label_sizing) {
     const std::string field = cat("label_sizing: label ", sizing.label);
-    if (auto s = at_least(field, sizing.max_edge_mm, kFinestEdgeVoxels); !s.ok()) return s;
-    if (auto s = at_least(field, sizing.max_distance_mm, kFinestDistanceVoxels); !s.ok()) return s;
+    LABELMESH_RETURN_IF_ERROR(at_least(field, sizing.max_edge_mm, kFinestEdgeVoxels));
+    LABELMESH_RETURN_IF_ERROR(at_least(field, sizing.max_distance_mm, kFinestDistanceVoxels));
   }
   return absl::OkStatus();
 }

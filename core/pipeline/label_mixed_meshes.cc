@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <chrono>
 
+#include "core/util/status_macros.h"
 #include "core/util/text.h"
 
 namespace labelmesh {
@@ -59,7 +60,7 @@ absl::StatusOr<MixedVolumeResult> mesh_labels_mixed(const std::vector<LabelBound
       };
     }
     label_context.report("mixed_mesh", 0);
-    if (auto s = check_fillable(boundary); !s.ok()) return s;
+    LABELMESH_RETURN_IF_ERROR(check_fillable(boundary));
     mixed_mesh::MixedFigures figures;
     auto mesh =
         mixed_mesh::mesh_mixed(*boundary.surface, boundary.label, params, label_context, figures);

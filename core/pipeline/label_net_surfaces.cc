@@ -12,6 +12,7 @@
 #include "core/surface/surface_checks.h"
 #include "core/surface/surface_statistics.h"
 #include "core/surface/voxel_fidelity.h"
+#include "core/util/status_macros.h"
 #include "core/util/text.h"
 
 namespace labelmesh {
@@ -119,15 +120,15 @@ class LabelGuard {
     poisson_first =
         poisson_first && fidelity_.thickness_voxels >= params_.poisson.min_thickness_voxels;
     if (poisson_first) {
-      if (auto s = try_poisson(); !s.ok()) return s;
+      LABELMESH_RETURN_IF_ERROR(try_poisson());
     }
     if (!delivered()) {
       Candidate net{cut_.mesh, {}};
       const auto* corresponding = staircase_net_ == nullptr ? &cut_.staircase : nullptr;
-      if (auto s = measure(SurfaceAttemptMethod::kNet, net, corresponding); !s.ok()) return s;
+      LABELMESH_RETURN_IF_ERROR(measure(SurfaceAttemptMethod::kNet, net, corresponding));
     }
     if (fall_back && !delivered() && !poisson_first) {
-      if (auto s = try_poisson(); !s.ok()) return s;
+      LABELMESH_RETURN_IF_ERROR(try_poisson());
     }
     return deliver();
   }
@@ -161,7 +162,7 @@ class LabelGuard {
                                        candidate.mesh, *corresponding, layer_.geometry)
                                  : surface::sampled_hausdorff_voxels(
                                        candidate.mesh, voxel_boundary(), layer_.geometry, context_);
-    if (auto s = context_.check_stop(); !s.ok()) return s;
+    LABELMESH_RETURN_IF_ERROR(context_.check_stop());
     SurfaceAttempt attempt;
     attempt.method = method;
     attempt.volume_change = voxels->volume_change;
@@ -319,7 +320,7 @@ absl::StatusOr<LabelNets> smoothed_nets(const std::vector<volume::LabelVolume>& 
       flat.smoothing_rounds = 0;
       built.staircases[layer] = conforming::label_interfaces(layers[layer], here, flat, figures);
     }
-    if (auto s = context.check_stop(); !s.ok()) return s;
+    LABELMESH_RETURN_IF_ERROR(context.check_stop());
     const auto touching = touching_labels(built.nets[layer]);
     const bool fine_grid = anisotropy(layers[layer].geometry) <= params.net.poisson_max_anisotropy;
     for (size_t i = 0; i < count; ++i) {
@@ -347,11 +348,11 @@ absl::StatusOr<LabelNets> build_label_nets(const std::vector<volume::LabelVolume
                                            const std::vector<int32_t>& labels,
                                            const MeshParams& params, const RunContext& context,
                                            std::vector<StageTiming>& stages) {
-  if (auto s = check_net_options(params.net); !s.ok()) return s;
+  LABELMESH_RETURN_IF_ERROR(check_net_options(params.net));
   auto built = smoothed_nets(layers, layer_of, labels, params, context, stages);
   if (!built.ok()) return built.status();
   find_net_crossings(*built, stages);
-  if (auto s = context.check_stop(); !s.ok()) return s;
+  LABELMESH_RETURN_IF_ERROR(context.check_stop());
   return built;
 }
 
@@ -365,7 +366,7 @@ absl::Status add_net_label_surface(const LabelNets& nets, size_t layer, bool poi
   LabelGuard guard(volume, nets.nets[layer], nets.geometry[layer],
                    nets.staircases[layer] ? &*nets.staircases[layer] : nullptr,
                    nets.crossings[layer], label, tolerance, params, context, outcome);
-  if (auto s = guard.run(poisson_first); !s.ok()) return s;
+  LABELMESH_RETURN_IF_ERROR(guard.run(poisson_first));
   for (auto& surface : outcome.surfaces) surfaces.push_back(std::move(surface));
   for (const auto& stage : outcome.stages) add_stage_time(stages, stage.name, stage.seconds);
   return absl::OkStatus();

@@ -13,6 +13,7 @@
 #include "core/surface/surface_checks.h"
 #include "core/surface/vertex_normals.h"
 #include "core/util/side_by_side.h"
+#include "core/util/status_macros.h"
 #include "core/util/text.h"
 #include "core/volume/label_components.h"
 
@@ -378,7 +379,7 @@ absl::Status add_label_surfaces(const volume::LabelVolume& volume,
         attempt.error = std::string(piece.status().message());
       }
     }
-    if (auto s = context.check_stop(); !s.ok()) return s;
+    LABELMESH_RETURN_IF_ERROR(context.check_stop());
     build_reference();
     surface::SurfaceStatistics statistics;
     if (attempt.error.empty()) {
@@ -387,7 +388,7 @@ absl::Status add_label_surfaces(const volume::LabelVolume& volume,
       statistics = measure_attempt(mesh, *marching_cubes_reference, marching_cubes_volume,
                                    tolerance, context, attempt);
     }
-    if (auto s = context.check_stop(); !s.ok()) return s;
+    LABELMESH_RETURN_IF_ERROR(context.check_stop());
     fidelity.attempts.push_back(std::move(attempt));
     candidates.push_back({std::move(mesh), statistics});
     return absl::OkStatus();
@@ -427,13 +428,13 @@ absl::Status add_label_surfaces(const volume::LabelVolume& volume,
     };
     if (try_poisson) {
       output.poisson.emplace();
-      if (auto s = poisson_attempt(SurfaceAttemptMethod::kPoisson, 1); !s.ok()) return s;
+      LABELMESH_RETURN_IF_ERROR(poisson_attempt(SurfaceAttemptMethod::kPoisson, 1));
       // A finer Poisson surface only helps one that was nearly within: on
       // the 61-label TotalSegmentator volume it rescued two labels, both
       // within 1.5 times the tolerance, and never one further out.
       if (fall_back && !delivered() &&
           excess_over(fidelity.attempts.back(), tolerance) <= kRefineWithin) {
-        if (auto s = poisson_attempt(SurfaceAttemptMethod::kPoissonRefined, 0.5); !s.ok()) return s;
+        LABELMESH_RETURN_IF_ERROR(poisson_attempt(SurfaceAttemptMethod::kPoissonRefined, 0.5));
       }
     }
     smoothed = {};
@@ -471,13 +472,13 @@ absl::Status add_label_surfaces(const volume::LabelVolume& volume,
              fine.error.empty() && fine.hausdorff_mm < coarse.hausdorff_mm;
     };
     if (fall_back && !delivered()) {
-      if (auto s = mask_attempt(SurfaceAttemptMethod::kMask, 1); !s.ok()) return s;
+      LABELMESH_RETURN_IF_ERROR(mask_attempt(SurfaceAttemptMethod::kMask, 1));
     }
     // A mask the mesher could not settle on at the label's sizing has a
     // feature no finer sizing resolves, and the finer attempt would spend four
     // times the budget on it.
     if (fall_back && !delivered() && !mask_did_not_settle) {
-      if (auto s = mask_attempt(SurfaceAttemptMethod::kMaskRefined, 0.5); !s.ok()) return s;
+      LABELMESH_RETURN_IF_ERROR(mask_attempt(SurfaceAttemptMethod::kMaskRefined, 0.5));
     }
     // Halving again helps a mask surface that the first halving brought
     // closer: a narrow groove that the coarser sizings bridged (brain label 8:
@@ -485,18 +486,17 @@ absl::Status add_label_surfaces(const volume::LabelVolume& volume,
     // so only a surface that stays small gets it.
     if (fall_back && !delivered() && mask_closes_in() &&
         uint64_t(candidates.back().statistics.nodes) * 4 <= kFinestMaskMaxNodes) {
-      if (auto s = mask_attempt(SurfaceAttemptMethod::kMaskFinest, 0.25); !s.ok()) return s;
+      LABELMESH_RETURN_IF_ERROR(mask_attempt(SurfaceAttemptMethod::kMaskFinest, 0.25));
     }
     // Last: the repaired surface itself, when nothing smoother was built.
     const bool none_built = std::none_of(fidelity.attempts.begin(), fidelity.attempts.end(),
                                          [](const SurfaceAttempt& a) { return a.error.empty(); });
     if (fall_back && none_built) {
-      if (auto s = try_surface(SurfaceAttemptMethod::kRepaired, 1, repaired_piece); !s.ok())
-        return s;
+      LABELMESH_RETURN_IF_ERROR(try_surface(SurfaceAttemptMethod::kRepaired, 1, repaired_piece));
     }
   } else {
     // The repaired surface is the output: measured, not rebuilt.
-    if (auto s = try_surface(SurfaceAttemptMethod::kRepaired, 1, repaired_piece); !s.ok()) return s;
+    LABELMESH_RETURN_IF_ERROR(try_surface(SurfaceAttemptMethod::kRepaired, 1, repaired_piece));
   }
   // The first attempt within the tolerance, else the one least outside it.
   fidelity.delivered = fidelity.attempts.size() - 1;

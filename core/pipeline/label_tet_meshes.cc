@@ -4,6 +4,7 @@
 #include <chrono>
 #include <new>
 
+#include "core/util/status_macros.h"
 #include "core/util/text.h"
 
 namespace labelmesh {
@@ -16,7 +17,7 @@ absl::StatusOr<VolumeResult> measure_and_join(const std::vector<LabelBoundary>& 
   VolumeResult result;
   for (const auto& boundary : boundaries) {
     // TetGen's own -d check would say the same, less precisely and later.
-    if (auto s = check_fillable(boundary); !s.ok()) return s;
+    LABELMESH_RETURN_IF_ERROR(check_fillable(boundary));
     volume_mesh::TetgenFigures figures;
     auto tets =
         volume_mesh::tetrahedralize(*boundary.surface, boundary.label, params, context, figures);

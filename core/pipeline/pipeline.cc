@@ -23,6 +23,7 @@
 #include "core/surface/voxel_fidelity.h"
 #include "core/util/exception_status.h"
 #include "core/util/side_by_side.h"
+#include "core/util/status_macros.h"
 #include "core/util/text.h"
 #include "core/volume/label_table.h"
 #include "core/volume/read_label_volume.h"
@@ -348,7 +349,7 @@ absl::Status add_volume_mesh(const MeshParams& params, const volume::ImageGeomet
     StageTimer timer(result.stages, "tet_improve");
     context.report("tet_improve", 0);
     const auto improve = improve_params_for(params, geometry);
-    if (auto s = improve_volume(*tets, improve, context); !s.ok()) return s;
+    LABELMESH_RETURN_IF_ERROR(improve_volume(*tets, improve, context));
   }
   result.volume = std::move(*tets);
   return absl::OkStatus();
@@ -468,8 +469,8 @@ absl::StatusOr<MeshResult> run_on_volume(const std::string& path,
               " layers); one conforming mesh gives each point one label, so mesh overlapping "
               "segments with --volume tet"));
     }
-    if (auto s = add_conforming_mesh(*volume, *labels, params, context, result); !s.ok()) return s;
-    if (auto s = refuse_warnings_if_strict(path, result, params); !s.ok()) return s;
+    LABELMESH_RETURN_IF_ERROR(add_conforming_mesh(*volume, *labels, params, context, result));
+    LABELMESH_RETURN_IF_ERROR(refuse_warnings_if_strict(path, result, params));
     keep_label_image();
     return result;
   }
@@ -519,7 +520,7 @@ absl::StatusOr<MeshResult> run_on_volume(const std::string& path,
   }
   add_stage_time(result.stages, "surface_statistics", statistics_stage.front().seconds);
   if (!quality_status.ok()) return quality_status;
-  if (auto s = context.check_stop(); !s.ok()) return s;
+  LABELMESH_RETURN_IF_ERROR(context.check_stop());
   if (quality && std::none_of(quality_surfaces.begin(), quality_surfaces.end(),
                               [](const SurfaceResult& s) { return s.is_output; })) {
     return absl::FailedPreconditionError(
@@ -531,7 +532,7 @@ absl::StatusOr<MeshResult> run_on_volume(const std::string& path,
   for (auto& surface : quality_surfaces) result.surfaces.push_back(std::move(surface));
   result.warnings = collect_warnings(result.surfaces, params);
   // Refused before the volume meshes, which would take long for nothing.
-  if (auto s = refuse_warnings_if_strict(path, result, params); !s.ok()) return s;
+  LABELMESH_RETURN_IF_ERROR(refuse_warnings_if_strict(path, result, params));
 
   if (tetrahedra || params.volume == VolumeMethod::kMixed || params.volume == VolumeMethod::kHex) {
     // Labels are meshed one by one: where they touch, their meshes overlap.
@@ -541,12 +542,12 @@ absl::StatusOr<MeshResult> run_on_volume(const std::string& path,
     }
   }
   if (tetrahedra) {
-    if (auto s = add_volume_mesh(params, volume->geometry, context, result); !s.ok()) return s;
+    LABELMESH_RETURN_IF_ERROR(add_volume_mesh(params, volume->geometry, context, result));
   }
   if (params.volume == VolumeMethod::kMixed || params.volume == VolumeMethod::kHex) {
-    if (auto s = add_mixed_mesh(params, volume->geometry, context, result); !s.ok()) return s;
+    LABELMESH_RETURN_IF_ERROR(add_mixed_mesh(params, volume->geometry, context, result));
   }
-  if (auto s = refuse_warnings_if_strict(path, result, params); !s.ok()) return s;
+  LABELMESH_RETURN_IF_ERROR(refuse_warnings_if_strict(path, result, params));
   keep_label_image();
   return result;
 }

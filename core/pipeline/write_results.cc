@@ -15,6 +15,7 @@
 #include "core/surface/write_surface.h"
 #include "core/util/exception_status.h"
 #include "core/util/stage_timer.h"
+#include "core/util/status_macros.h"
 #include "core/util/text.h"
 #include "core/volume/write_label_volume.h"
 #include "core/volume_mesh/write_volume_mesh.h"
@@ -84,11 +85,9 @@ absl::Status write_dicom_surfaces(MeshResult& result, const MeshParams& params,
     std::error_code ignored;
     std::filesystem::remove(stl_path, ignored);
     if (!read) return absl::InternalError(cat(stl_path.string(), ": cannot read the STL back"));
-    if (auto s = dicom::write_encapsulated_stl(
-            stl, path.string(), *result.input.dicom, series, ++instance,
-            title.empty() ? cat("label ", surface.label) : title);
-        !s.ok())
-      return s;
+    LABELMESH_RETURN_IF_ERROR(
+        dicom::write_encapsulated_stl(stl, path.string(), *result.input.dicom, series, ++instance,
+                                      title.empty() ? cat("label ", surface.label) : title));
     surface.files.push_back(name);
   }
   return absl::OkStatus();
@@ -108,7 +107,7 @@ absl::Status write_scene(MeshResult& result, const MeshParams& params, const std
         infos.push_back(
             {surface.label, label_name(surface.label, result.input.descriptions), params.frame});
       }
-      if (auto s = surface::write_surface_scene(meshes, infos, path); !s.ok()) return s;
+      LABELMESH_RETURN_IF_ERROR(surface::write_surface_scene(meshes, infos, path));
       result.scene_files.push_back(name);
       // VTK writes block i to surfaces/surfaces_<i>.vtp, beside the file.
       for (size_t block = 0; block < meshes.size(); ++block) {
@@ -132,7 +131,7 @@ absl::Status write_scene(MeshResult& result, const MeshParams& params, const std
         for (int row = 0; row < 3; ++row) g.direction[3 * row + column] = axis[row];
       }
     }
-    if (auto s = volume::write_label_volume(placed, path); !s.ok()) return s;
+    LABELMESH_RETURN_IF_ERROR(volume::write_label_volume(placed, path));
     result.scene_files.push_back(name);
   }
   return absl::OkStatus();
@@ -150,7 +149,7 @@ absl::Status write_all(MeshResult& result, const MeshParams& params, const std::
                                        [](const SurfaceResult& s) { return s.is_output; });
     size_t done = 0;
     for (auto& surface : result.surfaces) {
-      if (auto s = context.check_stop(); !s.ok()) return s;
+      LABELMESH_RETURN_IF_ERROR(context.check_stop());
       surface.files.clear();
       if (!surface.is_output) continue;
       for (auto format : params.formats) {
@@ -159,16 +158,16 @@ absl::Status write_all(MeshResult& result, const MeshParams& params, const std::
         const auto path = (std::filesystem::path(out_dir) / name).string();
         const surface::SurfaceFileInfo info{
             surface.label, label_name(surface.label, result.input.descriptions), params.frame};
-        if (auto s = surface::write_surface(surface.mesh, path, format, info); !s.ok()) return s;
+        LABELMESH_RETURN_IF_ERROR(surface::write_surface(surface.mesh, path, format, info));
         surface.files.push_back(name);
       }
       context.report("write", double(++done) / double(outputs));
     }
-    if (auto s = write_dicom_surfaces(result, params, out_dir); !s.ok()) return s;
+    LABELMESH_RETURN_IF_ERROR(write_dicom_surfaces(result, params, out_dir));
   }
   if (!params.scene_formats.empty()) {
     StageTimer timer(result.stages, "write_scene");
-    if (auto s = write_scene(result, params, out_dir); !s.ok()) return s;
+    LABELMESH_RETURN_IF_ERROR(write_scene(result, params, out_dir));
   }
   volume_mesh::VolumeFileInfo info;
   info.frame = params.frame;
@@ -181,10 +180,8 @@ absl::Status write_all(MeshResult& result, const MeshParams& params, const std::
     for (auto format : params.volume_formats) {
       const std::string name = cat("volume.", volume_mesh::volume_format_name(format));
       const auto path = (std::filesystem::path(out_dir) / name).string();
-      if (auto s = mixed_mesh::write_mixed_mesh(result.mixed->mesh, result.mixed->quality, path,
-                                                format, info);
-          !s.ok())
-        return s;
+      LABELMESH_RETURN_IF_ERROR(mixed_mesh::write_mixed_mesh(
+          result.mixed->mesh, result.mixed->quality, path, format, info));
       result.mixed->files.push_back(name);
     }
   }
@@ -200,10 +197,8 @@ absl::Status write_all(MeshResult& result, const MeshParams& params, const std::
     for (auto format : params.volume_formats) {
       const std::string name = cat("volume.", volume_mesh::volume_format_name(format));
       const auto path = (std::filesystem::path(out_dir) / name).string();
-      if (auto s = volume_mesh::write_volume_mesh(result.volume->mesh, result.volume->quality, path,
-                                                  format, volume_info);
-          !s.ok())
-        return s;
+      LABELMESH_RETURN_IF_ERROR(volume_mesh::write_volume_mesh(
+          result.volume->mesh, result.volume->quality, path, format, volume_info));
       result.volume->files.push_back(name);
       if (volume_info.interfaces != nullptr && format == volume_mesh::VolumeFormat::kVtu)
         result.volume->files.push_back(volume_mesh::interfaces_vtu_path(name));

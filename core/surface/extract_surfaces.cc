@@ -11,6 +11,7 @@
 #include <vtkPolyData.h>
 
 #include "core/surface/surface_statistics.h"
+#include "core/util/status_macros.h"
 #include "core/util/text.h"
 
 namespace labelmesh::surface {
@@ -78,7 +79,7 @@ absl::StatusOr<std::vector<TriangleMesh>> extract_component_surfaces(
   std::vector<TriangleMesh> surfaces;
   surfaces.reserve(ids.size());
   for (int32_t id : ids) {
-    if (auto s = context.check_stop(); !s.ok()) return s;
+    LABELMESH_RETURN_IF_ERROR(context.check_stop());
     if (id < 1 || static_cast<size_t>(id) > components.components.size()) {
       return absl::InvalidArgumentError(cat("component ", id, " does not exist"));
     }
@@ -95,7 +96,7 @@ absl::StatusOr<std::vector<LabelSurface>> extract_surfaces(
   std::vector<LabelSurface> surfaces;
   surfaces.reserve(labels.size());
   for (size_t n = 0; n < labels.size(); ++n) {
-    if (auto s = context.check_stop(); !s.ok()) return s;
+    LABELMESH_RETURN_IF_ERROR(context.check_stop());
     const volume::LabelStatistics* label = statistics.find(labels[n]);
     if (label == nullptr) {
       return absl::InvalidArgumentError(cat("label ", labels[n], " is not in the volume"));

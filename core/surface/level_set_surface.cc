@@ -18,6 +18,7 @@
 #include "core/surface/cgal/cgal_mesh.h"
 #include "core/surface/cgal/restricted_delaunay.h"
 #include "core/util/exception_status.h"
+#include "core/util/status_macros.h"
 #include "core/util/text.h"
 
 namespace labelmesh::surface {
@@ -213,7 +214,7 @@ std::vector<Vec3> crossings_around(const Field& field, double level, const Vec3&
 absl::StatusOr<TriangleMesh> mesh_level_set(const ScalarGrid& grid, const LevelSetParams& params,
                                             const std::vector<std::array<double, 3>>& seeds,
                                             const RunContext& context) {
-  if (auto s = check_input(grid, params); !s.ok()) return s;
+  LABELMESH_RETURN_IF_ERROR(check_input(grid, params));
   const auto mm_to_index = inverse(grid.index_to_mm);
   if (!mm_to_index) return absl::InvalidArgumentError("level-set grid: singular placement");
   const Field field(grid, *mm_to_index);

@@ -27,6 +27,7 @@
 #include "core/util/exception_status.h"
 #include "core/util/side_by_side.h"
 #include "core/util/stage_timer.h"
+#include "core/util/status_macros.h"
 #include "core/util/text.h"
 
 namespace labelmesh::surface {
@@ -92,8 +93,8 @@ absl::Status check_params(const PoissonParams& params) {
   if (params.reduction == PointReduction::kGrid &&
       (!(params.reduction_cell_mm > 0) || !std::isfinite(params.reduction_cell_mm)))
     return absl::InvalidArgumentError("point-cell: must be a positive length");
-  if (auto s = check_point_count("max-points", params.max_points); !s.ok()) return s;
-  if (auto s = check_point_count("split-points", params.split_points); !s.ok()) return s;
+  LABELMESH_RETURN_IF_ERROR(check_point_count("max-points", params.max_points));
+  LABELMESH_RETURN_IF_ERROR(check_point_count("split-points", params.split_points));
   if (params.split_points != 0 &&
       (!(params.split_overlap_mm > 0) || !std::isfinite(params.split_overlap_mm)))
     return absl::InvalidArgumentError("split overlap: must be a positive length");
@@ -348,7 +349,7 @@ absl::StatusOr<TriangleMesh> reconstruct_poisson_surface(
     const std::vector<geometry::Vec3>& points, const std::vector<geometry::Vec3>& normals,
     const PoissonParams& params, const RunContext& context, PoissonFigures& figures,
     const std::function<void()>& beside_meshing) {
-  if (auto s = check_params(params); !s.ok()) return s;
+  LABELMESH_RETURN_IF_ERROR(check_params(params));
   if (points.size() != normals.size())
     return absl::InternalError("poisson: one normal per point is needed");
   std::vector<OrientedPoint> oriented;

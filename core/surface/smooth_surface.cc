@@ -9,6 +9,7 @@
 #include <vtkWindowedSincPolyDataFilter.h>
 
 #include "core/surface/write_surface.h"
+#include "core/util/status_macros.h"
 #include "core/util/text.h"
 
 namespace labelmesh::surface {
@@ -21,7 +22,7 @@ absl::StatusOr<TriangleMesh> smooth_surface(const TriangleMesh& mesh, const Smoo
   if (!(params.pass_band > 0 && params.pass_band < 2))
     return absl::InvalidArgumentError(
         cat("smoothing-pass-band: ", params.pass_band, " is outside (0, 2)"));
-  if (auto s = context.check_stop(); !s.ok()) return s;
+  LABELMESH_RETURN_IF_ERROR(context.check_stop());
   if (params.iterations == 0 || mesh.triangles.empty()) return mesh;
 
   vtkNew<vtkWindowedSincPolyDataFilter> filter;
@@ -36,7 +37,7 @@ absl::StatusOr<TriangleMesh> smooth_surface(const TriangleMesh& mesh, const Smoo
   // Scaling into a unit cube keeps the Chebyshev recursion well conditioned.
   filter->NormalizeCoordinatesOn();
   filter->Update();
-  if (auto s = context.check_stop(); !s.ok()) return s;
+  LABELMESH_RETURN_IF_ERROR(context.check_stop());
 
   vtkPoints* moved = filter->GetOutput()->GetPoints();
   if (moved == nullptr || moved->GetNumberOfPoints() != vtkIdType(mesh.points.size()))

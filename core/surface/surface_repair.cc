@@ -21,6 +21,7 @@
 
 #include "core/surface/cgal/cgal_mesh.h"
 #include "core/util/exception_status.h"
+#include "core/util/status_macros.h"
 #include "core/util/text.h"
 
 namespace labelmesh::surface {
@@ -108,7 +109,7 @@ absl::StatusOr<TriangleMesh> repair(const TriangleMesh& input, const RepairParam
   Mesh& mesh = *built;
   counts.non_manifold_vertices_split +=
       static_cast<uint32_t>(PMP::duplicate_non_manifold_vertices(mesh));
-  if (auto s = context.check_stop(); !s.ok()) return s;
+  LABELMESH_RETURN_IF_ERROR(context.check_stop());
 
   // Collinear triangles first: the needle and cap tests assume a real triangle.
   const size_t faces_before = mesh.number_of_faces();
@@ -126,7 +127,7 @@ absl::StatusOr<TriangleMesh> repair(const TriangleMesh& input, const RepairParam
         params.max_collapse_length_mm);
     mesh.collect_garbage();
   }
-  if (auto s = context.check_stop(); !s.ok()) return s;
+  LABELMESH_RETURN_IF_ERROR(context.check_stop());
 
   std::vector<Mesh::Halfedge_index> holes;
   PMP::extract_boundary_cycles(mesh, std::back_inserter(holes));

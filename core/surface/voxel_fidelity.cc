@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "core/surface/surface_statistics.h"
+#include "core/util/status_macros.h"
 #include "core/util/vec3.h"
 #include "core/volume/voxel_access.h"
 
@@ -326,10 +327,10 @@ absl::StatusOr<VoxelFidelity> measure_voxel_fidelity(const TriangleMesh& mesh,
 
   auto box = label_box(volume, label);
   if (!box.ok()) return box.status();
-  if (auto s = context.check_stop(); !s.ok()) return s;
+  LABELMESH_RETURN_IF_ERROR(context.check_stop());
   const std::vector<Vec3> at = index_points(mesh, geometry);
   const Crossings crossings = column_crossings(at, mesh.triangles, *box);
-  if (auto s = context.check_stop(); !s.ok()) return s;
+  LABELMESH_RETURN_IF_ERROR(context.check_stop());
 
   std::vector<Vec3> wrong;
   const auto& b = *box;

@@ -7,6 +7,7 @@
 #include <optional>
 
 #include "absl/strings/str_cat.h"
+#include "core/util/status_macros.h"
 #include "core/volume/header_checks.h"
 
 namespace labelmesh::volume {
@@ -116,7 +117,7 @@ absl::StatusOr<std::array<Vec3, 2>> plane_axes(std::string_view path,
 absl::StatusOr<DicomSegGrid> dicom_seg_grid(std::string_view path,
                                             const internal::DicomSegHeader& header,
                                             const ReadLimits& limits) {
-  if (auto status = check_kind(path, header); !status.ok()) return status;
+  LABELMESH_RETURN_IF_ERROR(check_kind(path, header));
   if (!header.orientation) {
     return field_error(path, "(0020,0037) Image Orientation (Patient)", kNoPatientGeometry);
   }
@@ -142,10 +143,8 @@ absl::StatusOr<DicomSegGrid> dicom_seg_grid(std::string_view path,
   const Vec3 normal = cross(row_dir, column_dir);
   const double column_spacing = (*header.pixel_spacing)[1];  // between columns, along a row
   const double row_spacing = (*header.pixel_spacing)[0];
-  if (auto s = internal::check_spacing(path, "(0028,0030) Pixel Spacing",
-                                       {column_spacing, row_spacing, 1.0});
-      !s.ok())
-    return s;
+  LABELMESH_RETURN_IF_ERROR(internal::check_spacing(path, "(0028,0030) Pixel Spacing",
+                                                    {column_spacing, row_spacing, 1.0}));
 
   // Every frame must share the first one's in-plane origin.
   const double in_plane_tolerance = 0.01 * std::min(column_spacing, row_spacing);
@@ -198,7 +197,7 @@ absl::StatusOr<DicomSegGrid> dicom_seg_grid(std::string_view path,
   }
   ImageGeometry& g = grid.geometry;
   g.dims = {header.columns, header.rows, static_cast<int64_t>(std::llround(extent)) + 1};
-  if (auto s = internal::check_dims(path, "grid", g.dims, limits); !s.ok()) return s;
+  LABELMESH_RETURN_IF_ERROR(internal::check_dims(path, "grid", g.dims, limits));
   g.spacing = {column_spacing, row_spacing, spacing};
   for (int axis = 0; axis < 3; ++axis) g.origin[axis] = positions[0][axis] + normal[axis] * lowest;
   for (int row = 0; row < 3; ++row) {

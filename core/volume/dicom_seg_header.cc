@@ -17,6 +17,7 @@
 #include <fstream>
 #include <limits>
 
+#include "core/util/status_macros.h"
 #include "core/util/text.h"
 #include "core/volume/header_checks.h"
 
@@ -242,7 +243,7 @@ class Walker {
                          cat("is ", e.length, " bytes; at most ", kMaxValueBytes, " are accepted"));
     }
     std::string bytes(e.length, '\0');
-    if (auto s = read(e.value_offset, e.length, bytes.data()); !s.ok()) return s;
+    LABELMESH_RETURN_IF_ERROR(read(e.value_offset, e.length, bytes.data()));
     return std::string(strip(bytes));
   }
 
@@ -261,7 +262,7 @@ class Walker {
     if (e.length != 2) {
       return field_error(path_, tag_name(e.tag), cat("is ", e.length, " bytes; a US value is 2"));
     }
-    if (auto s = read(e.value_offset, 2, raw); !s.ok()) return s;
+    LABELMESH_RETURN_IF_ERROR(read(e.value_offset, 2, raw));
     const auto value = static_cast<uint16_t>(number(raw, 2));
     if (allowed && !allowed(value)) {
       return field_error(path_, tag_name(e.tag), cat("is ", value, need));
@@ -321,9 +322,9 @@ absl::StatusOr<Element> Walker::element_at(uint64_t pos, int depth) {
     }
     return field_error(path_, "data set", cat("the file ends at byte ", pos, " inside a sequence"));
   }
-  if (auto s = span("data set", "an element header", pos, 8); !s.ok()) return s;
+  LABELMESH_RETURN_IF_ERROR(span("data set", "an element header", pos, 8));
   char raw[12];
-  if (auto s = read(pos, 8, raw); !s.ok()) return s;
+  LABELMESH_RETURN_IF_ERROR(read(pos, 8, raw));
   Element e;
   e.tag = number(raw, 2) << 16 | number(raw + 2, 2);
   e.value_offset = pos + 8;
@@ -340,8 +341,8 @@ absl::StatusOr<Element> Walker::element_at(uint64_t pos, int depth) {
     return field_error(path_, tag_name(e.tag),
                        cat("the VR at byte ", pos + 4, " is not one PS3.5 defines"));
   }
-  if (auto s = span(tag_name(e.tag), "an element header", pos, 12); !s.ok()) return s;
-  if (auto s = read(pos + 8, 4, raw + 8); !s.ok()) return s;
+  LABELMESH_RETURN_IF_ERROR(span(tag_name(e.tag), "an element header", pos, 12));
+  LABELMESH_RETURN_IF_ERROR(read(pos + 8, 4, raw + 8));
   e.length = number(raw + 8, 4);
   e.value_offset = pos + 12;
   return e;
@@ -369,7 +370,7 @@ absl::StatusOr<uint64_t> Walker::walk_elements(uint64_t pos, uint64_t end, bool 
                          cat("has VR ", e->vr, "; PS3.6 gives ", known->vr));
     }
     if (depth == 0 && e->tag == kPixelData) {
-      if (auto s = pixel_data(*e); !s.ok()) return s;
+      LABELMESH_RETURN_IF_ERROR(pixel_data(*e));
       return end;
     }
     // Implicit VR: our sequences are known, and an undefined length outside
@@ -389,11 +390,11 @@ absl::StatusOr<uint64_t> Walker::walk_elements(uint64_t pos, uint64_t end, bool 
       return field_error(path_, tag_name(e->tag), "has an undefined length but is not a sequence");
     }
     if (e->value_offset + e->length > std::min({end, max_header_, file_size_})) {
-      if (auto s = span(tag_name(e->tag), "a value", e->value_offset, e->length); !s.ok()) return s;
+      LABELMESH_RETURN_IF_ERROR(span(tag_name(e->tag), "a value", e->value_offset, e->length));
       return field_error(path_, tag_name(e->tag),
                          cat("runs past the end of its item at byte ", end));
     }
-    if (auto s = use_value(*e, scope, groups); !s.ok()) return s;
+    LABELMESH_RETURN_IF_ERROR(use_value(*e, scope, groups));
     pos = e->value_offset + e->length;
   }
   return pos;
@@ -545,15 +546,15 @@ absl::StatusOr<DicomSegHeader> Walker::run() {
   uint64_t pos = 132;
   bool have_syntax = false;
   while (true) {
-    if (auto s = span("file meta information", "an element header", pos, 8); !s.ok()) return s;
+    LABELMESH_RETURN_IF_ERROR(span("file meta information", "an element header", pos, 8));
     char group[2];
-    if (auto s = read(pos, 2, group); !s.ok()) return s;
+    LABELMESH_RETURN_IF_ERROR(read(pos, 2, group));
     if (number(group, 2) != 0x0002) break;
     auto e = element_at(pos, /*depth=*/1);  // never at the end of the file: checked above
     if (!e.ok()) return e.status();
-    if (auto s = span(tag_name(e->tag), "a value", e->value_offset, e->length); !s.ok()) return s;
+    LABELMESH_RETURN_IF_ERROR(span(tag_name(e->tag), "a value", e->value_offset, e->length));
     if (e->tag == kTransferSyntax) {
-      if (auto s = store_text(*e, out_.transfer_syntax_uid); !s.ok()) return s;
+      LABELMESH_RETURN_IF_ERROR(store_text(*e, out_.transfer_syntax_uid));
       have_syntax = true;
     }
     pos = e->value_offset + e->length;

@@ -10,6 +10,7 @@
 #include <limits>
 #include <memory>
 
+#include "core/util/status_macros.h"
 #include "core/util/text.h"
 #include "core/volume/payload_stream.h"
 
@@ -75,7 +76,7 @@ absl::Status check_finite(std::string_view path, std::string_view field, const d
 
 absl::Status normalise_direction(std::string_view path, std::string_view field,
                                  std::array<double, 9>& d) {
-  if (auto status = check_finite(path, field, d.data(), 9); !status.ok()) return status;
+  LABELMESH_RETURN_IF_ERROR(check_finite(path, field, d.data(), 9));
   for (int c = 0; c < 3; ++c) {
     const double norm = std::sqrt(d[c] * d[c] + d[3 + c] * d[3 + c] + d[6 + c] * d[6 + c]);
     if (!(norm > 1e-12)) {

@@ -6,6 +6,7 @@
 // (CGAL's translation keys) when present.
 #include <cmath>
 
+#include "core/util/status_macros.h"
 #include "core/util/text.h"
 #include "core/volume/header_checks.h"
 #include "core/volume/header_formats.h"
@@ -63,7 +64,7 @@ absl::StatusOr<VolumeHeader> check_inr_header(const std::string& path, bool gzip
     }
     dims[axis] = static_cast<int64_t>(*value);
   }
-  if (auto s = check_dims(path, "XDIM/YDIM/ZDIM", dims, limits); !s.ok()) return s;
+  LABELMESH_RETURN_IF_ERROR(check_dims(path, "XDIM/YDIM/ZDIM", dims, limits));
   auto vdim = number_field(path, h, "VDIM", 1.0);
   if (!vdim.ok()) return vdim.status();
   if (*vdim != 1) return field_error(path, "VDIM", "must be 1 for a label volume");
@@ -121,7 +122,7 @@ absl::StatusOr<VolumeHeader> check_inr_header(const std::string& path, bool gzip
     if (!origin.ok()) return origin.status();
     g.origin[axis] = *origin;
   }
-  if (auto s = check_spacing(path, "VX/VY/VZ", g.spacing); !s.ok()) return s;
+  LABELMESH_RETURN_IF_ERROR(check_spacing(path, "VX/VY/VZ", g.spacing));
 
   header.data_path = path;
   header.encoding = gzip ? DataEncoding::kGzip : DataEncoding::kRaw;

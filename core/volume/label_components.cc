@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "core/util/disjoint_sets.h"
+#include "core/util/status_macros.h"
 #include "core/volume/voxel_access.h"
 
 namespace labelmesh::volume {
@@ -168,7 +169,7 @@ absl::StatusOr<Runs> find_runs(const Box& box, const std::vector<uint8_t>& mask,
   result.row_start.reserve(static_cast<size_t>(rows) + 1);
   for (int64_t row = 0; row < rows; ++row) {
     if (row % box.size[1] == 0) {
-      if (auto s = context.check_stop(); !s.ok()) return s;
+      LABELMESH_RETURN_IF_ERROR(context.check_stop());
     }
     result.row_start.push_back(result.runs.size());
     const uint8_t* voxels = mask.data() + row * box.size[0];

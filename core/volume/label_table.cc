@@ -14,6 +14,7 @@
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_split.h"
+#include "core/util/status_macros.h"
 #include "core/util/utf8.h"
 #include "core/volume/header_checks.h"
 
@@ -95,7 +96,7 @@ absl::StatusOr<LabelDescriptions> read_text_table(const std::string& path,
     }
     auto colour = colour_of(path, where, rgb);
     if (!colour.ok()) return colour.status();
-    if (auto s = add_entry(path, where, label, std::move(name), *colour, table); !s.ok()) return s;
+    LABELMESH_RETURN_IF_ERROR(add_entry(path, where, label, std::move(name), *colour, table));
   }
   return table;
 }
@@ -165,7 +166,7 @@ absl::StatusOr<LabelDescriptions> read_json_table(const std::string& path,
     } else {
       return field_error(path, where, "must be a name or an object with a name");
     }
-    if (auto s = add_entry(path, where, label, std::move(name), colour, table); !s.ok()) return s;
+    LABELMESH_RETURN_IF_ERROR(add_entry(path, where, label, std::move(name), colour, table));
   }
   return table;
 }

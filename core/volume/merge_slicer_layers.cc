@@ -12,6 +12,7 @@
 #include <vtkUnsignedShortArray.h>
 
 #include "absl/container/flat_hash_map.h"
+#include "core/util/status_macros.h"
 #include "core/util/text.h"
 #include "core/volume/header_checks.h"
 #include "core/volume/segment_layers.h"
@@ -55,7 +56,7 @@ absl::Status merge_typed(const std::string& path, const T* values, int layers, s
   std::vector<int> here;  // segments set in the current voxel
   for (size_t n = 0; n < voxels; ++n) {
     if ((n & ((size_t{1} << 20) - 1)) == 0) {
-      if (auto s = context.check_stop(); !s.ok()) return s;
+      LABELMESH_RETURN_IF_ERROR(context.check_stop());
     }
     labels[n] = 0;
     here.clear();
@@ -120,7 +121,7 @@ absl::StatusOr<std::vector<vtkSmartPointer<vtkDataArray>>> separate_typed(
       [&](size_t layer, SegmentVoxelSink sink) -> absl::Status {
         for (size_t n = 0; n < voxels; ++n) {
           if ((n & ((size_t{1} << 20) - 1)) == 0) {
-            if (auto s = context.check_stop(); !s.ok()) return s;
+            LABELMESH_RETURN_IF_ERROR(context.check_stop());
           }
           const T value = values[n * layers + layer];
           if (value == 0) continue;

@@ -4,6 +4,7 @@
 // LPS, which is MetaImage's (ITK's) frame.
 #include <cmath>
 
+#include "core/util/status_macros.h"
 #include "core/util/text.h"
 #include "core/volume/header_checks.h"
 #include "core/volume/header_formats.h"
@@ -81,7 +82,7 @@ absl::StatusOr<VolumeHeader> check_metaimage_header(const std::string& path,
   auto whole = whole_sizes(path, "DimSize", *dim_values);
   if (!whole.ok()) return whole.status();
   const std::array<int64_t, 3> dims = *whole;
-  if (auto s = check_dims(path, "DimSize", dims, limits); !s.ok()) return s;
+  LABELMESH_RETURN_IF_ERROR(check_dims(path, "DimSize", dims, limits));
 
   auto element_type = h.find("ElementType");
   if (!element_type) return field_error(path, "ElementType", "is missing");
@@ -112,8 +113,8 @@ absl::StatusOr<VolumeHeader> check_metaimage_header(const std::string& path,
     g.origin[axis] = (*origin)[axis];
     for (int row = 0; row < 3; ++row) g.direction[3 * row + axis] = (*matrix)[3 * axis + row];
   }
-  if (auto s = check_spacing(path, "ElementSpacing", g.spacing); !s.ok()) return s;
-  if (auto s = normalise_direction(path, "TransformMatrix", g.direction); !s.ok()) return s;
+  LABELMESH_RETURN_IF_ERROR(check_spacing(path, "ElementSpacing", g.spacing));
+  LABELMESH_RETURN_IF_ERROR(normalise_direction(path, "TransformMatrix", g.direction));
 
   auto msb = h.find("BinaryDataByteOrderMSB")
                  ? optional_bool(path, h, "BinaryDataByteOrderMSB", false)
@@ -151,7 +152,7 @@ absl::StatusOr<VolumeHeader> check_metaimage_header(const std::string& path,
   }
   if (!*compressed) {
     header.encoding = DataEncoding::kRaw;
-    if (auto s = check_raw_payload(header.data_path, header.file_offset, needed); !s.ok()) return s;
+    LABELMESH_RETURN_IF_ERROR(check_raw_payload(header.data_path, header.file_offset, needed));
     return header;
   }
   header.encoding = DataEncoding::kZlib;

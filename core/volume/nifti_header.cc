@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstring>
 
+#include "core/util/status_macros.h"
 #include "core/util/text.h"
 #include "core/volume/header_checks.h"
 #include "core/volume/header_formats.h"
@@ -126,14 +127,14 @@ absl::StatusOr<ScalarType> nifti_scalar_type(const std::string& path, int dataty
 absl::StatusOr<std::array<double, 12>> nifti_affine(const std::string& path, const NiftiFields& n) {
   std::array<double, 12> a{};
   if (n.sform_code > 0) {
-    if (auto s = check_finite(path, "srow_x/srow_y/srow_z", n.srow, 12); !s.ok()) return s;
+    LABELMESH_RETURN_IF_ERROR(check_finite(path, "srow_x/srow_y/srow_z", n.srow, 12));
     std::copy(n.srow, n.srow + 12, a.begin());
     return a;
   }
   const double qfac = n.pixdim[0] < 0 ? -1.0 : 1.0;
   if (n.qform_code > 0) {
-    if (auto s = check_finite(path, "quatern_b/c/d", n.quatern, 3); !s.ok()) return s;
-    if (auto s = check_finite(path, "qoffset_x/y/z", n.qoffset, 3); !s.ok()) return s;
+    LABELMESH_RETURN_IF_ERROR(check_finite(path, "quatern_b/c/d", n.quatern, 3));
+    LABELMESH_RETURN_IF_ERROR(check_finite(path, "qoffset_x/y/z", n.qoffset, 3));
     const double b = n.quatern[0], c = n.quatern[1], d = n.quatern[2];
     const double sum = b * b + c * c + d * d;
     if (sum > 1.0 + 1e-5) {
@@ -227,13 +228,13 @@ absl::StatusOr<VolumeHeader> check_nifti_header(const std::string& path, bool gz
           cat("is ", n.dim[extra], "; a label volume has one 3-D frame and one component"));
     }
   }
-  if (auto s = check_dims(path, "dim", dims, limits); !s.ok()) return s;
+  LABELMESH_RETURN_IF_ERROR(check_dims(path, "dim", dims, limits));
   auto type = nifti_scalar_type(path, n.datatype, n.bitpix);
   if (!type.ok()) return type.status();
 
   const std::array<double, 3> pixdim{n.pixdim[1], n.pixdim[2], n.pixdim[3]};
   if (n.sform_code <= 0) {
-    if (auto s = check_spacing(path, "pixdim", pixdim); !s.ok()) return s;
+    LABELMESH_RETURN_IF_ERROR(check_spacing(path, "pixdim", pixdim));
   }
   const int minimum_offset = n.version == 1 ? 352 : 544;
   if (!std::isfinite(n.vox_offset) || n.vox_offset < minimum_offset ||
@@ -279,7 +280,7 @@ absl::StatusOr<VolumeHeader> check_nifti_header(const std::string& path, bool gz
                                g.direction[6 + col] * g.direction[6 + col]);
   }
   const char* field = n.sform_code > 0 ? "srow_x/srow_y/srow_z" : "pixdim";
-  if (auto s = check_spacing(path, field, g.spacing); !s.ok()) return s;
+  LABELMESH_RETURN_IF_ERROR(check_spacing(path, field, g.spacing));
   if (auto s = normalise_direction(path, n.sform_code > 0 ? "srow" : "quatern", g.direction);
       !s.ok()) {
     return s;

@@ -9,6 +9,7 @@
 #include <utility>
 #include <vector>
 
+#include "core/util/status_macros.h"
 #include "core/util/text.h"
 #include "core/volume/header_checks.h"
 #include "core/volume/header_formats.h"
@@ -111,7 +112,7 @@ absl::StatusOr<NrrdAxes> nrrd_sizes(const std::string& path, const TextHeader& h
   auto whole = whole_sizes(path, "sizes", *sizes);
   if (!whole.ok()) return whole.status();
   axes.dims = *whole;
-  if (auto s = check_dims(path, "sizes", axes.dims, limits); !s.ok()) return s;
+  LABELMESH_RETURN_IF_ERROR(check_dims(path, "sizes", axes.dims, limits));
   const auto voxels = static_cast<uint64_t>(axes.dims[0] * axes.dims[1] * axes.dims[2]);
   if (voxels > limits.max_voxels / static_cast<uint64_t>(axes.layers)) {
     return field_error(path, "sizes",
@@ -190,7 +191,7 @@ absl::StatusOr<VolumeHeader> check_nrrd_header(const std::string& path, const Re
   if (!type_name) return field_error(path, "type", "is missing");
   auto type = nrrd_scalar_type(path, *type_name);
   if (!type.ok()) return type.status();
-  if (auto s = check_kinds(path, h, layered); !s.ok()) return s;
+  LABELMESH_RETURN_IF_ERROR(check_kinds(path, h, layered));
   for (std::string_view skip : {"byte skip", "byteskip", "line skip", "lineskip"}) {
     if (auto value = h.find(skip); value && *value != "0") {
       return field_error(path, skip, "skipping data before the voxels is not supported");
@@ -230,15 +231,15 @@ absl::StatusOr<VolumeHeader> check_nrrd_header(const std::string& path, const Re
       }
       g.spacing[axis] = std::sqrt(norm2);
     }
-    if (auto s = check_spacing(path, "space directions", g.spacing); !s.ok()) return s;
-    if (auto s = normalise_direction(path, "space directions", g.direction); !s.ok()) return s;
+    LABELMESH_RETURN_IF_ERROR(check_spacing(path, "space directions", g.spacing));
+    LABELMESH_RETURN_IF_ERROR(normalise_direction(path, "space directions", g.direction));
   } else if (auto all_spacings = h.find("spacings")) {
     auto spacings = grid_part(*all_spacings, layered);
     if (!spacings) return field_error(path, "spacings", "the list axis must come first, as nan");
     auto values = parse_numbers(path, "spacings", *spacings, 3);
     if (!values.ok()) return values.status();
     g.spacing = {(*values)[0], (*values)[1], (*values)[2]};
-    if (auto s = check_spacing(path, "spacings", g.spacing); !s.ok()) return s;
+    LABELMESH_RETURN_IF_ERROR(check_spacing(path, "spacings", g.spacing));
   }
   if (auto origin = h.find("space origin")) {
     auto values = parse_numbers(path, "space origin", *origin, 3);
@@ -286,7 +287,7 @@ absl::StatusOr<VolumeHeader> check_nrrd_header(const std::string& path, const Re
 
   const uint64_t needed = header.data_bytes();
   if (header.encoding == DataEncoding::kRaw) {
-    if (auto s = check_raw_payload(header.data_path, header.file_offset, needed); !s.ok()) return s;
+    LABELMESH_RETURN_IF_ERROR(check_raw_payload(header.data_path, header.file_offset, needed));
     return header;
   }
   if (auto s = check_encoded_payload(header.data_path, header.file_offset, DataEncoding::kGzip, 0,

@@ -20,6 +20,7 @@
 #include <vtkUnsignedShortArray.h>
 
 #include "absl/strings/str_cat.h"
+#include "core/util/status_macros.h"
 #include "core/util/utf8.h"
 #include "core/volume/dicom_seg_grid.h"
 #include "core/volume/header_checks.h"
@@ -96,7 +97,7 @@ absl::StatusOr<LabelVolume> read_dicom_seg(const std::string& path, const ReadLi
   if (!header.ok()) return header.status();
   auto grid = dicom_seg_grid(path, *header, limits);
   if (!grid.ok()) return grid.status();
-  if (auto s = context.check_stop(); !s.ok()) return s;
+  LABELMESH_RETURN_IF_ERROR(context.check_stop());
 
   DcmFileFormat file;
   if (file.loadFile(path.c_str()).bad())
@@ -156,7 +157,7 @@ absl::StatusOr<LabelVolume> read_dicom_seg(const std::string& path, const ReadLi
         voxel = segment;
     }
     if ((f & 63) == 0) {
-      if (auto s = context.check_stop(); !s.ok()) return s;
+      LABELMESH_RETURN_IF_ERROR(context.check_stop());
     }
   }
   if (!shared.empty() && !limits.separate_overlapping) {
@@ -202,7 +203,7 @@ absl::StatusOr<LabelVolume> read_dicom_seg(const std::string& path, const ReadLi
         [&](size_t segment, SegmentVoxelSink sink) -> absl::Status {
           for (uint32_t f : frames_of[segment]) {
             if ((frames_visited++ & 63) == 0) {
-              if (auto s = context.check_stop(); !s.ok()) return s;
+              LABELMESH_RETURN_IF_ERROR(context.check_stop());
             }
             const uint64_t slice_start = uint64_t(grid->frame_slice[f]) * frame_pixels;
             const uint64_t first = uint64_t(f) * frame_pixels;

@@ -13,6 +13,7 @@
 #include <vtkPointData.h>
 #include <vtkXMLImageDataReader.h>
 
+#include "core/util/status_macros.h"
 #include "core/util/text.h"
 #include "core/util/vtk_error_flag.h"
 #include "core/volume/header_checks.h"
@@ -184,7 +185,7 @@ absl::StatusOr<vtkSmartPointer<vtkDataArray>> to_label_array(const std::string& 
 
 absl::StatusOr<LabelVolume> read_label_volume(const std::string& path, const ReadLimits& limits,
                                               const RunContext& context) {
-  if (auto s = context.check_stop(); !s.ok()) return s;
+  LABELMESH_RETURN_IF_ERROR(context.check_stop());
   if (format_of_file(path) == ImageFormat::kDicomSeg) return read_dicom_seg(path, limits, context);
   auto header = check_volume_header(path, limits);
   if (!header.ok()) return header.status();
@@ -199,7 +200,7 @@ absl::StatusOr<LabelVolume> read_label_volume(const std::string& path, const Rea
       decoded->array->GetNumberOfTuples() != header->geometry.voxel_count() * header->layers) {
     return field_error(path, "voxel data", "does not hold one value per voxel");
   }
-  if (auto s = context.check_stop(); !s.ok()) return s;
+  LABELMESH_RETURN_IF_ERROR(context.check_stop());
   auto labels = to_label_array(path, *header, decoded->array);
   if (!labels.ok()) return labels.status();
 

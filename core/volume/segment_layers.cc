@@ -8,6 +8,7 @@
 #include <vtkIntArray.h>
 #include <vtkUnsignedShortArray.h>
 
+#include "core/util/status_macros.h"
 #include "core/util/text.h"
 #include "core/volume/header_checks.h"
 
@@ -46,7 +47,7 @@ absl::StatusOr<std::vector<vtkSmartPointer<vtkDataArray>>> separate_typed(
     layer_voxels.push_back(data);
     return absl::OkStatus();
   };
-  if (auto s = add_layer(); !s.ok()) return s;
+  LABELMESH_RETURN_IF_ERROR(add_layer());
 
   const size_t segments = labels.size();
   // Per segment: the layers where one of its voxels is taken, bit k for
@@ -56,7 +57,7 @@ absl::StatusOr<std::vector<vtkSmartPointer<vtkDataArray>>> separate_typed(
   std::vector<size_t> in_group;  // segments seen in the current group
   bool out_of_range = false;
   for (size_t group = 0; group < groups; ++group) {
-    if (auto s = context.check_stop(); !s.ok()) return s;
+    LABELMESH_RETURN_IF_ERROR(context.check_stop());
     in_group.clear();
     const uint64_t existing =
         layers.size() >= 64 ? ~uint64_t{0} : (uint64_t{1} << layers.size()) - 1;
@@ -79,7 +80,7 @@ absl::StatusOr<std::vector<vtkSmartPointer<vtkDataArray>>> separate_typed(
     for (size_t segment : in_group) {
       const int k = std::countr_one(blocked[segment]);
       if (k == static_cast<int>(layers.size())) {
-        if (auto s = add_layer(); !s.ok()) return s;
+        LABELMESH_RETURN_IF_ERROR(add_layer());
       }
       placed[segment] = k;
     }

@@ -7,6 +7,7 @@
 #include <set>
 #include <utility>
 
+#include "core/util/status_macros.h"
 #include "core/util/text.h"
 #include "core/util/utf8.h"
 #include "core/volume/header_checks.h"
@@ -238,7 +239,7 @@ absl::StatusOr<std::vector<SlicerSegment>> parse_slicer_segments(
     if (!segment.ok()) return segment.status();
     segments.push_back(std::move(*segment));
   }
-  if (auto s = check_distinct_values(path, segments); !s.ok()) return s;
+  LABELMESH_RETURN_IF_ERROR(check_distinct_values(path, segments));
   const std::vector<int32_t> labels = slicer_labels(segments);
   for (size_t i = 0; i < segments.size(); ++i) segments[i].description.label = labels[i];
   return segments;

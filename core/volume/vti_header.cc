@@ -7,6 +7,7 @@
 #include <cmath>
 #include <optional>
 
+#include "core/util/status_macros.h"
 #include "core/util/text.h"
 #include "core/volume/header_checks.h"
 #include "core/volume/header_formats.h"
@@ -78,7 +79,7 @@ absl::StatusOr<VolumeHeader> check_vti_header(const std::string& path, const Rea
     }
     dims[axis] = static_cast<int64_t>(hi - lo) + 1;
   }
-  if (auto s = check_dims(path, "WholeExtent", dims, limits); !s.ok()) return s;
+  LABELMESH_RETURN_IF_ERROR(check_dims(path, "WholeExtent", dims, limits));
 
   VolumeHeader header;
   header.format = ImageFormat::kVti;
@@ -90,12 +91,12 @@ absl::StatusOr<VolumeHeader> check_vti_header(const std::string& path, const Rea
     if (!values.ok()) return values.status();
     g.spacing = {(*values)[0], (*values)[1], (*values)[2]};
   }
-  if (auto s = check_spacing(path, "Spacing", g.spacing); !s.ok()) return s;
+  LABELMESH_RETURN_IF_ERROR(check_spacing(path, "Spacing", g.spacing));
   if (auto text = find_attribute(*image, "Direction")) {
     auto values = parse_numbers(path, "Direction", *text, 9);
     if (!values.ok()) return values.status();
     std::copy(values->begin(), values->end(), g.direction.begin());
-    if (auto s = normalise_direction(path, "Direction", g.direction); !s.ok()) return s;
+    LABELMESH_RETURN_IF_ERROR(normalise_direction(path, "Direction", g.direction));
   }
   std::array<double, 3> vtk_origin{0, 0, 0};
   if (auto text = find_attribute(*image, "Origin")) {
@@ -111,8 +112,7 @@ absl::StatusOr<VolumeHeader> check_vti_header(const std::string& path, const Rea
     }
   }
   // A far extent start times a large spacing can leave the finite doubles.
-  if (auto s = check_finite(path, "Origin/WholeExtent/Spacing", g.origin.data(), 3); !s.ok())
-    return s;
+  LABELMESH_RETURN_IF_ERROR(check_finite(path, "Origin/WholeExtent/Spacing", g.origin.data(), 3));
 
   const size_t point_data = xml.find("<PointData");
   if (point_data == std::string_view::npos) {

@@ -17,6 +17,7 @@
 #include <vtkPointData.h>
 #include <vtkXMLImageDataWriter.h>
 
+#include "core/util/status_macros.h"
 #include "core/util/text.h"
 #include "core/util/vtk_error_flag.h"
 #include "core/volume/volume_header.h"
@@ -106,7 +107,7 @@ absl::Status write_metaimage(const LabelVolume& volume, const std::string& path,
   }
   const std::string raw = raw_name_for(path);
   h << "ElementDataFile = " << raw << "\n";
-  if (auto s = write_bytes(path, h.str(), nullptr, 0, false); !s.ok()) return s;
+  LABELMESH_RETURN_IF_ERROR(write_bytes(path, h.str(), nullptr, 0, false));
   const auto raw_path = (std::filesystem::path(path).parent_path() / raw).string();
   return write_bytes(raw_path, "", array->GetVoidPointer(0), bytes, false);
 }
@@ -134,7 +135,7 @@ absl::Status write_nrrd(const LabelVolume& volume, const std::string& path, bool
   }
   const std::string raw = raw_name_for(path);
   h << "data file: " << raw << "\n";
-  if (auto s = write_bytes(path, h.str(), nullptr, 0, false); !s.ok()) return s;
+  LABELMESH_RETURN_IF_ERROR(write_bytes(path, h.str(), nullptr, 0, false));
   const auto raw_path = (std::filesystem::path(path).parent_path() / raw).string();
   return write_bytes(raw_path, "", array->GetVoidPointer(0), bytes, false);
 }

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "core/util/disjoint_sets.h"
+#include "core/util/status_macros.h"
 #include "core/util/text.h"
 #include "core/util/vec3.h"
 #include "core/volume_mesh/tetgen_call.h"
@@ -204,7 +205,7 @@ absl::StatusOr<std::vector<Vec3>> cavity_points(const Boundary& boundary, const 
 absl::StatusOr<TetMesh> run(const surface::TriangleMesh& mesh, int32_t label,
                             const TetgenParams& params, const std::vector<Vec3>* known_holes,
                             const RunContext& context, TetgenFigures& figures) {
-  if (auto status = check_tetgen_params(params); !status.ok()) return status;
+  LABELMESH_RETURN_IF_ERROR(check_tetgen_params(params));
   const std::string what = cat("the surface of label ", label);
   auto boundary = used_boundary(mesh, label);
   if (!boundary.ok()) return boundary.status();
@@ -215,7 +216,7 @@ absl::StatusOr<TetMesh> run(const surface::TriangleMesh& mesh, int32_t label,
         cat("the surface of label ", label,
             " encloses no volume: it is wound inwards or flat (normals must point out)"));
   }
-  if (auto status = context.check_stop(); !status.ok()) return status;
+  LABELMESH_RETURN_IF_ERROR(context.check_stop());
   context.report(kStage, 0);
 
   tetgenio in;
@@ -224,14 +225,14 @@ absl::StatusOr<TetMesh> run(const surface::TriangleMesh& mesh, int32_t label,
   // -d reports intersecting facets instead of failing, which TetGen 1.5.0 cannot do safely.
   {
     tetgenio check;
-    if (auto status = run_tetgen("pdzQ", in, check, what); !status.ok()) return status;
+    LABELMESH_RETURN_IF_ERROR(run_tetgen("pdzQ", in, check, what));
     if (check.numberoftrifaces > 0) {
       return absl::FailedPreconditionError(cat("tetgen: the surface of label ", label,
                                                " intersects itself (", check.numberoftrifaces,
                                                " of its triangles cross others)"));
     }
   }
-  if (auto status = context.check_stop(); !status.ok()) return status;
+  LABELMESH_RETURN_IF_ERROR(context.check_stop());
   context.report(kStage, 0.2);
 
   if (known_holes != nullptr || component_count(*boundary) > 1) {
@@ -240,7 +241,7 @@ absl::StatusOr<TetMesh> run(const surface::TriangleMesh& mesh, int32_t label,
       holes = *known_holes;
     } else {
       tetgenio cdt;
-      if (auto status = run_tetgen("pzQ", in, cdt, what); !status.ok()) return status;
+      LABELMESH_RETURN_IF_ERROR(run_tetgen("pzQ", in, cdt, what));
       holes = cavity_points(*boundary, cdt, label);
     }
     if (!holes.ok()) return holes.status();
@@ -251,14 +252,14 @@ absl::StatusOr<TetMesh> run(const surface::TriangleMesh& mesh, int32_t label,
         for (int k = 0; k < 3; ++k) in.holelist[3 * i + k] = (*holes)[i][k];
       }
     }
-    if (auto status = context.check_stop(); !status.ok()) return status;
+    LABELMESH_RETURN_IF_ERROR(context.check_stop());
     context.report(kStage, 0.4);
   }
 
   const std::string switches = tetgen_quality_switches(params) + "zQ";
   tetgenio out;
-  if (auto status = run_tetgen(switches, in, out, what); !status.ok()) return status;
-  if (auto status = context.check_stop(); !status.ok()) return status;
+  LABELMESH_RETURN_IF_ERROR(run_tetgen(switches, in, out, what));
+  LABELMESH_RETURN_IF_ERROR(context.check_stop());
 
   if (out.numberofcorners != 4 || out.numberoftetrahedra <= 0 || out.tetrahedronlist == nullptr) {
     return absl::InternalError(cat("tetgen: produced no tetrahedra for label ", label));

@@ -25,6 +25,7 @@
 #include <vtkXMLUnstructuredGridWriter.h>
 
 #include "core/util/name_slug.h"
+#include "core/util/status_macros.h"
 #include "core/util/text.h"
 #include "core/util/text_file.h"
 #include "core/util/vtk_error_flag.h"
@@ -82,8 +83,7 @@ absl::Status write_interfaces_vtu(const TetMesh& mesh, const VolumeFileInfo& inf
 absl::Status write_vtu(const TetMesh& mesh, const std::vector<double>& quality,
                        const VolumeFileInfo& info, const std::string& path) {
   if (info.interfaces != nullptr) {
-    if (auto status = write_interfaces_vtu(mesh, info, interfaces_vtu_path(path)); !status.ok())
-      return status;
+    LABELMESH_RETURN_IF_ERROR(write_interfaces_vtu(mesh, info, interfaces_vtu_path(path)));
   }
   vtkNew<vtkCellArray> cells;
   cells->AllocateExact(static_cast<vtkIdType>(mesh.tetrahedra.size()),
@@ -114,7 +114,7 @@ absl::Status write_vtu(const TetMesh& mesh, const std::vector<double>& quality,
 // Gmsh MSH 2.2 ASCII (Gmsh reference manual, "Legacy formats: MSH file format version 2").
 absl::Status write_msh(const TetMesh& mesh, const std::vector<double>& quality,
                        const VolumeFileInfo& info, const std::string& path) {
-  if (auto status = check_positive_labels(mesh.labels, path, "MSH"); !status.ok()) return status;
+  LABELMESH_RETURN_IF_ERROR(check_positive_labels(mesh.labels, path, "MSH"));
   std::optional<Interfaces> interfaces;
   std::vector<std::string> surface_names;
   if (info.interfaces != nullptr) {
@@ -192,7 +192,7 @@ absl::Status write_medit(const TetMesh& mesh, const VolumeFileInfo& info, const 
 // S1 = 1-2-3, S2 = 1-4-2, S3 = 2-4-3, S4 = 3-4-1; indexed here by the omitted local node.
 absl::Status write_abaqus(const TetMesh& mesh, const VolumeFileInfo& info,
                           const std::string& path) {
-  if (auto status = check_positive_labels(mesh.labels, path, "INP"); !status.ok()) return status;
+  LABELMESH_RETURN_IF_ERROR(check_positive_labels(mesh.labels, path, "INP"));
   static constexpr std::array<int, 4> kFaceByOmittedNode{3, 4, 2, 1};
   const auto labels = distinct_labels(mesh.labels);
   const auto faces = label_boundary_faces(mesh);
@@ -256,7 +256,7 @@ absl::Status write_tetgen(const TetMesh& mesh, const VolumeFileInfo& info,
       const auto p = in_frame(mesh.points[i], info.frame);
       file << i + 1 << ' ' << p[0] << ' ' << p[1] << ' ' << p[2] << '\n';
     }
-    if (auto status = file.finish(); !status.ok()) return status;
+    LABELMESH_RETURN_IF_ERROR(file.finish());
   }
   TextFile file(ele_path, "the volume mesh");
   file << "# labelmesh: tetrahedra numbered from 1; the region attribute is the label\n";

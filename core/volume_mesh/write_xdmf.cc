@@ -3,6 +3,7 @@
 // XML text: one file, no HDF5, read by meshio, ParaView and dolfinx.
 #include <string_view>
 
+#include "core/util/status_macros.h"
 #include "core/util/text_file.h"
 #include "core/volume_mesh/mesh_file_parts.h"
 
@@ -83,7 +84,7 @@ absl::Status write_facets(const TetMesh& mesh, const VolumeFileInfo& info,
 absl::Status write_xdmf(const TetMesh& mesh, const std::vector<double>& quality,
                         const VolumeFileInfo& info, const std::string& path) {
   if (info.interfaces != nullptr) {
-    if (auto status = write_facets(mesh, info, facets_xdmf_path(path)); !status.ok()) return status;
+    LABELMESH_RETURN_IF_ERROR(write_facets(mesh, info, facets_xdmf_path(path)));
   }
   TextFile file(path, "the volume mesh");
   head(file, info);

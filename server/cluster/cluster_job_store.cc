@@ -6,6 +6,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/digest/sha256.h"
+#include "core/util/status_macros.h"
 #include "server/durable_file.h"
 #include "server/spool.h"
 #include "spdlog/spdlog.h"
@@ -75,9 +76,8 @@ absl::StatusOr<uint32_t> ClusterJobStore::accept(v1::JobRecord record,
   }
   if (existing.status().code() != absl::StatusCode::kNotFound) return existing.status();
   record.mutable_job()->set_state(v1::JOB_STATE_QUEUED);
-  if (auto status = files_.put(absl::StrCat("jobs/", id, "/job.pb"), record.SerializeAsString());
-      !status.ok())
-    return status;
+  LABELMESH_RETURN_IF_ERROR(
+      files_.put(absl::StrCat("jobs/", id, "/job.pb"), record.SerializeAsString()));
   fs::rename(upload_path, absl::StrCat(files_.job_dir(id), "/input", record.input_extension()),
              error);
   if (error) return spool_io_error("cannot move the upload into its job", error.value());

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 #include "server/cluster/cluster_jobs.h"
 
+#include "core/util/status_macros.h"
+
 #include "absl/strings/str_cat.h"
 #include "server/job_events.h"
 
@@ -47,7 +49,7 @@ absl::StatusOr<v1::JobRecord> ClusterJobs::change_record(const std::string& job_
     if (!stored.ok()) return stored.status();
     auto record = parse(*stored, job_id);
     if (!record.ok()) return record.status();
-    if (auto status = change(*record); !status.ok()) return status;
+    LABELMESH_RETURN_IF_ERROR(change(*record));
     auto written = states_.update(job_id, record->SerializeAsString(), stored->revision);
     if (written.ok()) return record;
     if (written.status().code() != absl::StatusCode::kAborted) return written.status();
@@ -80,7 +82,7 @@ absl::StatusOr<v1::JobRecord> ClusterJobs::submit(v1::JobRecord record) {
     (void)states_.remove(job_id);
     return queued.status();
   }
-  if (auto status = log_state(record); !status.ok()) return status;
+  LABELMESH_RETURN_IF_ERROR(log_state(record));
   return record;
 }
 
@@ -117,7 +119,7 @@ absl::StatusOr<Claim> ClusterJobs::claim(const std::string& job_id, const Delive
     return absl::OkStatus();
   });
   if (!record.ok()) return record.status();
-  if (auto status = log_state(*record); !status.ok()) return status;
+  LABELMESH_RETURN_IF_ERROR(log_state(*record));
   claim.record = std::move(*record);
   return claim;
 }
@@ -141,7 +143,7 @@ absl::StatusOr<v1::JobRecord> ClusterJobs::finish(const Claim& claim, v1::JobSta
     return absl::OkStatus();
   });
   if (!record.ok()) return record.status();
-  if (auto status = log_state(*record); !status.ok()) return status;
+  LABELMESH_RETURN_IF_ERROR(log_state(*record));
   return record;
 }
 
@@ -162,7 +164,7 @@ absl::StatusOr<v1::JobRecord> ClusterJobs::cancel(const std::string& job_id) {
   });
   if (!record.ok()) return record.status();
   if (record->job().state() == v1::JOB_STATE_CANCELLED) {
-    if (auto status = log_state(*record); !status.ok()) return status;
+    LABELMESH_RETURN_IF_ERROR(log_state(*record));
   }
   return record;
 }
@@ -185,12 +187,12 @@ absl::StatusOr<bool> ClusterJobs::remove(const std::string& job_id) {
   });
   if (!record.ok()) return record.status();
   if (running) return false;
-  if (auto status = erase(job_id); !status.ok()) return status;
+  LABELMESH_RETURN_IF_ERROR(erase(job_id));
   return true;
 }
 
 absl::Status ClusterJobs::erase(const std::string& job_id) {
-  if (auto status = states_.remove(job_id); !status.ok()) return status;
+  LABELMESH_RETURN_IF_ERROR(states_.remove(job_id));
   return events_.remove(job_id);
 }
 
@@ -205,7 +207,7 @@ absl::Status ClusterJobs::requeue(const Claim& claim) {
     return absl::OkStatus();
   });
   if (!record.ok()) return record.status();
-  if (auto status = log_state(*record); !status.ok()) return status;
+  LABELMESH_RETURN_IF_ERROR(log_state(*record));
   return queue_
       .enqueue(claim.job_id, absl::StrCat(queue_key(claim.record), "@", claim.attempt),
                made(claim.record))
@@ -230,7 +232,7 @@ absl::StatusOr<bool> ClusterJobs::give_up(const std::string& job_id, double star
   });
   if (!record.ok()) return record.status();
   if (gave_up) {
-    if (auto status = log_state(*record); !status.ok()) return status;
+    LABELMESH_RETURN_IF_ERROR(log_state(*record));
   }
   return gave_up;
 }

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 #include "server/cluster/cluster_worker.h"
 
+#include "core/util/status_macros.h"
+
 #include <future>
 
 namespace labelmesh::cluster {
@@ -16,7 +18,7 @@ absl::StatusOr<bool> ClusterWorker::run_one() {
   if (claim.status().code() == absl::StatusCode::kFailedPrecondition ||
       claim.status().code() == absl::StatusCode::kNotFound) {
     // Ended, or deleted: nothing to run, and nothing to deliver again.
-    if (auto status = delivery.ack(); !status.ok()) return status;
+    LABELMESH_RETURN_IF_ERROR(delivery.ack());
     return true;
   }
   if (!claim.ok()) return claim.status();
@@ -44,7 +46,7 @@ absl::StatusOr<bool> ClusterWorker::run_one() {
     auto requeued = jobs_.requeue(*claim);
     // Taken over meanwhile: the other attempt has it.
     if (!requeued.ok() && requeued.code() != absl::StatusCode::kAborted) return requeued;
-    if (auto status = delivery.ack(); !status.ok()) return status;
+    LABELMESH_RETURN_IF_ERROR(delivery.ack());
     return true;
   }
   auto ended = jobs_.finish(*claim, outcome.state, outcome.result);
@@ -53,12 +55,12 @@ absl::StatusOr<bool> ClusterWorker::run_one() {
     return true;
   }
   if (ended.status().code() == absl::StatusCode::kNotFound) {
-    if (auto status = delivery.ack(); !status.ok()) return status;
+    LABELMESH_RETURN_IF_ERROR(delivery.ack());
     return true;
   }
   if (!ended.ok()) return ended.status();
   if (ended_) ended_(*claim, ended);
-  if (auto status = delivery.ack(); !status.ok()) return status;
+  LABELMESH_RETURN_IF_ERROR(delivery.ack());
   return true;
 }
 

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 #include "server/cluster/event_log.h"
 
+#include "core/util/status_macros.h"
+
 #include <mutex>
 
 #include "absl/strings/str_cat.h"
@@ -72,7 +74,7 @@ absl::StatusOr<std::unique_ptr<EventLog>> EventLog::open(NatsClient& client,
   stream.Retention = js_LimitsPolicy;
   stream.Storage = js_FileStorage;
   stream.MaxAge = absl::ToInt64Nanoseconds(config.max_age);
-  if (auto status = add_stream(client, stream); !status.ok()) return status;
+  LABELMESH_RETURN_IF_ERROR(add_stream(client, stream));
   return std::unique_ptr<EventLog>(new EventLog(client, config));
 }
 

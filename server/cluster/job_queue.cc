@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 #include "server/cluster/job_queue.h"
 
+#include "core/util/status_macros.h"
+
 #include "absl/strings/str_cat.h"
 
 namespace labelmesh::cluster {
@@ -44,7 +46,7 @@ absl::StatusOr<std::unique_ptr<JobQueue>> JobQueue::open(NatsClient& client,
   stream.Retention = js_WorkQueuePolicy;
   stream.Storage = js_FileStorage;
   stream.Duplicates = absl::ToInt64Nanoseconds(config.duplicate_window);
-  if (auto status = add_stream(client, stream); !status.ok()) return status;
+  LABELMESH_RETURN_IF_ERROR(add_stream(client, stream));
 
   jsSubOptions options;
   jsSubOptions_Init(&options);
