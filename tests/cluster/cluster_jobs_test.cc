@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "cluster/cluster_node.h"
+#include "support/status_matchers.h"
 #include "support/test_files.h"
 
 namespace labelmesh::cluster {
@@ -38,7 +39,7 @@ TEST(ClusterJobs, ARetriedSubmitGivesTheSameJobQueuedOnce) {
   Node frontend(server), other_frontend(server);
   ASSERT_TRUE(frontend.jobs->submit(new_job("j1")).ok());
   auto again = other_frontend.jobs->submit(new_job("j1"));
-  ASSERT_TRUE(again.ok()) << again.status();
+  ASSERT_THAT(again, testing::IsOk());
   EXPECT_EQ(again->job().state(), v1::JOB_STATE_QUEUED);
   EXPECT_EQ(frontend.queue->stored().value(), 1u);
 }
@@ -53,7 +54,7 @@ TEST(ClusterJobs, ALateResultFromAWorkerThatLostItsJobIsRefused) {
   auto first = a.queue->take(absl::Seconds(2));
   ASSERT_TRUE(first.ok() && first->has_value());
   auto a_claim = a.jobs->claim("j1");
-  ASSERT_TRUE(a_claim.ok()) << a_claim.status();
+  ASSERT_THAT(a_claim, testing::IsOk());
   EXPECT_EQ(a_claim->attempt, 1u);
   auto second = b.queue->take(absl::Seconds(5));
   ASSERT_TRUE(second.ok() && second->has_value());
@@ -68,7 +69,7 @@ TEST(ClusterJobs, ALateResultFromAWorkerThatLostItsJobIsRefused) {
   EXPECT_TRUE((*second)->ack().ok());
   // A comes back late: its result is refused and the job stays B's.
   const auto late = a.jobs->finish(*a_claim, v1::JOB_STATE_FAILED, {});
-  EXPECT_EQ(late.status().code(), absl::StatusCode::kAborted) << late.status();
+  EXPECT_THAT(late, testing::StatusIs(absl::StatusCode::kAborted)) << late.status();
   const auto job = frontend.jobs->get("j1").value();
   EXPECT_EQ(job.job().state(), v1::JOB_STATE_SUCCEEDED);
   EXPECT_EQ(job.job().attempts(), 2u);

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "cluster/nats_server.h"
+#include "support/status_matchers.h"
 #include "support/test_files.h"
 
 namespace labelmesh::cluster {
@@ -13,13 +14,13 @@ namespace {
 
 std::unique_ptr<NatsClient> connect(const testing::NatsServer& server) {
   auto client = NatsClient::connect(server.url(), "labelmesh-test", absl::Seconds(5));
-  EXPECT_TRUE(client.ok()) << client.status();
+  EXPECT_THAT(client, testing::IsOk());
   return client.ok() ? std::move(*client) : nullptr;
 }
 
 std::unique_ptr<EventLog> open_log(NatsClient& client) {
   auto log = EventLog::open(client, {});
-  EXPECT_TRUE(log.ok()) << log.status();
+  EXPECT_THAT(log, testing::IsOk());
   return log.ok() ? std::move(*log) : nullptr;
 }
 
@@ -53,7 +54,7 @@ TEST(EventLog, AnotherFrontendFollowsAJobFromAnyPoint) {
   EXPECT_LT(sequences[1], sequences[2]);
 
   auto from_start = frontend->follow("job-a", 0);
-  ASSERT_TRUE(from_start.ok()) << from_start.status();
+  ASSERT_THAT(from_start, testing::IsOk());
   auto first = (*from_start)->next(absl::Seconds(2));
   ASSERT_TRUE(first.ok() && first->has_value());
   EXPECT_EQ((*first)->data, "queued");

@@ -8,6 +8,7 @@
 
 #include "cluster/nats_server.h"
 #include "server/cluster/job_states.h"
+#include "support/status_matchers.h"
 #include "support/test_files.h"
 
 namespace labelmesh::cluster {
@@ -18,7 +19,7 @@ struct Cluster {
 
   std::unique_ptr<NatsClient> client() {
     auto client = NatsClient::connect(server.url(), "labelmesh-test", absl::Seconds(5));
-    EXPECT_TRUE(client.ok()) << client.status();
+    EXPECT_THAT(client, testing::IsOk());
     return client.ok() ? std::move(*client) : nullptr;
   }
 
@@ -34,7 +35,7 @@ JobQueueConfig quick(absl::Duration ack_wait = absl::Seconds(30), int max_delive
 
 std::unique_ptr<JobQueue> open_queue(NatsClient& client, const JobQueueConfig& config) {
   auto queue = JobQueue::open(client, config);
-  EXPECT_TRUE(queue.ok()) << queue.status();
+  EXPECT_THAT(queue, testing::IsOk());
   return queue.ok() ? std::move(*queue) : nullptr;
 }
 
@@ -155,10 +156,10 @@ TEST(JobStates, AStaleWriterIsRefused) {
   auto client = cluster.client();
   ASSERT_NE(client, nullptr);
   auto states = JobStates::open(*client, "labelmesh_jobs");
-  ASSERT_TRUE(states.ok()) << states.status();
+  ASSERT_THAT(states, testing::IsOk());
   auto& table = **states;
   const auto created = table.create("job-a", "queued");
-  ASSERT_TRUE(created.ok()) << created.status();
+  ASSERT_THAT(created, testing::IsOk());
   EXPECT_EQ(table.create("job-a", "queued").status().code(), absl::StatusCode::kAlreadyExists);
 
   // Two workers read the same revision; the first to write wins.
@@ -166,9 +167,9 @@ TEST(JobStates, AStaleWriterIsRefused) {
   EXPECT_EQ(seen.value, "queued");
   EXPECT_EQ(seen.revision, *created);
   const auto running = table.update("job-a", "running on worker 2", seen.revision);
-  ASSERT_TRUE(running.ok()) << running.status();
+  ASSERT_THAT(running, testing::IsOk());
   const auto stale = table.update("job-a", "finished by worker 1", seen.revision);
-  EXPECT_EQ(stale.status().code(), absl::StatusCode::kAborted) << stale.status();
+  EXPECT_THAT(stale, testing::StatusIs(absl::StatusCode::kAborted)) << stale.status();
   EXPECT_EQ(table.get("job-a").value().value, "running on worker 2");
 
   EXPECT_TRUE(table.remove("job-a").ok());
@@ -181,14 +182,14 @@ TEST(NatsClient, NoServerIsUnavailable) {
   const std::string url = server.url();
   server.stop();
   auto client = NatsClient::connect(url, "labelmesh-test", absl::Milliseconds(500));
-  EXPECT_EQ(client.status().code(), absl::StatusCode::kUnavailable) << client.status();
+  EXPECT_THAT(client, testing::StatusIs(absl::StatusCode::kUnavailable)) << client.status();
 }
 
 // An unanswered call (NATS away, the client reconnecting) is UNAVAILABLE, what
 // clients retry, not DEADLINE_EXCEEDED, which is for their own deadlines.
 TEST(NatsClient, AnUnansweredCallIsUnavailable) {
   const absl::Status status = nats_error(NATS_TIMEOUT, "publish job-x");
-  EXPECT_EQ(status.code(), absl::StatusCode::kUnavailable);
+  EXPECT_THAT(status, testing::StatusIs(absl::StatusCode::kUnavailable));
   EXPECT_NE(std::string(status.message()).find("publish job-x"), std::string::npos) << status;
   EXPECT_EQ(nats_error(NATS_NOT_FOUND, "get").code(), absl::StatusCode::kNotFound);
   EXPECT_TRUE(nats_error(NATS_OK, "get").ok());

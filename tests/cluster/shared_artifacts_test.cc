@@ -5,6 +5,7 @@
 
 #include <filesystem>
 
+#include "support/status_matchers.h"
 #include "support/test_files.h"
 
 namespace labelmesh::cluster {
@@ -15,7 +16,7 @@ namespace fs = std::filesystem;
 TEST(SharedArtifacts, FilesAppearWholeUnderTheirName) {
   const auto root = testing::scratch_dir("artifacts");
   auto store = SharedArtifacts::open(root.string());
-  ASSERT_TRUE(store.ok()) << store.status();
+  ASSERT_THAT(store, testing::IsOk());
   EXPECT_TRUE(fs::is_directory(root / "uploads"));
   EXPECT_TRUE(fs::is_directory(root / "jobs"));
   const std::string bytes(1 << 20, 'x');

@@ -13,6 +13,7 @@
 #include "core/volume/phantom.h"
 #include "core/volume/phantom_grid.h"
 #include "support/label_volumes.h"
+#include "support/status_matchers.h"
 
 namespace labelmesh::conforming {
 namespace {
@@ -57,7 +58,7 @@ TEST(CoarsenLabels, EachCoarserVoxelTakesTheNearestVoxelsLabel) {
   for (double factor : {2.0, 1.5}) {
     SCOPED_TRACE(factor);
     auto coarse = coarsen_labels(phantom.volume, {}, {factor, factor, factor}, RunContext{});
-    ASSERT_TRUE(coarse.ok()) << coarse.status();
+    ASSERT_THAT(coarse, testing::IsOk());
     for (int a = 0; a < 3; ++a) {
       EXPECT_EQ(coarse->geometry.dims[a],
                 static_cast<int64_t>(std::ceil(fine_geometry.dims[a] / factor)));
@@ -88,11 +89,11 @@ TEST(CoarsenLabels, TheMesherCoarsensWhenTheInterfacesWouldBeTooLarge) {
   ConformingFigures fine_figures, coarse_figures;
   volume_mesh::ImproveFigures improve;
   auto fine = mesh_conforming(phantom.volume, {}, params, RunContext{}, fine_figures, improve);
-  ASSERT_TRUE(fine.ok()) << fine.status();
+  ASSERT_THAT(fine, testing::IsOk());
   EXPECT_EQ(fine_figures.coarsening.factors, (std::array<double, 3>{1, 1, 1}));
   params.max_interface_faces = fine_figures.coarsening.interface_faces / 3;
   auto coarse = mesh_conforming(phantom.volume, {}, params, RunContext{}, coarse_figures, improve);
-  ASSERT_TRUE(coarse.ok()) << coarse.status();
+  ASSERT_THAT(coarse, testing::IsOk());
   for (double factor : coarse_figures.coarsening.factors) EXPECT_NEAR(factor, std::sqrt(3.0), 0.01);
   EXPECT_TRUE(check_conforming_mesh(*coarse).ok());
   EXPECT_LT(coarse->tetrahedra.size(), fine->tetrahedra.size() / 2);

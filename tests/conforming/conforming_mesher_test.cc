@@ -12,6 +12,7 @@
 #include "core/util/vec3.h"
 #include "core/volume/label_statistics.h"
 #include "core/volume/phantom.h"
+#include "support/status_matchers.h"
 
 namespace labelmesh::conforming {
 namespace {
@@ -139,7 +140,7 @@ Meshed mesh_phantom(const volume::LabelVolume& volume, const std::vector<int32_t
   volume_mesh::ImproveFigures improve;
   auto mesh =
       mesh_conforming(volume, labels, ConformingParams{}, RunContext{}, meshed.figures, improve);
-  EXPECT_TRUE(mesh.ok()) << mesh.status();
+  EXPECT_THAT(mesh, testing::IsOk());
   if (mesh.ok()) meshed.mesh = std::move(*mesh);
   return meshed;
 }
@@ -203,7 +204,7 @@ TEST(ConformingMesher, RefusesAVolumeWithoutTheSelectedLabels) {
   auto mesh =
       mesh_conforming(phantom.volume, {7}, ConformingParams{}, RunContext{}, figures, improve);
   ASSERT_FALSE(mesh.ok());
-  EXPECT_EQ(mesh.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(mesh, testing::StatusIs(absl::StatusCode::kInvalidArgument));
 }
 
 TEST(ConformityCheck, FindsWhatBreaksAMesh) {

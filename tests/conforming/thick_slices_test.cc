@@ -13,6 +13,7 @@
 #include "core/volume/phantom_grid.h"
 #include "core/volume/voxel_access.h"
 #include "support/label_volumes.h"
+#include "support/status_matchers.h"
 
 namespace labelmesh::conforming {
 namespace {
@@ -47,7 +48,7 @@ std::vector<int32_t> labels_of(const volume::LabelVolume& volume) {
 
 volume::LabelVolume interpolated(const volume::LabelVolume& thick, const ThickSlices& cut) {
   auto fine = interpolate_thick_slices(thick, {}, cut, RunContext{});
-  EXPECT_TRUE(fine.ok()) << fine.status();
+  EXPECT_THAT(fine, testing::IsOk());
   return fine.ok() ? std::move(*fine) : volume::LabelVolume{};
 }
 
@@ -77,7 +78,7 @@ TEST(ThickSlices, RefuseACutThatIsNotOne) {
   const auto thick = thick_nested_balls();
   for (const ThickSlices cut : {ThickSlices{2, 1}, ThickSlices{3, 2}, ThickSlices{-1, 2}}) {
     const auto fine = interpolate_thick_slices(thick, {}, cut, RunContext{});
-    EXPECT_EQ(fine.status().code(), absl::StatusCode::kInvalidArgument);
+    EXPECT_THAT(fine, testing::StatusIs(absl::StatusCode::kInvalidArgument));
   }
 }
 
@@ -165,7 +166,7 @@ TEST(ThickSlices, GiveAConformingMeshOfFiniteElementQuality) {
   ConformingFigures figures;
   volume_mesh::ImproveFigures improve;
   auto mesh = mesh_conforming(thick, {}, ConformingParams{}, RunContext{}, figures, improve);
-  ASSERT_TRUE(mesh.ok()) << mesh.status();
+  ASSERT_THAT(mesh, testing::IsOk());
   EXPECT_EQ(figures.thick_slices.axis, 2);
   EXPECT_TRUE(check_conforming_mesh(*mesh).ok());
   const auto quality = volume_mesh::summarise_quality(*mesh);

@@ -31,6 +31,7 @@
 #include "core/mixed_mesh/mixed_faces.h"
 #include "core/mixed_mesh/mixed_mesh.h"
 #include "core/mixed_mesh/write_mixed_mesh.h"
+#include "support/status_matchers.h"
 #include "support/test_files.h"
 
 namespace labelmesh::mixed_mesh {
@@ -169,13 +170,13 @@ TEST(MixedMeshCheck, RejectsMalformedMeshes) {
   bad = good;
   bad.cells[2][5] = uint32_t(good.points.size());
   const auto out_of_range = check_mixed_mesh(bad);
-  EXPECT_EQ(out_of_range.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(out_of_range, testing::StatusIs(absl::StatusCode::kInvalidArgument));
   EXPECT_NE(std::string(out_of_range.message()).find("cell 2 names point 12"), std::string::npos)
       << out_of_range;
   bad = good;
   bad.cells[1][4] = bad.cells[1][0];  // the pyramid's apex on a base corner
   const auto repeated = check_mixed_mesh(bad);
-  EXPECT_EQ(repeated.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(repeated, testing::StatusIs(absl::StatusCode::kInvalidArgument));
   EXPECT_NE(std::string(repeated.message()).find("twice"), std::string::npos) << repeated;
   bad = good;
   bad.types[0] = static_cast<CellType>(7);
@@ -499,7 +500,7 @@ Written write_all_four(VolumeFormat format, std::string_view test) {
   w.quality.quality = {0.9, 0.8, 0.7, 0.6};
   w.path = (w.dir / ("mixed." + std::string(volume_format_name(format)))).string();
   const auto status = write_mixed_mesh(w.mesh, w.quality, w.path, format, names());
-  EXPECT_TRUE(status.ok()) << status;
+  EXPECT_THAT(status, testing::IsOk());
   return w;
 }
 
@@ -663,12 +664,12 @@ TEST(MixedMeshWrite, BadInputsAreErrorsNamingTheFile) {
 
   const std::string node = (dir / "x.node").string();
   const auto tetgen = write_mixed_mesh(mesh, quality, node, VolumeFormat::kTetgen);
-  EXPECT_EQ(tetgen.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(tetgen, testing::StatusIs(absl::StatusCode::kInvalidArgument));
   EXPECT_NE(std::string(tetgen.message()).find("tetrahedra only"), std::string::npos) << tetgen;
   EXPECT_FALSE(std::filesystem::exists(node));
   const std::string xdmf = (dir / "x.xdmf").string();
   const auto xdmf_status = write_mixed_mesh(mesh, quality, xdmf, VolumeFormat::kXdmf);
-  EXPECT_EQ(xdmf_status.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(xdmf_status, testing::StatusIs(absl::StatusCode::kInvalidArgument));
   EXPECT_NE(std::string(xdmf_status.message()).find("tetrahedral meshes only"), std::string::npos);
   EXPECT_FALSE(std::filesystem::exists(xdmf));
 
@@ -676,7 +677,7 @@ TEST(MixedMeshWrite, BadInputsAreErrorsNamingTheFile) {
   MixedQuality short_quality = quality;
   short_quality.quality.pop_back();
   const auto wrong_size = write_mixed_mesh(mesh, short_quality, msh, VolumeFormat::kMsh);
-  EXPECT_EQ(wrong_size.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(wrong_size, testing::StatusIs(absl::StatusCode::kInvalidArgument));
   EXPECT_EQ(std::string(wrong_size.message()).rfind(msh + ": 3 quality values", 0), 0u)
       << wrong_size;
   // No quality at all is fine.
@@ -686,7 +687,7 @@ TEST(MixedMeshWrite, BadInputsAreErrorsNamingTheFile) {
   unlabelled.labels[2] = 0;
   for (VolumeFormat format : {VolumeFormat::kMsh, VolumeFormat::kAbaqus}) {
     const auto status = write_mixed_mesh(unlabelled, {}, msh, format);
-    EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument) << status;
+    EXPECT_THAT(status, testing::StatusIs(absl::StatusCode::kInvalidArgument)) << status;
     EXPECT_NE(std::string(status.message()).find("label 0"), std::string::npos) << status;
   }
   EXPECT_TRUE(write_mixed_mesh(unlabelled, {}, (dir / "x.vtu").string(), VolumeFormat::kVtu).ok());
@@ -700,7 +701,7 @@ TEST(MixedMeshWrite, BadInputsAreErrorsNamingTheFile) {
        {VolumeFormat::kVtu, VolumeFormat::kMsh, VolumeFormat::kMedit, VolumeFormat::kAbaqus}) {
     const std::string path = "/nonexistent/dir/x." + std::string(volume_format_name(format));
     const auto status = write_mixed_mesh(mesh, quality, path, format);
-    EXPECT_EQ(status.code(), absl::StatusCode::kInternal) << status;
+    EXPECT_THAT(status, testing::StatusIs(absl::StatusCode::kInternal)) << status;
     EXPECT_NE(std::string(status.message()).find("/nonexistent/dir/x."), std::string::npos);
   }
 }

@@ -24,6 +24,7 @@
 #include "core/surface/surface_statistics.h"
 #include "core/volume/phantom.h"
 #include "core/volume/write_label_volume.h"
+#include "support/status_matchers.h"
 #include "support/test_files.h"
 
 namespace labelmesh::mixed_mesh {
@@ -37,7 +38,7 @@ surface::TriangleMesh delivered_surface(const std::string& path, int32_t label) 
   params.surface = SurfaceMethod::kPoisson;
   params.labels = {label};
   auto result = run_pipeline(path, params, {});
-  EXPECT_TRUE(result.ok()) << result.status();
+  EXPECT_THAT(result, testing::IsOk());
   for (auto& s : result->surfaces)
     if (s.is_output && s.label == label) return s.mesh;
   ADD_FAILURE() << "no output surface";
@@ -86,7 +87,7 @@ TEST_P(MixedMesher, BothLayersAreValidAndFillTheSurface) {
   tet_layer.hexahedral_layer = false;
   MixedFigures tet_figures;
   auto mesh = mesh_mixed(surface, 7, tet_layer, {}, tet_figures);
-  ASSERT_TRUE(mesh.ok()) << mesh.status();
+  ASSERT_THAT(mesh, testing::IsOk());
   {
     const MixedQuality q = measure_mixed_mesh(*mesh);
     EXPECT_GT(q.hexahedra, 0u);
@@ -107,7 +108,7 @@ TEST_P(MixedMesher, BothLayersAreValidAndFillTheSurface) {
   hex_layer.core.cell_mm = expect.cell_mm;
   MixedFigures figures;
   mesh = mesh_mixed(surface, 7, hex_layer, {}, figures);
-  ASSERT_TRUE(mesh.ok()) << mesh.status();
+  ASSERT_THAT(mesh, testing::IsOk());
   ASSERT_EQ(figures.layer_refused, "");
   const MixedQuality q = measure_mixed_mesh(*mesh);
   EXPECT_EQ(q.tetrahedra, 0u);
@@ -137,7 +138,7 @@ TEST_P(MixedMesher, BothLayersAreValidAndFillTheSurface) {
   octree.octree.interior_mm = 4 * expect.cell_mm;
   MixedFigures octree_figures;
   auto coarse = mesh_mixed(surface, 7, octree, {}, octree_figures);
-  ASSERT_TRUE(coarse.ok()) << coarse.status();
+  ASSERT_THAT(coarse, testing::IsOk());
   ASSERT_EQ(octree_figures.layer_refused, "");
   const MixedQuality oq = measure_mixed_mesh(*coarse);
   EXPECT_EQ(oq.invalid, 0u);
@@ -268,7 +269,7 @@ TEST(MixedVolumeStage, NestedSpheresConformAndKeepTheirVolume) {
   params.volume_formats = {volume_mesh::VolumeFormat::kVtu, volume_mesh::VolumeFormat::kMsh,
                            volume_mesh::VolumeFormat::kMedit, volume_mesh::VolumeFormat::kAbaqus};
   auto result = run_pipeline(path, params, {});
-  ASSERT_TRUE(result.ok()) << result.status();
+  ASSERT_THAT(result, testing::IsOk());
   ASSERT_TRUE(result->mixed.has_value());
   ASSERT_TRUE(write_results(*result, params, (dir / "out").string(), {}).ok());
   const v1::Report report = make_report(*result, params);
@@ -311,9 +312,9 @@ TEST(MixedVolumeStage, HexahedraOnlyLeavesOutWhatCannotBeValid) {
   options.set_hex_size_mm(1.5);
   options.add_formats("vtu");
   auto params = params_from_options(options);
-  ASSERT_TRUE(params.ok()) << params.status();
+  ASSERT_THAT(params, testing::IsOk());
   auto result = run_pipeline(path, *params, {});
-  ASSERT_TRUE(result.ok()) << result.status();
+  ASSERT_THAT(result, testing::IsOk());
   ASSERT_TRUE(write_results(*result, *params, (dir / "fine").string(), {}).ok());
   v1::Report report = make_report(*result, *params);
   const auto& v = report.volume();
@@ -339,7 +340,7 @@ TEST(MixedVolumeStage, HexahedraOnlyLeavesOutWhatCannotBeValid) {
 
   params->hex_size_mm = 2;
   result = run_pipeline(path, *params, {});
-  ASSERT_TRUE(result.ok()) << result.status();
+  ASSERT_THAT(result, testing::IsOk());
   ASSERT_TRUE(write_results(*result, *params, (dir / "coarse").string(), {}).ok());
   report = make_report(*result, *params);
   EXPECT_EQ(report.volume().labels_left_out_size(), 3);
@@ -351,7 +352,7 @@ TEST(MixedVolumeStage, HexahedraOnlyLeavesOutWhatCannotBeValid) {
   params->guard.strict = true;
   result = run_pipeline(path, *params, {});
   ASSERT_FALSE(result.ok());
-  EXPECT_EQ(result.status().code(), absl::StatusCode::kFailedPrecondition);
+  EXPECT_THAT(result, testing::StatusIs(absl::StatusCode::kFailedPrecondition));
   EXPECT_NE(std::string(result.status().message()).find("strict: 3 label(s)"), std::string::npos)
       << result.status();
   EXPECT_NE(std::string(result.status().message()).find("no volume mesh"), std::string::npos);
@@ -363,7 +364,7 @@ TEST(MixedVolumeStage, TetGenNodeFilesAreRefusedForMixedMeshes) {
   options.add_formats("node");
   const auto params = params_from_options(options);
   ASSERT_FALSE(params.ok());
-  EXPECT_EQ(params.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(params, testing::StatusIs(absl::StatusCode::kInvalidArgument));
   EXPECT_NE(std::string(params.status().message()).find("tetrahedra only"), std::string::npos);
   options.clear_formats();
   options.set_hex_size_mm(0.01);
@@ -377,7 +378,7 @@ TEST(MixedVolumeStage, TetGenNodeFilesAreRefusedForMixedMeshes) {
             std::string::npos);
   options.set_hex_interior_size_mm(8);
   auto taken = params_from_options(options);
-  ASSERT_TRUE(taken.ok()) << taken.status();
+  ASSERT_THAT(taken, testing::IsOk());
   EXPECT_EQ(taken->hex_interior_size_mm, 8);
   EXPECT_EQ(make_options(*taken).hex_interior_size_mm(), 8);
 }

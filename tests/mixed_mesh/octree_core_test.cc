@@ -15,6 +15,7 @@
 
 #include "core/mixed_mesh/check_mixed_mesh.h"
 #include "core/mixed_mesh/mixed_faces.h"
+#include "support/status_matchers.h"
 
 namespace labelmesh::mixed_mesh {
 namespace {
@@ -152,7 +153,7 @@ TEST(OctreeCore, ABlockCoarsensInsideAndKeepsItsBoundary) {
   params.interior_mm = 8 * h;
   OctreeFigures figures;
   auto coarse = coarsen_core(core, params, figures);
-  ASSERT_TRUE(coarse.ok()) << coarse.status();
+  ASSERT_THAT(coarse, testing::IsOk());
   ASSERT_TRUE(check_mixed_mesh(*coarse).ok());
   const MixedQuality q = measure_mixed_mesh(*coarse);
   EXPECT_EQ(q.invalid, 0u);

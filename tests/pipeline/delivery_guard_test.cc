@@ -21,6 +21,7 @@
 #include "core/volume/phantom.h"
 #include "core/volume/thin_shapes.h"
 #include "core/volume/write_label_volume.h"
+#include "support/status_matchers.h"
 #include "support/test_files.h"
 
 namespace labelmesh {
@@ -63,7 +64,7 @@ const LabelWarning* warning_for(const MeshResult& result, int32_t label) {
 void expect_every_label_accounted_for(PhantomShape shape, const std::string& name) {
   const auto path = phantom_file(shape, name);
   auto result = run_pipeline(path, poisson_params(), RunContext{});
-  ASSERT_TRUE(result.ok()) << result.status();
+  ASSERT_THAT(result, testing::IsOk());
   int delivered = 0;
   for (const auto& thin : volume::thin_shapes()) {
     SCOPED_TRACE(std::string(thin.name));
@@ -113,7 +114,7 @@ TEST(DeliveryGuard, StrictFailsWhenALabelIsNotDelivered) {
   params.guard.strict = true;
   auto result = run_pipeline(path, params, RunContext{});
   ASSERT_FALSE(result.ok());
-  EXPECT_EQ(result.status().code(), absl::StatusCode::kFailedPrecondition);
+  EXPECT_THAT(result, testing::StatusIs(absl::StatusCode::kFailedPrecondition));
   EXPECT_NE(std::string(result.status().message()).find("strict"), std::string::npos);
 }
 
@@ -124,7 +125,7 @@ TEST(DeliveryGuard, OneAndTwoVoxelsKeptAreMeshedOrWarned) {
   params.poisson.min_component_voxels = 1;
   params.poisson.prune_strands = false;
   auto result = run_pipeline(path, params, RunContext{});
-  ASSERT_TRUE(result.ok()) << result.status();
+  ASSERT_THAT(result, testing::IsOk());
   for (int32_t label : {9, 10}) {
     const SurfaceResult* s = output_of(*result, label);
     const bool warned = warning_for(*result, label) != nullptr;
@@ -143,7 +144,7 @@ TEST(DeliveryGuard, WithoutFallBackASurfaceOutsideToleranceIsWarnedNotHidden) {
   params.guard.fall_back = false;
   params.guard.hausdorff_mm = 0.05;  // no smooth surface is that near the staircase
   auto result = run_pipeline(path, params, RunContext{});
-  ASSERT_TRUE(result.ok()) << result.status();
+  ASSERT_THAT(result, testing::IsOk());
   const SurfaceResult* s = output_of(*result, 1);
   ASSERT_NE(s, nullptr);
   EXPECT_EQ(s->stage, "poisson");
@@ -183,7 +184,7 @@ TEST(DeliveryGuard, ThinLabelsStartWithTheMaskUnlessPoissonIsAskedFor) {
   const auto path = phantom_file(PhantomShape::kTorus, "torus.mha");
   auto first_attempt = [&](const MeshParams& params) {
     auto result = run_pipeline(path, params, RunContext{});
-    EXPECT_TRUE(result.ok()) << result.status();
+    EXPECT_THAT(result, testing::IsOk());
     const SurfaceResult* s = result.ok() ? output_of(*result, 1) : nullptr;
     EXPECT_TRUE(s != nullptr && s->fidelity && !s->fidelity->attempts.empty());
     return s != nullptr && s->fidelity && !s->fidelity->attempts.empty() ? *s : SurfaceResult{};
@@ -240,12 +241,12 @@ TEST(LevelSetSurface, MeshesASphereMaskWithThirtyDegreeAnglesCloseToItsVoxels) {
   ASSERT_TRUE(marching_cubes.ok());
   const auto& staircase = marching_cubes->front();
   auto field = surface::component_field(*components, 1, phantom.volume.geometry, 0.4);
-  ASSERT_TRUE(field.ok()) << field.status();
+  ASSERT_THAT(field, testing::IsOk());
   surface::LevelSetParams params;
   params.max_edge_mm = 3;
   params.max_distance_mm = 0.1;
   auto mesh = surface::mesh_level_set(*field, params, staircase.points, RunContext{});
-  ASSERT_TRUE(mesh.ok()) << mesh.status();
+  ASSERT_THAT(mesh, testing::IsOk());
   const auto s = surface::compute_surface_statistics(*mesh);
   EXPECT_TRUE(s.closed);
   EXPECT_TRUE(s.manifold);
@@ -287,7 +288,7 @@ TEST(LevelSetSurface, PlacesTheSurfaceThroughTheGridsPlacement) {
   params.max_distance_mm = 0.05;
   const std::vector<std::array<double, 3>> seeds{{centre[0] + radius, centre[1], centre[2]}};
   auto mesh = surface::mesh_level_set(grid, params, seeds, RunContext{});
-  ASSERT_TRUE(mesh.ok()) << mesh.status();
+  ASSERT_THAT(mesh, testing::IsOk());
   double worst = 0;
   for (const auto& p : mesh->points) {
     const double r = std::hypot(p[0] - centre[0], p[1] - centre[1], p[2] - centre[2]);

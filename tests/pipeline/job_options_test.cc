@@ -2,6 +2,7 @@
 // Job options: every range is checked in one place (params_from_options), and
 // what it accepts survives the trip back to the proto.
 #include "core/pipeline/job_options.h"
+#include "support/status_matchers.h"
 
 #include <gtest/gtest.h>
 
@@ -17,10 +18,10 @@ namespace {
 
 TEST(JobOptions, DefaultsAreValidAndSurviveTheRoundTrip) {
   const auto params = params_from_options(v1::MeshOptions());
-  ASSERT_TRUE(params.ok()) << params.status();
+  ASSERT_THAT(params, testing::IsOk());
   const v1::MeshOptions again = make_options(*params);
   const auto reread = params_from_options(again);
-  ASSERT_TRUE(reread.ok()) << reread.status();
+  ASSERT_THAT(reread, testing::IsOk());
   EXPECT_EQ(make_options(*reread).SerializeAsString(), again.SerializeAsString());
   EXPECT_DOUBLE_EQ(reread->poisson.min_angle_deg, 30);
   EXPECT_TRUE(reread->guard.fall_back);
@@ -42,7 +43,7 @@ TEST(JobOptions, SetValuesSurviveTheRoundTrip) {
   options.add_formats("ply");
   options.add_formats("vtu");
   const auto params = params_from_options(options);
-  ASSERT_TRUE(params.ok()) << params.status();
+  ASSERT_THAT(params, testing::IsOk());
   EXPECT_EQ(params->labels, std::vector<int32_t>{7});
   EXPECT_DOUBLE_EQ(params->poisson.min_angle_deg, 25);
   EXPECT_DOUBLE_EQ(params->poisson.max_edge_mm, 3.5);
@@ -53,7 +54,7 @@ TEST(JobOptions, SetValuesSurviveTheRoundTrip) {
   ASSERT_EQ(params->poisson.label_sizing.size(), 1u);
   EXPECT_DOUBLE_EQ(params->poisson.label_sizing[0].max_edge_mm, 1.25);
   const auto reread = params_from_options(make_options(*params));
-  ASSERT_TRUE(reread.ok()) << reread.status();
+  ASSERT_THAT(reread, testing::IsOk());
   EXPECT_DOUBLE_EQ(reread->poisson.label_sizing[0].max_edge_mm, 1.25);
   EXPECT_EQ(reread->formats.size(), 1u);
   EXPECT_EQ(reread->volume_formats.size(), 1u);
@@ -125,7 +126,7 @@ TEST(JobOptions, EveryOutOfRangeValueIsRefusedByName) {
     bad.set(options);
     const auto params = params_from_options(options);
     ASSERT_FALSE(params.ok()) << bad.field;
-    EXPECT_EQ(params.status().code(), absl::StatusCode::kInvalidArgument) << bad.field;
+    EXPECT_THAT(params, testing::StatusIs(absl::StatusCode::kInvalidArgument)) << bad.field;
     EXPECT_TRUE(absl::StrContains(params.status().message(), bad.field))
         << bad.field << ": " << params.status().message();
   }
@@ -138,7 +139,7 @@ TEST(JobOptions, LabelNamesAreBoundedAndSurviveTheRoundTrip) {
   liver->set_name("liver");
   for (uint32_t c : {221u, 130u, 101u}) liver->add_colour_rgb(c);
   auto params = params_from_options(options);
-  ASSERT_TRUE(params.ok()) << params.status();
+  ASSERT_THAT(params, testing::IsOk());
   ASSERT_EQ(params->label_names.size(), 1u);
   EXPECT_EQ(params->label_names[0].colour, (std::array<uint8_t, 3>{221, 130, 101}));
   const v1::MeshOptions again = make_options(*params);
@@ -172,7 +173,7 @@ TEST(JobOptions, RepeatedLabelsAndFormatsAreKeptOnceInOrder) {
   for (int label : {7, 3, 7, 7, 3, 9}) options.add_labels(label);
   for (const char* format : {"off", "stl", "off", "off", "stl"}) options.add_formats(format);
   const auto params = params_from_options(options);
-  ASSERT_TRUE(params.ok()) << params.status();
+  ASSERT_THAT(params, testing::IsOk());
   EXPECT_EQ(params->labels, (std::vector<int32_t>{7, 3, 9}));
   ASSERT_EQ(params->formats.size(), 2u);
   EXPECT_EQ(params->formats[0], surface::SurfaceFormat::kOff);
@@ -184,18 +185,18 @@ TEST(JobOptions, DicomSurfacesAreAFormatBesideTheSurfaceFiles) {
   v1::MeshOptions options;
   for (const char* format : {"dcm", "stl", "dcm"}) options.add_formats(format);
   auto params = params_from_options(options);
-  ASSERT_TRUE(params.ok()) << params.status();
+  ASSERT_THAT(params, testing::IsOk());
   EXPECT_TRUE(params->dicom_surfaces);
   EXPECT_EQ(params->formats, std::vector<surface::SurfaceFormat>{surface::SurfaceFormat::kStl});
   const auto again = params_from_options(make_options(*params));
-  ASSERT_TRUE(again.ok()) << again.status();
+  ASSERT_THAT(again, testing::IsOk());
   EXPECT_TRUE(again->dicom_surfaces);
   EXPECT_EQ(make_options(*again).formats_size(), 2);
   // Another list of formats, without dcm, asks for none.
   options.clear_formats();
   options.add_formats("vtp");
   params = params_from_options(options);
-  ASSERT_TRUE(params.ok()) << params.status();
+  ASSERT_THAT(params, testing::IsOk());
   EXPECT_FALSE(params->dicom_surfaces);
 }
 
@@ -209,7 +210,7 @@ TEST(JobOptions, SizingInMillimetresIsCheckedAgainstTheGrid) {
   EXPECT_TRUE(check_sizing_for_grid(poisson, geometry).ok());
   poisson.max_edge_mm = 1.4;
   auto status = check_sizing_for_grid(poisson, geometry);
-  EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(status, testing::StatusIs(absl::StatusCode::kInvalidArgument));
   EXPECT_TRUE(absl::StrContains(status.message(), "max_edge_mm")) << status.message();
   poisson.max_edge_mm = 0;
   poisson.label_sizing.push_back({114, 2, 0.01});

@@ -11,6 +11,7 @@
 #include "core/pipeline/pipeline.h"
 #include "core/volume/phantom.h"
 #include "core/volume/write_label_volume.h"
+#include "support/status_matchers.h"
 #include "support/test_files.h"
 
 namespace labelmesh {
@@ -25,7 +26,7 @@ MeshResult mesh_with_tets(const std::string& path, std::vector<int32_t> labels =
   params.labels = std::move(labels);
   params.volume = VolumeMethod::kTetgen;
   auto result = run_pipeline(path, params, RunContext{});
-  EXPECT_TRUE(result.ok()) << result.status();
+  EXPECT_THAT(result, testing::IsOk());
   return result.ok() ? std::move(*result) : MeshResult{};
 }
 
@@ -121,11 +122,11 @@ TEST(VolumeMeshes, SelfIntersectingSurfaceIsRefusedByLabel) {
     for (const auto& f : faces) cubes.triangles.push_back({base + f[0], base + f[1], base + f[2]});
   }
   const auto refused = tetrahedralize_labels({{7, &cubes, uint64_t{4}}}, {}, RunContext{});
-  EXPECT_EQ(refused.status().code(), absl::StatusCode::kFailedPrecondition);
+  EXPECT_THAT(refused, testing::StatusIs(absl::StatusCode::kFailedPrecondition));
   EXPECT_NE(std::string(refused.status().message()).find("label 7"), std::string::npos);
   // Without the count from the surface checks, TetGen's own check finds it.
   const auto found = tetrahedralize_labels({{7, &cubes, std::nullopt}}, {}, RunContext{});
-  EXPECT_EQ(found.status().code(), absl::StatusCode::kFailedPrecondition);
+  EXPECT_THAT(found, testing::StatusIs(absl::StatusCode::kFailedPrecondition));
 }
 
 TEST(VolumeMeshesRealData, LiverTetrahedraAreValid) {

@@ -7,6 +7,7 @@
 
 #include "core/pipeline/pipeline.h"
 #include "core/pipeline/write_results.h"
+#include "support/status_matchers.h"
 #include "support/test_files.h"
 
 namespace labelmesh {
@@ -35,7 +36,7 @@ TEST(OutputNames, ADicomSegSegmentNamesItsSurfaceFiles) {
   MeshParams params;
   auto result =
       run_pipeline(testing::shared_data("dicom-seg/dcmqi-24x38x3-seg.dcm"), params, RunContext{});
-  ASSERT_TRUE(result.ok()) << result.status();
+  ASSERT_THAT(result, testing::IsOk());
   ASSERT_TRUE(write_results(*result, params, out.string(), RunContext{}).ok());
   EXPECT_TRUE(std::filesystem::exists(out / "surface-label1-liver.stl"));
   EXPECT_TRUE(std::filesystem::exists(out / "surface-label1-liver.vtp"));

@@ -23,6 +23,7 @@
 #include "core/volume/phantom.h"
 #include "core/volume/read_label_volume.h"
 #include "core/volume/write_label_volume.h"
+#include "support/status_matchers.h"
 #include "support/test_files.h"
 
 namespace labelmesh {
@@ -33,7 +34,7 @@ namespace fs = std::filesystem;
 std::string write_phantom(const fs::path& dir, volume::PhantomShape shape) {
   const auto path = (dir / "phantom.nii.gz").string();
   const auto status = volume::write_label_volume(volume::make_phantom(shape).volume, path);
-  EXPECT_TRUE(status.ok()) << status;
+  EXPECT_THAT(status, testing::IsOk());
   return path;
 }
 
@@ -47,7 +48,7 @@ TEST(Pipeline, OneOutputSurfacePerLabelAndItsFilesWritten) {
   const fs::path dir = testing::scratch_dir("pipeline_outputs");
   const std::string input = write_phantom(dir, volume::PhantomShape::kNestedSpheres);
   auto result = run_pipeline(input, repaired_params(), {});
-  ASSERT_TRUE(result.ok()) << result.status();
+  ASSERT_THAT(result, testing::IsOk());
   std::set<int32_t> output_labels;
   for (const auto& surface : result->surfaces) {
     if (!surface.is_output) continue;
@@ -123,7 +124,7 @@ TEST(Pipeline, SceneFilesAndTheRasFrame) {
   params.scene_formats = {SceneFormat::kVtm, SceneFormat::kVti, SceneFormat::kMha};
   params.frame = CoordinateFrame::kRas;
   auto result = run_pipeline(input, params, {});
-  ASSERT_TRUE(result.ok()) << result.status();
+  ASSERT_THAT(result, testing::IsOk());
   ASSERT_NE(result->label_image, nullptr);
   const fs::path out = dir / "out";
   ASSERT_TRUE(write_results(*result, params, out.string(), {}).ok());
@@ -141,9 +142,9 @@ TEST(Pipeline, SceneFilesAndTheRasFrame) {
   // the same voxels placed in RAS.
   const auto& g = result->input.geometry;
   auto mha = volume::read_label_volume((out / "labels.mha").string(), {}, {});
-  ASSERT_TRUE(mha.ok()) << mha.status();
+  ASSERT_THAT(mha, testing::IsOk());
   auto vti = volume::read_label_volume((out / "labels.vti").string(), {}, {});
-  ASSERT_TRUE(vti.ok()) << vti.status();
+  ASSERT_THAT(vti, testing::IsOk());
   const auto mha_stats = volume::compute_label_statistics(*mha);
   EXPECT_EQ(mha_stats.labels.size(), 3u);
   for (int axis = 0; axis < 3; ++axis) {
@@ -161,7 +162,7 @@ TEST(Pipeline, BadRequestsGetTheirOwnCodesNamingTheCause) {
   const std::string missing = (dir / "no-such.nii.gz").string();
   auto result = run_pipeline(missing, repaired_params(), {});
   ASSERT_FALSE(result.ok());
-  EXPECT_EQ(result.status().code(), absl::StatusCode::kNotFound);
+  EXPECT_THAT(result, testing::StatusIs(absl::StatusCode::kNotFound));
   EXPECT_TRUE(absl::StrContains(result.status().message(), "no-such.nii.gz"));
 
   const std::string sphere = write_phantom(dir, volume::PhantomShape::kSphere);
@@ -169,7 +170,7 @@ TEST(Pipeline, BadRequestsGetTheirOwnCodesNamingTheCause) {
   absent.labels = {7};
   result = run_pipeline(sphere, absent, {});
   ASSERT_FALSE(result.ok());
-  EXPECT_EQ(result.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(result, testing::StatusIs(absl::StatusCode::kInvalidArgument));
   EXPECT_TRUE(absl::StrContains(result.status().message(), "label 7"));
 
   volume::LabelVolume empty = volume::make_phantom(volume::PhantomShape::kSphere).volume;
@@ -180,7 +181,7 @@ TEST(Pipeline, BadRequestsGetTheirOwnCodesNamingTheCause) {
   ASSERT_TRUE(volume::write_label_volume(empty, background).ok());
   result = run_pipeline(background, repaired_params(), {});
   ASSERT_FALSE(result.ok());
-  EXPECT_EQ(result.status().code(), absl::StatusCode::kFailedPrecondition);
+  EXPECT_THAT(result, testing::StatusIs(absl::StatusCode::kFailedPrecondition));
   EXPECT_TRUE(absl::StrContains(result.status().message(), "only background"));
 
   // DICOM surfaces take their patient and study from a DICOM SEG input.
@@ -188,7 +189,7 @@ TEST(Pipeline, BadRequestsGetTheirOwnCodesNamingTheCause) {
   dicom.dicom_surfaces = true;
   result = run_pipeline(sphere, dicom, {});
   ASSERT_FALSE(result.ok());
-  EXPECT_EQ(result.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(result, testing::StatusIs(absl::StatusCode::kInvalidArgument));
   EXPECT_TRUE(absl::StrContains(result.status().message(), "needs a DICOM SEG input"))
       << result.status();
   EXPECT_TRUE(absl::StrContains(result.status().message(), sphere)) << result.status();
@@ -198,7 +199,7 @@ TEST(Pipeline, BadRequestsGetTheirOwnCodesNamingTheCause) {
   stopped.stop = &stop;
   result = run_pipeline(sphere, repaired_params(), stopped);
   ASSERT_FALSE(result.ok());
-  EXPECT_EQ(result.status().code(), absl::StatusCode::kCancelled);
+  EXPECT_THAT(result, testing::StatusIs(absl::StatusCode::kCancelled));
 }
 
 }  // namespace

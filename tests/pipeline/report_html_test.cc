@@ -29,6 +29,7 @@
 #include "core/util/text.h"
 #include "core/volume/phantom.h"
 #include "core/volume/write_label_volume.h"
+#include "support/status_matchers.h"
 #include "support/test_files.h"
 
 namespace labelmesh {
@@ -300,7 +301,7 @@ std::string write_sphere(const fs::path& dir) {
   const auto path = (dir / "sphere.nii.gz").string();
   const auto status =
       volume::write_label_volume(volume::make_phantom(volume::PhantomShape::kSphere).volume, path);
-  EXPECT_TRUE(status.ok()) << status;
+  EXPECT_THAT(status, testing::IsOk());
   return path;
 }
 
@@ -309,7 +310,7 @@ TEST(ReportHtml, WrittenBesideReportJson) {
   MeshParams params;
   params.surface = SurfaceMethod::kRepaired;
   auto result = run_pipeline(write_sphere(dir), params, {});
-  ASSERT_TRUE(result.ok()) << result.status();
+  ASSERT_THAT(result, testing::IsOk());
   ASSERT_TRUE(write_results(*result, params, (dir / "out").string(), {}).ok());
   ASSERT_TRUE(fs::exists(dir / "out" / "report.json"));
   const std::string html = testing::read_bytes(dir / "out" / "report.html");

@@ -12,6 +12,7 @@
 #include <string>
 
 #include "core/pipeline/pipeline.h"
+#include "support/status_matchers.h"
 #include "support/test_files.h"
 
 namespace labelmesh {
@@ -29,7 +30,7 @@ class SharedVolumes : public ::testing::TestWithParam<const char*> {};
 TEST_P(SharedVolumes, EveryLabelIsWithinToleranceOrTooSmall) {
   LABELMESH_SKIP_WITHOUT_SHARED_DATA();
   auto result = run_pipeline(testing::shared_data(GetParam()), poisson_params(), RunContext{});
-  ASSERT_TRUE(result.ok()) << result.status();
+  ASSERT_THAT(result, testing::IsOk());
   std::set<int32_t> too_small;
   for (const auto& warning : result->warnings) {
     EXPECT_NE(warning.reason.find("too small to mesh"), std::string::npos)
@@ -73,7 +74,7 @@ TEST(SharedVolumesBrain, ANarrowGrooveGetsTheFinestMaskSurface) {
   params.labels = {8};
   auto result =
       run_pipeline(testing::shared_data("iso2mesh_brain_seg_converted.nii.gz"), params, {});
-  ASSERT_TRUE(result.ok()) << result.status();
+  ASSERT_THAT(result, testing::IsOk());
   EXPECT_TRUE(result->warnings.empty());
   const auto output = std::find_if(result->surfaces.begin(), result->surfaces.end(),
                                    [](const SurfaceResult& s) { return s.is_output; });

@@ -18,6 +18,7 @@
 #include "server/metrics.h"
 #include "server/spool.h"
 #include "support/service_harness.h"
+#include "support/status_matchers.h"
 
 namespace labelmesh::testing {
 namespace {
@@ -454,7 +455,7 @@ TEST_F(AccessControlTest, JobsFromBeforeIdentitiesBelongToTheAnonymousClient) {
   const std::string id = server::new_job_id();
   {
     auto spool = server::Spool::open(spool_.string());
-    ASSERT_TRUE(spool.ok()) << spool.status();
+    ASSERT_THAT(spool, testing::IsOk());
     fs::create_directories(spool->job_dir(id));
     v1::JobRecord record;
     record.mutable_job()->set_job_id(id);

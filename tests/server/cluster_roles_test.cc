@@ -18,6 +18,7 @@
 #include "server/metrics.h"
 #include "server/spool.h"
 #include "support/service_harness.h"
+#include "support/status_matchers.h"
 
 namespace labelmesh {
 namespace {
@@ -254,7 +255,7 @@ TEST_F(ClusterRolesTest, ARequestIdReusedAfterADeleteIsANewJobAndTheOldMessageIs
   auto new_message = connection_->queue->take(absl::Seconds(2)).value();
   ASSERT_TRUE(new_message.has_value());
   auto claim = connection_->jobs->claim(second, {new_message->made()});
-  ASSERT_TRUE(claim.ok()) << claim.status();
+  ASSERT_THAT(claim, testing::IsOk());
   EXPECT_EQ(claim->attempt, 1u);
 }
 
@@ -367,7 +368,7 @@ server::ServerConfig role_config(const fs::path& dir, const std::string& role,
 TEST_F(ClusterRolesTest, AFrontendIsReadyWhileItReachesNatsAndLiveThroughout) {
   using Status = grpc::health::v1::HealthCheckResponse;
   auto frontend = server::LabelmeshServer::start(role_config(dir_, "frontend", nats_->url()));
-  ASSERT_TRUE(frontend.ok()) << frontend.status();
+  ASSERT_THAT(frontend, testing::IsOk());
   const int port = (*frontend)->port();
   EXPECT_EQ(health(port, ""), Status::SERVING);
   EXPECT_EQ(health(port, server::kLivenessService), Status::SERVING);
@@ -417,7 +418,7 @@ TEST_F(ClusterRolesTest, ASubmitWhileNatsIsDownIsUnavailableAtOnce) {
 TEST_F(ClusterRolesTest, AWorkerRunsAJobFromTheSharedDirectoryAndServesOnlyHealth) {
   const std::string id = accept_sphere();
   auto worker = server::LabelmeshServer::start(role_config(dir_, "worker", nats_->url()));
-  ASSERT_TRUE(worker.ok()) << worker.status();
+  ASSERT_THAT(worker, testing::IsOk());
   const v1::Job job = wait_until_ended(id);
   ASSERT_EQ(job.state(), v1::JOB_STATE_SUCCEEDED) << job.error().message();
   EXPECT_EQ(job.attempts(), 1u);
@@ -454,7 +455,7 @@ TEST_F(ClusterRolesTest, AWorkerWithNoRoomForResultsLeavesJobsQueued) {
   auto full_config = role_config(dir_, "worker", nats_->url());
   full_config.spool_reserve_bytes = uint64_t{1} << 60;  // More than any disk has free.
   auto full = server::LabelmeshServer::start(full_config);
-  ASSERT_TRUE(full.ok()) << full.status();
+  ASSERT_THAT(full, testing::IsOk());
   std::this_thread::sleep_for(std::chrono::seconds(3));
   v1::Job job = store_->get(id).value();
   EXPECT_EQ(job.state(), v1::JOB_STATE_QUEUED) << job.error().message();
@@ -462,7 +463,7 @@ TEST_F(ClusterRolesTest, AWorkerWithNoRoomForResultsLeavesJobsQueued) {
   (*full)->shutdown();
 
   auto worker = server::LabelmeshServer::start(role_config(dir_, "worker", nats_->url()));
-  ASSERT_TRUE(worker.ok()) << worker.status();
+  ASSERT_THAT(worker, testing::IsOk());
   job = wait_until_ended(id);
   EXPECT_EQ(job.state(), v1::JOB_STATE_SUCCEEDED) << job.error().message();
   EXPECT_EQ(job.attempts(), 1u);

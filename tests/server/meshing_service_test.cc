@@ -24,6 +24,7 @@
 #include "server/metrics.h"
 #include "server/worker_process.h"
 #include "support/service_harness.h"
+#include "support/status_matchers.h"
 
 namespace labelmesh::testing {
 namespace {
@@ -171,7 +172,7 @@ TEST_F(MeshingServiceTest, TheServiceMakesTheSameMixedMeshAsTheLibrary) {
   auto params = params_from_options(options);
   ASSERT_TRUE(params.ok());
   auto local = run_pipeline(input.string(), *params, {});
-  ASSERT_TRUE(local.ok()) << local.status();
+  ASSERT_THAT(local, testing::IsOk());
   const v1::VolumeMeshSummary mine = make_report(*local, *params).volume();
   EXPECT_EQ(served.mesher(), "mixed_grid");
   EXPECT_GT(served.hexahedra(), 0u);
@@ -239,7 +240,7 @@ TEST_F(MeshingServiceTest, ConformingJobsShareInterfacesAsInTheCli) {
   auto params = params_from_options(options);
   ASSERT_TRUE(params.ok());
   auto local = run_pipeline(input.string(), *params, {});
-  ASSERT_TRUE(local.ok()) << local.status();
+  ASSERT_THAT(local, testing::IsOk());
   const v1::VolumeMeshSummary mine = make_report(*local, *params).volume();
   EXPECT_EQ(served.tetrahedra(), mine.tetrahedra());
   EXPECT_EQ(served.nodes(), mine.nodes());
@@ -818,7 +819,7 @@ TEST_F(MeshingServiceTest, RefusesToStartWithAWorkerOfAnotherVersion) {
   config_.worker_executable = other.string();
   auto started = server::LabelmeshServer::start(config_);
   ASSERT_FALSE(started.ok());
-  EXPECT_EQ(started.status().code(), absl::StatusCode::kFailedPrecondition);
+  EXPECT_THAT(started, testing::StatusIs(absl::StatusCode::kFailedPrecondition));
   EXPECT_TRUE(absl::StrContains(started.status().message(), "0.0.0-other"))
       << started.status().message();
 
@@ -837,7 +838,7 @@ TEST_F(MeshingServiceTest, AWorkerThatHangsAtVersionIsKilled) {
   const absl::Status status =
       server::check_worker_version(hanging.string(), std::chrono::milliseconds(300));
   const auto waited = std::chrono::steady_clock::now() - before;
-  EXPECT_EQ(status.code(), absl::StatusCode::kFailedPrecondition);
+  EXPECT_THAT(status, testing::StatusIs(absl::StatusCode::kFailedPrecondition));
   EXPECT_TRUE(absl::StrContains(status.message(), "did not answer --version")) << status.message();
   EXPECT_LT(waited, std::chrono::seconds(30));
 }

@@ -9,6 +9,7 @@
 #include "server/error_details.h"
 #include "server/json_log_format.h"
 #include "server/server_config.h"
+#include "support/status_matchers.h"
 #include "support/test_files.h"
 
 namespace labelmesh::testing {
@@ -35,7 +36,7 @@ TEST(ServerConfigRules, ANonLoopbackAddressNeedsClientAuthenticationOrAllowAnony
   config.tls_cert = "cert.pem";
   config.tls_key = "key.pem";
   auto status = server::validate_config(config);
-  EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(status, testing::StatusIs(absl::StatusCode::kInvalidArgument));
   EXPECT_NE(status.message().find("--allow-anonymous"), std::string::npos) << status;
   config.allow_anonymous = true;
   EXPECT_TRUE(server::validate_config(config).ok());
@@ -71,7 +72,7 @@ TEST(ServerConfigRules, AbandonedUploadsOutliveEveryPauseOfALivingUpload) {
   config.nats_url = "nats://127.0.0.1:4222";
   config.artifact_dir = "/srv/labelmesh";
   auto status = server::validate_config(config);
-  EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(status, testing::StatusIs(absl::StatusCode::kInvalidArgument));
   EXPECT_NE(status.message().find("--abandoned-upload-age"), std::string::npos) << status;
   config.abandoned_upload_age = absl::Minutes(6);
   EXPECT_TRUE(server::validate_config(config).ok());
@@ -85,7 +86,7 @@ TEST(ClientsFile, ListsNamedTokensAndRefusesWhatIsAmbiguous) {
   const auto path = dir / "clients";
   write_file(path, "# comment\n\nalice a-token-0123456789ab\n  root r-token-0123456789ab admin \n");
   auto holders = server::read_clients_file(path.string());
-  ASSERT_TRUE(holders.ok()) << holders.status();
+  ASSERT_THAT(holders, testing::IsOk());
   ASSERT_EQ(holders->size(), 2u);
   EXPECT_EQ((*holders)[0].name, "alice");
   EXPECT_FALSE((*holders)[0].admin);

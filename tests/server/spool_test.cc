@@ -14,6 +14,7 @@
 
 #include "absl/strings/match.h"
 #include "server/durable_file.h"
+#include "support/status_matchers.h"
 #include "support/test_files.h"
 
 namespace labelmesh {
@@ -42,7 +43,7 @@ bool save_queued(const server::Spool& spool, const std::string& id) {
 TEST(Spool, AFailedWriteKeepsThePreviousRecord) {
   const fs::path root = scratch_dir("SpoolFailedWrite");
   auto spool = server::Spool::open(root.string());
-  ASSERT_TRUE(spool.ok()) << spool.status();
+  ASSERT_THAT(spool, testing::IsOk());
   const std::string id = server::new_job_id();
   ASSERT_TRUE(save_queued(*spool, id));
 
@@ -72,7 +73,7 @@ TEST(Spool, AFailedWriteKeepsThePreviousRecord) {
 TEST(Spool, UnreadableRecordsAreQuarantinedNotDeleted) {
   const fs::path root = scratch_dir("SpoolQuarantine");
   auto spool = server::Spool::open(root.string());
-  ASSERT_TRUE(spool.ok()) << spool.status();
+  ASSERT_THAT(spool, testing::IsOk());
   const std::string good = server::new_job_id();
   ASSERT_TRUE(save_queued(*spool, good));
   // A record cut to nothing, one that is not a record, one naming another
@@ -106,7 +107,7 @@ TEST(Spool, UnreadableRecordsAreQuarantinedNotDeleted) {
 TEST(Spool, EachAttemptHasItsOwnOutputDirectory) {
   const fs::path root = scratch_dir("SpoolAttemptOutput");
   auto spool = server::Spool::open(root.string());
-  ASSERT_TRUE(spool.ok()) << spool.status();
+  ASSERT_THAT(spool, testing::IsOk());
   const std::string id = server::new_job_id();
   ASSERT_TRUE(save_queued(*spool, id));
   ASSERT_TRUE(spool->reset_output(id, 1).ok());
@@ -119,7 +120,7 @@ TEST(Spool, EachAttemptHasItsOwnOutputDirectory) {
   testing::write_file(fs::path(spool->output_dir(id, 1)) / "report.json", "stale");
   testing::write_file(fs::path(spool->output_dir(id, 2)) / "report.json", "{}");
   auto artifacts = spool->collect_artifacts(id, 2);
-  ASSERT_TRUE(artifacts.ok()) << artifacts.status();
+  ASSERT_THAT(artifacts, testing::IsOk());
   ASSERT_EQ(artifacts->size(), 1u);
   EXPECT_EQ((*artifacts)[0].name(), "report.json");
 }
@@ -149,12 +150,12 @@ TEST(SpoolErrors, ClientsSeePathsOnlyFromTheSpoolsFoldersOn) {
             "cannot read the free space of labelmesh");
   EXPECT_EQ(server::spool_relative("no path here"), "no path here");
   const absl::Status full = server::spool_io_error("cannot write /srv/spool/jobs/x/job.pb", ENOSPC);
-  EXPECT_EQ(full.code(), absl::StatusCode::kResourceExhausted);
+  EXPECT_THAT(full, testing::StatusIs(absl::StatusCode::kResourceExhausted));
   EXPECT_TRUE(absl::StartsWith(full.message(), "spool disk full: cannot write jobs/x/job.pb"))
       << full;
   EXPECT_FALSE(absl::StrContains(full.message(), "/srv")) << full;
   const absl::Status other = server::spool_io_error("cannot sync /srv/spool/uploads/u", EIO);
-  EXPECT_EQ(other.code(), absl::StatusCode::kInternal);
+  EXPECT_THAT(other, testing::StatusIs(absl::StatusCode::kInternal));
   EXPECT_FALSE(absl::StrContains(other.message(), "/srv")) << other;
 }
 

@@ -19,6 +19,7 @@
 #include "core/volume/write_label_volume.h"
 #include "labelmesh/v1/service.grpc.pb.h"
 #include "server/labelmesh_server.h"
+#include "support/status_matchers.h"
 #include "support/test_files.h"
 
 namespace labelmesh::testing {
@@ -39,7 +40,7 @@ inline std::filesystem::path write_phantom(const std::filesystem::path& dir,
   const std::filesystem::path path = dir / "phantom.nii.gz";
   auto status =
       volume::write_label_volume(volume::make_phantom(shape, scale).volume, path.string());
-  EXPECT_TRUE(status.ok()) << status;
+  EXPECT_THAT(status, testing::IsOk());
   return path;
 }
 

@@ -13,6 +13,7 @@
 #include "core/volume/label_statistics.h"
 #include "core/volume/phantom.h"
 #include "core/volume/read_label_volume.h"
+#include "support/status_matchers.h"
 #include "support/test_files.h"
 
 namespace labelmesh::surface {
@@ -26,7 +27,7 @@ std::vector<LabelSurface> extract_all(const volume::LabelVolume& v) {
   std::vector<int32_t> labels;
   for (const auto& l : stats.labels) labels.push_back(l.label);
   auto surfaces = extract_surfaces(v, stats, labels, RunContext{});
-  EXPECT_TRUE(surfaces.ok()) << surfaces.status();
+  EXPECT_THAT(surfaces, testing::IsOk());
   return surfaces.ok() ? std::move(*surfaces) : std::vector<LabelSurface>{};
 }
 
@@ -149,12 +150,12 @@ TEST(ExtractSurfaces, AbsentLabelIsAnError) {
   const auto v = filled_cube(2, false);
   const auto stats = volume::compute_label_statistics(v);
   const auto result = extract_surfaces(v, stats, {9}, RunContext{});
-  EXPECT_EQ(result.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(result, testing::StatusIs(absl::StatusCode::kInvalidArgument));
 }
 
 void expect_volumes_match_voxels(const std::string& file, uint64_t min_voxels, double tolerance) {
   auto v = volume::read_label_volume(testing::shared_data(file), {}, RunContext{});
-  ASSERT_TRUE(v.ok()) << v.status();
+  ASSERT_THAT(v, testing::IsOk());
   const auto stats = volume::compute_label_statistics(*v);
   const auto surfaces = extract_all(*v);
   ASSERT_EQ(surfaces.size(), stats.labels.size());
@@ -172,7 +173,7 @@ void expect_volumes_match_voxels(const std::string& file, uint64_t min_voxels, d
 TEST(ExtractSurfacesRealData, LiverSurfacesAreClosedManifoldAndKeepVolume) {
   LABELMESH_SKIP_WITHOUT_SHARED_DATA();
   auto v = volume::read_label_volume(testing::shared_data("liver.inr.gz"), {}, RunContext{});
-  ASSERT_TRUE(v.ok()) << v.status();
+  ASSERT_THAT(v, testing::IsOk());
   const auto stats = volume::compute_label_statistics(*v);
   const auto surfaces = extract_all(*v);
   ASSERT_EQ(surfaces.size(), 4u);

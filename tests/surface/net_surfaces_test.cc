@@ -22,6 +22,7 @@
 #include "support/analytic_shapes.h"
 #include "support/label_grid.h"
 #include "support/slicer_like.h"
+#include "support/status_matchers.h"
 #include "support/test_files.h"
 
 namespace labelmesh {
@@ -121,7 +122,7 @@ TEST(VoxelFidelity, TheStaircaseIsExactAndAShrunkCopyIsNot) {
   const auto statistics = volume::compute_label_statistics(v);
   const auto cut = conforming::net_label_surface(staircase_net(v), 1, v.geometry);
   auto exact = surface::measure_voxel_fidelity(cut.staircase, v, statistics.labels.front(), {});
-  ASSERT_TRUE(exact.ok()) << exact.status();
+  ASSERT_THAT(exact, testing::IsOk());
   EXPECT_NEAR(exact->volume_change, 0, 1e-9);
   EXPECT_EQ(exact->misclassified, 0u);
   EXPECT_GT(exact->boundary_voxels, 1000u);
@@ -158,7 +159,7 @@ const SurfaceResult* output_of(const MeshResult& result, int32_t label) {
 TEST(NetSurfaces, NestedLabelsShareTheirInterfacesWithoutOverlap) {
   auto result = run_pipeline_on_volume(
       volume::make_phantom(volume::PhantomShape::kNestedSpheres).volume, MeshParams{}, {});
-  ASSERT_TRUE(result.ok()) << result.status();
+  ASSERT_THAT(result, testing::IsOk());
   EXPECT_TRUE(result->warnings.empty());
   std::map<int32_t, const SurfaceResult*> out;
   for (int32_t label : {1, 2, 3}) {
@@ -205,7 +206,7 @@ TEST(NetSurfaces, ThickSliceShapesAreTruerThanTheSlicerLikePipeline) {
     const auto slicer = testing::slicer_like_surfaces(v, statistics, {1});
     ASSERT_EQ(slicer.size(), 1u);
     auto result = run_pipeline_on_volume(v, MeshParams{}, {});
-    ASSERT_TRUE(result.ok()) << result.status();
+    ASSERT_THAT(result, testing::IsOk());
     const auto* ours = output_of(*result, 1);
     ASSERT_NE(ours, nullptr);
     EXPECT_EQ(ours->stage, "net") << shape.name;
@@ -221,7 +222,7 @@ TEST(NetSurfaces, ThickSliceShapesAreTruerThanTheSlicerLikePipeline) {
 TEST(NetSurfaces, CoarseIsotropicSphereIsWithinAQuarterVoxel) {
   const auto shape = testing::sphere_shape(25);
   auto result = run_pipeline_on_volume(testing::sample_shape(shape, {3, 3, 3}), MeshParams{}, {});
-  ASSERT_TRUE(result.ok()) << result.status();
+  ASSERT_THAT(result, testing::IsOk());
   const auto* ours = output_of(*result, 1);
   ASSERT_NE(ours, nullptr);
   const auto error = testing::shape_error(ours->mesh, shape);
@@ -238,7 +239,7 @@ TEST(NetSurfacesRealData, MrLabelsAreFaithfulSmoothOrWarned) {
   const auto path = testing::shared_data("totalseg_example_seg_mr.nii.gz");
   if (!std::filesystem::exists(path)) GTEST_SKIP() << "missing " << path;
   auto result = run_pipeline(path, MeshParams{}, {});
-  ASSERT_TRUE(result.ok()) << result.status();
+  ASSERT_THAT(result, testing::IsOk());
   std::vector<double> ours, marching_cubes;
   size_t outputs = 0, outside = 0, nets = 0;
   for (const auto& s : result->surfaces) {
@@ -270,7 +271,7 @@ TEST(NetSurfacesRealData, MrLabelsAreFaithfulSmoothOrWarned) {
   strict.guard.strict = true;
   auto refused = run_pipeline(path, strict, {});
   ASSERT_FALSE(refused.ok());
-  EXPECT_EQ(refused.status().code(), absl::StatusCode::kFailedPrecondition);
+  EXPECT_THAT(refused, testing::StatusIs(absl::StatusCode::kFailedPrecondition));
   EXPECT_NE(refused.status().message().find("voxel centres on the wrong side"), std::string::npos)
       << refused.status();
 }
@@ -283,7 +284,7 @@ TEST(NetSurfacesRealData, EveryBrainLabelIsAClosedManifold) {
   const auto path = testing::shared_data("iso2mesh_brain_seg_converted.nii.gz");
   if (!std::filesystem::exists(path)) GTEST_SKIP() << "missing " << path;
   auto v = volume::read_label_volume(path, {}, RunContext{});
-  ASSERT_TRUE(v.ok()) << v.status();
+  ASSERT_THAT(v, testing::IsOk());
   const auto net = smoothed_net(*v);
   const auto net_crossings = surface::crossing_triangles(net.points, net.triangles);
   uint32_t split = 0;

@@ -20,6 +20,7 @@
 #include "core/volume/phantom.h"
 #include "core/volume/write_label_volume.h"
 #include "support/label_grid.h"
+#include "support/status_matchers.h"
 #include "support/test_files.h"
 
 namespace labelmesh {
@@ -55,7 +56,7 @@ MeshParams poisson_everywhere() {
 
 MeshResult mesh_file(const std::string& path, const MeshParams& params = poisson_everywhere()) {
   auto result = run_pipeline(path, params, RunContext{});
-  EXPECT_TRUE(result.ok()) << result.status();
+  EXPECT_THAT(result, testing::IsOk());
   return result.ok() ? std::move(*result) : MeshResult{};
 }
 
@@ -275,7 +276,7 @@ TEST(PoissonSurface, ALabelOfOnlySpecksIsReportedUnlessAskedFor) {
   MeshParams only_speck = poisson_everywhere();
   only_speck.labels = {2};
   const auto refused = run_pipeline(path, only_speck, RunContext{});
-  EXPECT_EQ(refused.status().code(), absl::StatusCode::kFailedPrecondition);
+  EXPECT_THAT(refused, testing::StatusIs(absl::StatusCode::kFailedPrecondition));
   EXPECT_NE(std::string(refused.status().message()).find("label 2"), std::string::npos);
 }
 
@@ -365,7 +366,7 @@ TEST(PoissonSurface, CancellingStopsWithinASecond) {
   auto result = run_pipeline(path, params, context);
   const auto returned = std::chrono::steady_clock::now();
   canceller.join();
-  EXPECT_EQ(result.status().code(), absl::StatusCode::kCancelled);
+  EXPECT_THAT(result, testing::StatusIs(absl::StatusCode::kCancelled));
   EXPECT_TRUE(in_poisson) << "the stop was meant to come during the Poisson stage";
   EXPECT_LT(std::chrono::duration<double>(returned - asked).count(), 1.0);
 }
@@ -379,7 +380,7 @@ TEST(PoissonSurface, AStopDuringTheChecksCancelsTheRun) {
     if (update.stage == "surface_distance") stop = true;
   };
   auto result = run_pipeline(path, poisson_everywhere(), context);
-  EXPECT_EQ(result.status().code(), absl::StatusCode::kCancelled);
+  EXPECT_THAT(result, testing::StatusIs(absl::StatusCode::kCancelled));
 }
 
 TEST(PoissonSurface, AStopCancelsBothHalves) {
@@ -403,14 +404,14 @@ TEST(PoissonSurface, AStopCancelsBothHalves) {
   params.split_overlap_mm = 5;
   surface::PoissonFigures figures;
   const auto whole = surface::reconstruct_poisson_surface(points, normals, params, {}, figures);
-  ASSERT_TRUE(whole.ok()) << whole.status();
+  ASSERT_THAT(whole, testing::IsOk());
   EXPECT_TRUE(figures.solved_in_halves);
   std::atomic<bool> stop{true};
   RunContext stopping;
   stopping.stop = &stop;
   const auto stopped =
       surface::reconstruct_poisson_surface(points, normals, params, stopping, figures);
-  EXPECT_EQ(stopped.status().code(), absl::StatusCode::kCancelled);
+  EXPECT_THAT(stopped, testing::StatusIs(absl::StatusCode::kCancelled));
 }
 
 TEST(PoissonSurface, RepairedStageWritesTheRepairedSurface) {

@@ -9,6 +9,7 @@
 #include "core/surface/surface_statistics.h"
 #include "core/volume/label_statistics.h"
 #include "core/volume/phantom.h"
+#include "support/status_matchers.h"
 
 namespace labelmesh::surface {
 namespace {
@@ -19,7 +20,7 @@ using volume::PhantomShape;
 TriangleMesh marching_cubes(const volume::Phantom& phantom) {
   const auto stats = volume::compute_label_statistics(phantom.volume);
   auto surfaces = extract_surfaces(phantom.volume, stats, {1}, RunContext{});
-  EXPECT_TRUE(surfaces.ok()) << surfaces.status();
+  EXPECT_THAT(surfaces, testing::IsOk());
   return surfaces.ok() && !surfaces->empty() ? std::move((*surfaces)[0].mesh) : TriangleMesh{};
 }
 
@@ -37,7 +38,7 @@ TEST(SmoothSurface, FlattensTheStaircaseWithoutShrinking) {
   const TriangleMesh staircase = marching_cubes(phantom);
   ASSERT_GT(staircase.points.size(), 1000u);
   auto smoothed = smooth_surface(staircase, SmoothingParams{}, RunContext{});
-  ASSERT_TRUE(smoothed.ok()) << smoothed.status();
+  ASSERT_THAT(smoothed, testing::IsOk());
   // Connectivity is untouched: same points, same triangles.
   ASSERT_EQ(smoothed->points.size(), staircase.points.size());
   EXPECT_EQ(smoothed->triangles, staircase.triangles);
@@ -71,7 +72,7 @@ TEST(SmoothSurface, BadParametersAreRefused) {
   wide.pass_band = 2;
   for (const auto& params : {negative, wide}) {
     auto refused = smooth_surface(staircase, params, RunContext{});
-    EXPECT_EQ(refused.status().code(), absl::StatusCode::kInvalidArgument);
+    EXPECT_THAT(refused, testing::StatusIs(absl::StatusCode::kInvalidArgument));
     EXPECT_NE(std::string(refused.status().message()).find("smoothing-"), std::string::npos);
   }
 }

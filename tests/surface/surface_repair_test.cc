@@ -15,6 +15,7 @@
 #include "core/surface/surface_statistics.h"
 #include "core/volume/label_statistics.h"
 #include "support/label_grid.h"
+#include "support/status_matchers.h"
 
 namespace labelmesh::surface {
 namespace {
@@ -34,7 +35,7 @@ TriangleMesh block_surface() {
 
 TriangleMesh repair(const TriangleMesh& mesh, RepairCounts& counts) {
   auto repaired = repair_surface(mesh, RepairParams{}, RunContext{}, counts);
-  EXPECT_TRUE(repaired.ok()) << repaired.status();
+  EXPECT_THAT(repaired, testing::IsOk());
   return repaired.ok() ? std::move(*repaired) : TriangleMesh{};
 }
 

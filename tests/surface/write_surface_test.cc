@@ -27,6 +27,7 @@
 #include "core/surface/extract_surfaces.h"
 #include "core/volume/label_statistics.h"
 #include "core/volume/phantom.h"
+#include "support/status_matchers.h"
 #include "support/test_files.h"
 
 namespace labelmesh::surface {
@@ -177,7 +178,7 @@ TEST(WriteSurface, TheSceneHasOneNamedBlockPerLabel) {
 
 TEST(WriteSurface, UnwritablePathIsAnError) {
   const auto status = write_surface(torus_surface(), "/nonexistent/dir/x.vtp", SurfaceFormat::kVtp);
-  EXPECT_EQ(status.code(), absl::StatusCode::kInternal);
+  EXPECT_THAT(status, testing::StatusIs(absl::StatusCode::kInternal));
   EXPECT_NE(std::string(status.message()).find("/nonexistent/dir/x.vtp"), std::string::npos);
 }
 

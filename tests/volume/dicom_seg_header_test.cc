@@ -14,6 +14,7 @@
 #include <utility>
 #include <vector>
 
+#include "support/status_matchers.h"
 #include "support/test_files.h"
 
 namespace labelmesh {
@@ -28,7 +29,7 @@ std::string seg_file(std::string_view name) {
 
 DicomSegHeader parse_ok(const std::string& path) {
   auto header = parse_dicom_seg_header(path);
-  EXPECT_TRUE(header.ok()) << header.status();
+  EXPECT_THAT(header, testing::IsOk());
   return header.ok() ? *std::move(header) : DicomSegHeader{};
 }
 
@@ -41,7 +42,7 @@ absl::Status parse_bytes(const std::filesystem::path& dir, std::string_view byte
 }
 
 void expect_invalid(const absl::Status& status, std::string_view field, std::string_view problem) {
-  EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument) << status;
+  EXPECT_THAT(status, testing::StatusIs(absl::StatusCode::kInvalidArgument)) << status;
   EXPECT_NE(status.message().find(std::string(field)), std::string::npos) << status;
   EXPECT_NE(status.message().find(std::string(problem)), std::string::npos) << status;
 }
@@ -375,7 +376,7 @@ TEST(DicomSegHeader, ReadsTheSameHeaderInEveryNativeSyntaxAndLengthForm) {
 
 TEST(DicomSegHeader, ReportsAMissingFileAsNotFound) {
   auto header = parse_dicom_seg_header("/nonexistent/seg.dcm");
-  EXPECT_EQ(header.status().code(), absl::StatusCode::kNotFound);
+  EXPECT_THAT(header, testing::StatusIs(absl::StatusCode::kNotFound));
 }
 
 TEST(DicomSegHeader, RefusesAFileWithoutTheDicmMagic) {
@@ -500,7 +501,7 @@ TEST(DicomSegHeader, RefusesSequencesNestedMoreThanEightDeep) {
       w.element(0x7FE0, 0x0010, "OB", "");
       const absl::Status status = parse_bytes(dir, part10("1.2.840.10008.1.2.1", w.bytes()));
       if (depth == 8) {
-        EXPECT_TRUE(status.ok()) << status;
+        EXPECT_THAT(status, testing::IsOk());
       } else {
         expect_invalid(status, "(0008,1115)", "nests sequences more than 8 deep");
       }
@@ -592,7 +593,7 @@ TEST(DicomSegHeader, RefusesMoreFramesOrSegmentsThanItsLimits) {
     w.element(0x7FE0, 0x0010, "OB", "");
     const absl::Status status = parse_bytes(dir, part10("1.2.840.10008.1.2.1", w.bytes()));
     if (segments == 65535) {
-      EXPECT_TRUE(status.ok()) << status;
+      EXPECT_THAT(status, testing::IsOk());
     } else {
       expect_invalid(status, "(0062,0002) SegmentSequence", "holds more than 65535 segments");
     }

@@ -10,6 +10,7 @@
 
 #include "core/volume/label_statistics.h"
 #include "support/label_grid.h"
+#include "support/status_matchers.h"
 
 namespace labelmesh::volume {
 namespace {
@@ -21,7 +22,7 @@ LabelComponents components_of(const LabelVolume& v, int32_t label, bool prune) {
   ComponentOptions options;
   options.prune_strands = prune;
   auto found = find_label_components(v, *entry, options, RunContext{});
-  EXPECT_TRUE(found.ok()) << found.status();
+  EXPECT_THAT(found, testing::IsOk());
   return found.ok() ? std::move(*found) : LabelComponents{};
 }
 
@@ -165,7 +166,7 @@ TEST(LabelComponents, SmallCavitiesAreFilledLargeAndOpenOnesKept) {
   options.fill_cavities_below = 64;
   const auto stats = compute_label_statistics(v);
   const auto found = find_label_components(v, stats.labels[0], options, RunContext{});
-  ASSERT_TRUE(found.ok()) << found.status();
+  ASSERT_THAT(found, testing::IsOk());
   EXPECT_EQ(found->filled_cavities, 2u);
   EXPECT_EQ(found->filled_voxels, 9u);
   ASSERT_EQ(found->components.size(), 1u);
@@ -292,7 +293,7 @@ TEST(LabelComponents, CancelledRunStops) {
   RunContext context;
   context.stop = &stop;
   auto found = find_label_components(v, stats.labels[0], ComponentOptions{}, context);
-  EXPECT_EQ(found.status().code(), absl::StatusCode::kCancelled);
+  EXPECT_THAT(found, testing::StatusIs(absl::StatusCode::kCancelled));
 }
 
 }  // namespace

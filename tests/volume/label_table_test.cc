@@ -8,6 +8,7 @@
 #include "absl/strings/match.h"
 #include "absl/time/clock.h"
 #include "core/util/utf8.h"
+#include "support/status_matchers.h"
 #include "support/test_files.h"
 
 namespace labelmesh::volume {
@@ -22,7 +23,7 @@ std::string write_table(const std::string& file, const std::string& text) {
 TEST(LabelTable, ReadsAnItkSnapLabelFile) {
   LABELMESH_SKIP_WITHOUT_SHARED_DATA();
   auto table = read_label_table(testing::shared_data("MRIcrop-seg.label"));
-  ASSERT_TRUE(table.ok()) << table.status();
+  ASSERT_THAT(table, testing::IsOk());
   // Twelve rows; label 0 ("Clear") is the background.
   ASSERT_EQ(table->size(), 11u);
   EXPECT_EQ((*table)[0].label, 1);
@@ -37,7 +38,7 @@ TEST(LabelTable, ReadsAFreeSurferColourTable) {
                                             "0   Unknown                 0   0   0   0\n"
                                             "2   Left-Cerebral-White-Matter  245 245 245 0\n"
                                             "41  Right-Cerebral-White-Matter 0 225 0 0\n"));
-  ASSERT_TRUE(table.ok()) << table.status();
+  ASSERT_THAT(table, testing::IsOk());
   ASSERT_EQ(table->size(), 2u);
   EXPECT_EQ((*table)[1].label, 41);
   EXPECT_EQ((*table)[1].name, "Right-Cerebral-White-Matter");
@@ -47,7 +48,7 @@ TEST(LabelTable, ReadsAFreeSurferColourTable) {
 TEST(LabelTable, ReadsAJsonMapOfNamesOrObjects) {
   auto table = read_label_table(write_table(
       "names.json", R"({"5": "liver", "114": {"name": "spleen", "color": [157, 108, 162]}})"));
-  ASSERT_TRUE(table.ok()) << table.status();
+  ASSERT_THAT(table, testing::IsOk());
   ASSERT_EQ(table->size(), 2u);
   EXPECT_EQ((*table)[0].label, 5);
   EXPECT_EQ((*table)[0].name, "liver");
@@ -59,7 +60,7 @@ TEST(LabelTable, ReadsAJsonMapOfNamesOrObjects) {
 TEST(LabelTable, AHashInsideAQuotedNameIsNoComment) {
   auto table =
       read_label_table(write_table("hash.label", "# lesions\n1 255 0 0 1 1 1 \"Lesion #2\"\n"));
-  ASSERT_TRUE(table.ok()) << table.status();
+  ASSERT_THAT(table, testing::IsOk());
   ASSERT_EQ(table->size(), 1u);
   EXPECT_EQ((*table)[0].name, "Lesion #2");
 }
@@ -67,7 +68,7 @@ TEST(LabelTable, AHashInsideAQuotedNameIsNoComment) {
 // A Latin-1 file: the report's string fields take only UTF-8.
 TEST(LabelTable, NamesThatAreNotUtf8AreMadeValid) {
   auto table = read_label_table(write_table("latin1.label", "1 1 2 3 1 1 1 \"Gl\xe4ndula\"\n"));
-  ASSERT_TRUE(table.ok()) << table.status();
+  ASSERT_THAT(table, testing::IsOk());
   ASSERT_EQ(table->size(), 1u);
   EXPECT_EQ((*table)[0].name, "Gl?ndula");
   EXPECT_EQ(valid_utf8("Gl\xc3\xa4ndula \xe2\x82\xac"), "Gl\xc3\xa4ndula \xe2\x82\xac");
@@ -90,7 +91,7 @@ TEST(LabelTable, ErrorsNameTheFileAndLine) {
     const std::string path = write_table("bad.txt", c.text);
     auto table = read_label_table(path);
     ASSERT_FALSE(table.ok()) << c.text;
-    EXPECT_EQ(table.status().code(), absl::StatusCode::kInvalidArgument);
+    EXPECT_THAT(table, testing::StatusIs(absl::StatusCode::kInvalidArgument));
     EXPECT_TRUE(absl::StrContains(table.status().message(), path)) << table.status();
     EXPECT_TRUE(absl::StrContains(table.status().message(), c.expected)) << table.status();
   }
@@ -104,14 +105,14 @@ TEST(LabelTable, DeeplyNestedJsonIsRefusedAtOnce) {
   const auto refused = read_label_table(path);
   EXPECT_LT(absl::Now() - start, absl::Seconds(1));
   ASSERT_FALSE(refused.ok());
-  EXPECT_EQ(refused.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(refused, testing::StatusIs(absl::StatusCode::kInvalidArgument));
   EXPECT_TRUE(absl::StrContains(refused.status().message(), "deep.json")) << refused.status();
   EXPECT_TRUE(absl::StrContains(refused.status().message(), "nests deeper than 8"))
       << refused.status();
   // Brackets inside a name do not count; a colour nests three deep.
   const auto fine = read_label_table(write_table(
       "fine.json", R"({"5": {"name": "[[[[[[[[[[ liver {{{{{{{{{{", "color": [1, 2, 3]}})"));
-  ASSERT_TRUE(fine.ok()) << fine.status();
+  ASSERT_THAT(fine, testing::IsOk());
   ASSERT_EQ(fine->size(), 1u);
   EXPECT_EQ((*fine)[0].name, "[[[[[[[[[[ liver {{{{{{{{{{");
 }

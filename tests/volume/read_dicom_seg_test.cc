@@ -20,6 +20,7 @@
 #include "core/volume/dicom_seg_grid.h"
 #include "core/volume/read_label_volume.h"
 #include "core/volume/voxel_access.h"
+#include "support/status_matchers.h"
 #include "support/test_files.h"
 
 namespace labelmesh::volume {
@@ -29,7 +30,7 @@ std::string seg_file(const std::string& name) { return testing::shared_data("dic
 
 LabelVolume read_or_fail(const std::string& path, const ReadLimits& limits = {}) {
   auto volume = read_label_volume(path, limits, RunContext{});
-  EXPECT_TRUE(volume.ok()) << volume.status();
+  EXPECT_THAT(volume, testing::IsOk());
   return volume.ok() ? std::move(*volume) : LabelVolume{};
 }
 
@@ -141,7 +142,7 @@ TEST(DicomSeg, FractionalPixelsAreInsideFromTheThreshold) {
 TEST(DicomSeg, OverlappingSegmentsAreAnErrorNamingThem) {
   LABELMESH_SKIP_WITHOUT_SHARED_DATA();
   const absl::Status status = refusal_of("highdicom-seg_image_ct_binary_overlap.dcm");
-  EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(status, testing::StatusIs(absl::StatusCode::kInvalidArgument));
   // pydicom: the two segments' frames share 16 pixels.
   EXPECT_TRUE(absl::StrContains(status.message(), "segments 1 and 2 share 16 voxels")) << status;
   EXPECT_TRUE(absl::StrContains(status.message(), "highdicom-seg_image_ct_binary_overlap.dcm"))
@@ -161,7 +162,7 @@ int64_t voxels_with(vtkImageData* image, int64_t label) {
 // pydicom's pixel_array would sum them, without the reader.
 std::map<int64_t, int64_t> bits_per_segment(const std::string& path) {
   auto header = internal::parse_dicom_seg_header(path);
-  EXPECT_TRUE(header.ok()) << header.status();
+  EXPECT_THAT(header, testing::IsOk());
   if (!header.ok()) return {};
   EXPECT_EQ(header->bits_allocated, 1);
   const std::string bytes = testing::read_bytes(path);
@@ -246,7 +247,7 @@ TEST(DicomSeg, LayersKeptApartCountAgainstTheVoxelLimit) {
   limits.separate_overlapping = true;
   limits.max_voxels = 16 * 16 * 165;  // one layer, not two
   const absl::Status status = read_label_volume(path, limits, RunContext{}).status();
-  EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(status, testing::StatusIs(absl::StatusCode::kInvalidArgument));
   EXPECT_TRUE(absl::StrContains(status.message(), "highdicom-seg_image_ct_binary_overlap.dcm"))
       << status;
   EXPECT_TRUE(absl::StrContains(status.message(), "2 layers of 42240 voxels")) << status;
@@ -259,7 +260,7 @@ TEST(DicomSeg, SparseFramesLandOnTheSliceGridAcrossTheGap) {
   LABELMESH_SKIP_WITHOUT_SHARED_DATA();
   // Frames at z -99.48 and 103.02 to 105.52 mm, 1.25 mm apart: 165 slices.
   auto header = check_volume_header(seg_file("highdicom-seg_image_ct_binary_overlap.dcm"));
-  ASSERT_TRUE(header.ok()) << header.status();
+  ASSERT_THAT(header, testing::IsOk());
   EXPECT_EQ(header->geometry.dims, (std::array<int64_t, 3>{16, 16, 165}));
   EXPECT_NEAR(header->geometry.origin[2], -99.48, 1e-4);
 }
@@ -267,14 +268,14 @@ TEST(DicomSeg, SparseFramesLandOnTheSliceGridAcrossTheGap) {
 TEST(DicomSeg, WhatHasNoPatientSpaceVolumeIsRefusedSayingWhy) {
   LABELMESH_SKIP_WITHOUT_SHARED_DATA();
   const absl::Status radiograph = refusal_of("highdicom-seg_image_cr_binary.dcm");
-  EXPECT_EQ(radiograph.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(radiograph, testing::StatusIs(absl::StatusCode::kInvalidArgument));
   EXPECT_TRUE(absl::StrContains(radiograph.message(), "no 3D patient-space geometry"))
       << radiograph;
   const absl::Status slide = refusal_of("highdicom-seg_image_sm_control.dcm");
-  EXPECT_EQ(slide.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(slide, testing::StatusIs(absl::StatusCode::kInvalidArgument));
   EXPECT_TRUE(absl::StrContains(slide.message(), "slide microscopy")) << slide;
   const absl::Status label_map = refusal_of("dcmqi-sparse-labelmap-noppv.dcm");
-  EXPECT_EQ(label_map.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(label_map, testing::StatusIs(absl::StatusCode::kInvalidArgument));
   EXPECT_TRUE(absl::StrContains(label_map.message(), "Label Map Segmentation Storage"))
       << label_map;
 }
@@ -285,12 +286,12 @@ TEST(DicomSeg, SegmentsNumberedOutOfOrderAreRefused) {
   LABELMESH_SKIP_WITHOUT_SHARED_DATA();
   const std::string path = seg_file("dcmqi-24x38x3-seg.dcm");
   auto header = internal::parse_dicom_seg_header(path);
-  ASSERT_TRUE(header.ok()) << header.status();
+  ASSERT_THAT(header, testing::IsOk());
   ASSERT_TRUE(dicom_seg_grid(path, *header, ReadLimits{}).ok());
   header->segment_numbers = {2};
   header->frame_segments = {2, 2, 2};
   const absl::Status status = dicom_seg_grid(path, *header, ReadLimits{}).status();
-  EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(status, testing::StatusIs(absl::StatusCode::kInvalidArgument));
   EXPECT_TRUE(absl::StrContains(status.message(), "numbered 1, 2, 3")) << status;
 }
 
@@ -300,7 +301,7 @@ TEST(DicomSeg, TheVoxelLimitHoldsBeforeAnythingIsRead) {
   tiny.max_voxels = 24 * 38 * 3 - 1;
   const auto status =
       read_label_volume(seg_file("dcmqi-24x38x3-seg.dcm"), tiny, RunContext{}).status();
-  EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(status, testing::StatusIs(absl::StatusCode::kInvalidArgument));
   EXPECT_TRUE(absl::StrContains(status.message(), "exceeds the limit of 2735")) << status;
 }
 

@@ -11,6 +11,7 @@
 #include "core/volume/label_statistics.h"
 #include "core/volume/phantom.h"
 #include "core/volume/write_label_volume.h"
+#include "support/status_matchers.h"
 #include "support/test_files.h"
 
 namespace labelmesh::volume {
@@ -20,7 +21,7 @@ using testing::Nifti1Bytes;
 
 LabelVolume read_or_die(const std::string& path) {
   auto volume = read_label_volume(path, ReadLimits{}, RunContext{});
-  EXPECT_TRUE(volume.ok()) << volume.status();
+  EXPECT_THAT(volume, testing::IsOk());
   return volume.ok() ? std::move(*volume) : LabelVolume{};
 }
 
@@ -119,7 +120,7 @@ TEST(ReadLabelVolume, RealValuedVolumesNeedWholeNumbers) {
   const auto refused =
       read_label_volume((dir / "fraction.nii").string(), ReadLimits{}, RunContext{});
   ASSERT_FALSE(refused.ok());
-  EXPECT_EQ(refused.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(refused, testing::StatusIs(absl::StatusCode::kInvalidArgument));
   EXPECT_NE(std::string(refused.status().message()).find("whole-number"), std::string::npos);
 }
 
@@ -129,7 +130,7 @@ TEST(ReadLabelVolume, StopsWhenCancelled) {
   context.stop = &stop;
   const auto result =
       read_label_volume(testing::shared_data("liver.inr.gz"), ReadLimits{}, context);
-  EXPECT_EQ(result.status().code(), absl::StatusCode::kCancelled);
+  EXPECT_THAT(result, testing::StatusIs(absl::StatusCode::kCancelled));
 }
 
 // The real segmentations: dims and label voxel counts from shared/data/SOURCES.md.
@@ -148,7 +149,7 @@ TEST_P(RealData, MatchesSources) {
   const RealVolume& expected = GetParam();
   const auto summary =
       summarise_volume(testing::shared_data(expected.file), ReadLimits{}, RunContext{});
-  ASSERT_TRUE(summary.ok()) << summary.status();
+  ASSERT_THAT(summary, testing::IsOk());
   EXPECT_EQ(summary->geometry.dims, expected.dims);
   const auto& stats = summary->statistics;
   EXPECT_EQ(stats.labels.size(), expected.label_count);

@@ -17,6 +17,7 @@
 #include "core/volume/read_label_volume.h"
 #include "core/volume/slicer_segments.h"
 #include "support/gzip_file.h"
+#include "support/status_matchers.h"
 #include "support/test_files.h"
 
 namespace labelmesh::volume {
@@ -120,7 +121,7 @@ TEST(SlicerSeg, SingleLayerKeepsValuesNamesAndColours) {
                                               {"  rein gauche \xc3\xa9  ", 5, 0, "1 1 1"}}),
                single_layer_voxels(), true);
   auto volume = read(path);
-  ASSERT_TRUE(volume.ok()) << volume.status();
+  ASSERT_THAT(volume, testing::IsOk());
   EXPECT_EQ(voxel_counts(*volume), (std::map<int32_t, uint64_t>{{1, 10}, {2, 20}, {5, 7}}));
   ASSERT_EQ(volume->descriptions.size(), 3u);
   const auto& liver = volume->descriptions[0];
@@ -150,7 +151,7 @@ TEST(SlicerSeg, GeometryIsThatOfAPlainNrrd) {
   const std::string layered =
       seg_file(dir, "layered.seg.nrrd", grid_header(1) + segment_keys({{"a"}}), voxels, false);
   auto expected = read(plain);
-  ASSERT_TRUE(expected.ok()) << expected.status();
+  ASSERT_THAT(expected, testing::IsOk());
   // RAS (10,20,30) is LPS (-10,-20,30); axis 0 runs along y, axis 1 along -x.
   const std::array<double, 3> origin{-10, -20, 30}, spacing{0.5, 0.8, 2};
   const std::array<double, 9> direction{0, 1, 0, -1, 0, 0, 0, 0, 1};
@@ -161,7 +162,7 @@ TEST(SlicerSeg, GeometryIsThatOfAPlainNrrd) {
   for (int i = 0; i < 9; ++i) EXPECT_NEAR(expected->geometry.direction[i], direction[i], 1e-12);
   for (const std::string& path : {single, layered}) {
     auto volume = read(path);
-    ASSERT_TRUE(volume.ok()) << volume.status();
+    ASSERT_THAT(volume, testing::IsOk());
     EXPECT_EQ(volume->geometry.dims, expected->geometry.dims) << path;
     EXPECT_EQ(volume->geometry.origin, expected->geometry.origin) << path;
     EXPECT_EQ(volume->geometry.spacing, expected->geometry.spacing) << path;
@@ -180,11 +181,11 @@ TEST(SlicerSeg, LayersThatReuseAValueAreRenumberedInSegmentOrder) {
                grid_header(2) + segment_keys({{"skin", 1, 0}, {"tumour", 1, 1}, {"bone", 2, 0}}),
                interleave({first, second}), true);
   auto header = check_volume_header(path);
-  ASSERT_TRUE(header.ok()) << header.status();
+  ASSERT_THAT(header, testing::IsOk());
   EXPECT_EQ(header->layers, 2);
   EXPECT_EQ(header->data_bytes(), 2u * kVoxels);
   auto volume = read(path);
-  ASSERT_TRUE(volume.ok()) << volume.status();
+  ASSERT_THAT(volume, testing::IsOk());
   EXPECT_EQ(voxel_counts(*volume), (std::map<int32_t, uint64_t>{{1, 12}, {2, 40}, {3, 3}}));
   ASSERT_EQ(volume->descriptions.size(), 3u);
   EXPECT_EQ(volume->descriptions[0].name, "skin");
@@ -202,7 +203,7 @@ TEST(SlicerSeg, LayersWithDistinctValuesKeepThem) {
       seg_file(dir, "distinct.seg.nrrd", grid_header(2) + segment_keys({{"a", 3, 0}, {"b", 7, 1}}),
                interleave({first, second}), false);
   auto volume = read(path);
-  ASSERT_TRUE(volume.ok()) << volume.status();
+  ASSERT_THAT(volume, testing::IsOk());
   EXPECT_EQ(voxel_counts(*volume), (std::map<int32_t, uint64_t>{{3, 5}, {7, 6}}));
   EXPECT_EQ(volume->descriptions[0].label, 3);
   EXPECT_EQ(volume->descriptions[1].label, 7);
@@ -218,7 +219,7 @@ TEST(SlicerSeg, OverlappingSegmentsAreAnErrorNamingThem) {
       interleave({first, second}), false);
   auto volume = read(path);
   ASSERT_FALSE(volume.ok());
-  EXPECT_EQ(volume.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(volume, testing::StatusIs(absl::StatusCode::kInvalidArgument));
   const std::string message(volume.status().message());
   EXPECT_NE(message.find(path), std::string::npos) << message;
   EXPECT_NE(message.find("segment 0 \"liver\" and segment 1 \"tumour\" share 4 voxels"),
@@ -250,7 +251,7 @@ TEST(SlicerSeg, OverlappingSegmentsCanBeKeptApartInLayers) {
   ReadLimits limits;
   limits.separate_overlapping = true;
   auto volume = read(path, limits);
-  ASSERT_TRUE(volume.ok()) << volume.status();
+  ASSERT_THAT(volume, testing::IsOk());
   // Values reused across layers: labels 1..4 in segment order. The tumour
   // cannot share the liver's layer; spleen and vessel fit beside the liver.
   ASSERT_EQ(volume->more_layers.size(), 1u);
@@ -270,7 +271,7 @@ TEST(SlicerSeg, OverlappingSegmentsCanBeKeptApartInLayers) {
 
   auto refused = read(path);
   ASSERT_FALSE(refused.ok());
-  EXPECT_EQ(refused.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(refused, testing::StatusIs(absl::StatusCode::kInvalidArgument));
   const std::string message(refused.status().message());
   EXPECT_NE(message.find("segment 1 \"tumour\" and segment 3 \"vessel\" share 3 voxels"),
             std::string::npos)
@@ -292,8 +293,8 @@ TEST(SlicerSeg, KeepingOverlapsApartChangesNothingWhenNothingOverlaps) {
   limits.separate_overlapping = true;
   auto plain = read(path);
   auto kept = read(path, limits);
-  ASSERT_TRUE(plain.ok()) << plain.status();
-  ASSERT_TRUE(kept.ok()) << kept.status();
+  ASSERT_THAT(plain, testing::IsOk());
+  ASSERT_THAT(kept, testing::IsOk());
   EXPECT_TRUE(kept->more_layers.empty());
   vtkDataArray* a = plain->voxels->GetPointData()->GetScalars();
   vtkDataArray* b = kept->voxels->GetPointData()->GetScalars();
@@ -384,7 +385,7 @@ TEST_P(SlicerSegHostile, IsRefusedNamingTheFileAndKey) {
                                     std::vector<uint8_t>(2 * kVoxels, 0), false);
   auto header = check_volume_header(path);
   ASSERT_FALSE(header.ok()) << hostile.test_name << " was accepted";
-  EXPECT_EQ(header.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(header, testing::StatusIs(absl::StatusCode::kInvalidArgument));
   const std::string message(header.status().message());
   EXPECT_NE(message.find(path), std::string::npos) << message;
   EXPECT_NE(message.find(hostile.field), std::string::npos) << message;
@@ -401,7 +402,7 @@ TEST(SlicerSeg, NamesUpTo128BytesAfterTrimmingAreKept) {
       seg_file(dir, "long.seg.nrrd", grid_header(0) + segment_keys({{"  " + name + "  "}}),
                std::vector<uint8_t>(kVoxels, 0), false);
   auto header = check_volume_header(path);
-  ASSERT_TRUE(header.ok()) << header.status();
+  ASSERT_THAT(header, testing::IsOk());
   ASSERT_EQ(header->segments.size(), 1u);
   EXPECT_EQ(header->segments[0].description.name, name);
 }
@@ -416,7 +417,7 @@ TEST(SlicerSeg, SegmentsWithoutLayerOrValueKeysHaveALayerEach) {
       dir, "old.seg.nrrd", grid_header(2) + "Segment0_ID:=a\nSegment0_Name:=a\nSegment1_ID:=b\n",
       interleave({first, second}), false);
   auto volume = read(path);
-  ASSERT_TRUE(volume.ok()) << volume.status();
+  ASSERT_THAT(volume, testing::IsOk());
   EXPECT_EQ(voxel_counts(*volume), (std::map<int32_t, uint64_t>{{1, 4}, {2, 5}}));
   EXPECT_EQ(volume->descriptions[1].name, "b");  // the ID when there is no name
 }

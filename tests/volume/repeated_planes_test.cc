@@ -9,6 +9,7 @@
 
 #include "core/volume/read_label_volume.h"
 #include "support/label_grid.h"
+#include "support/status_matchers.h"
 #include "support/test_files.h"
 
 namespace labelmesh::volume {
@@ -75,11 +76,11 @@ TEST(RepeatedPlanesRealData, TheLiverWasDrawnOnEveryThirdSlice) {
   LABELMESH_SKIP_WITHOUT_SHARED_DATA();
   // 76 runs of exactly three equal slices: drawn at 2 mm, stored at 0.67 mm.
   auto liver = read_label_volume(testing::shared_data("liver.inr.gz"), ReadLimits{}, RunContext{});
-  ASSERT_TRUE(liver.ok()) << liver.status();
+  ASSERT_THAT(liver, testing::IsOk());
   EXPECT_EQ(repeated_planes_of(*liver), (std::array<int, 3>{1, 1, 3}));
   // Drawn on every 1.5 mm slice as stored.
   auto frog = read_label_volume(testing::shared_data("frogtissue.mhd"), ReadLimits{}, RunContext{});
-  ASSERT_TRUE(frog.ok()) << frog.status();
+  ASSERT_THAT(frog, testing::IsOk());
   EXPECT_EQ(repeated_planes_of(*frog), (std::array<int, 3>{1, 1, 1}));
 }
 

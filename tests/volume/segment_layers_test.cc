@@ -2,6 +2,7 @@
 // First-fit layering of overlapping segments: where each segment goes, and
 // the bounds on how many layers there may be.
 #include "core/volume/segment_layers.h"
+#include "support/status_matchers.h"
 
 #include <gtest/gtest.h>
 
@@ -54,7 +55,7 @@ TEST(SegmentLayers, EachSegmentGoesToTheFirstLayerWhereItFits) {
   // 1 and 2 share voxel 2; 3 overlaps only 2, 4 overlaps 1 and 2, 5 nothing.
   const Segments segments{{{0, 1, 2}, {2, 3, 4}, {4, 5}, {1, 3, 6}, {7}}};
   auto layers = separate(segments, 8);
-  ASSERT_TRUE(layers.ok()) << layers.status();
+  ASSERT_THAT(layers, testing::IsOk());
   ASSERT_EQ(layers->size(), 3u);
   EXPECT_EQ(layer_of_labels(*layers, 5), (std::vector<int>{-1, 0, 1, 0, 2, 0}));
   // Every segment whole: its voxels all carry its label in its layer.
@@ -69,7 +70,7 @@ TEST(SegmentLayers, EachSegmentGoesToTheFirstLayerWhereItFits) {
 
 TEST(SegmentLayers, DisjointSegmentsShareOneLayer) {
   auto layers = separate(Segments{{{0, 1}, {}, {2, 3}}}, 4);
-  ASSERT_TRUE(layers.ok()) << layers.status();
+  ASSERT_THAT(layers, testing::IsOk());
   ASSERT_EQ(layers->size(), 1u);
   EXPECT_EQ(layer_of_labels(*layers, 3), (std::vector<int>{-1, 0, -1, 0}));
 }
@@ -79,13 +80,13 @@ TEST(SegmentLayers, AtMost64Layers) {
   all_at_one_voxel.voxels.assign(kMostSegmentLayers + 1, std::vector<uint64_t>{0});
   auto layers = separate(all_at_one_voxel, 1);
   ASSERT_FALSE(layers.ok());
-  EXPECT_EQ(layers.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(layers, testing::StatusIs(absl::StatusCode::kInvalidArgument));
   EXPECT_TRUE(absl::StrContains(layers.status().message(), "test.dcm")) << layers.status();
   EXPECT_TRUE(absl::StrContains(layers.status().message(), "more than 64 layers"))
       << layers.status();
   all_at_one_voxel.voxels.pop_back();
   layers = separate(all_at_one_voxel, 1);
-  ASSERT_TRUE(layers.ok()) << layers.status();
+  ASSERT_THAT(layers, testing::IsOk());
   EXPECT_EQ(layers->size(), 64u);
 }
 
@@ -94,7 +95,7 @@ TEST(SegmentLayers, LayersTimesVoxelsStayWithinTheVoxelLimit) {
   ReadLimits limits;
   limits.max_voxels = 2 * 10;
   auto layers = separate(overlapping, 10, limits);
-  ASSERT_TRUE(layers.ok()) << layers.status();
+  ASSERT_THAT(layers, testing::IsOk());
   EXPECT_EQ(layers->size(), 2u);
   limits.max_voxels = 2 * 10 - 1;
   layers = separate(overlapping, 10, limits);
@@ -108,7 +109,7 @@ TEST(SegmentLayers, AStopRequestEndsTheLayout) {
   RunContext context;
   context.stop = &stop;
   auto layers = separate(Segments{{{0}}}, 1, ReadLimits{}, context);
-  EXPECT_EQ(layers.status().code(), absl::StatusCode::kCancelled);
+  EXPECT_THAT(layers, testing::StatusIs(absl::StatusCode::kCancelled));
 }
 
 }  // namespace

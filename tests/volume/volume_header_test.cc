@@ -11,6 +11,7 @@
 #include <limits>
 
 #include "support/gzip_file.h"
+#include "support/status_matchers.h"
 #include "support/test_files.h"
 
 namespace labelmesh::volume {
@@ -230,7 +231,7 @@ TEST(VolumeHeader, CorpusHasAtLeastTwentyFiles) { EXPECT_GE(corpus().size(), 20u
 TEST(VolumeHeader, MissingFileIsNotFound) {
   const auto header = check_volume_header("/nonexistent/volume.nii.gz");
   ASSERT_FALSE(header.ok());
-  EXPECT_EQ(header.status().code(), absl::StatusCode::kNotFound);
+  EXPECT_THAT(header, testing::StatusIs(absl::StatusCode::kNotFound));
 }
 
 TEST(VolumeHeader, FreeTextHeaderFieldsAreNeverEchoed) {
@@ -264,7 +265,7 @@ TEST(VolumeHeader, GzipBombIsBoundedByTheDeclaredSize) {
   bytes.append(size_t{64} << 20, '\0');
   ASSERT_TRUE(testing::write_gzip(path, bytes));
   const auto header = check_volume_header(path);
-  ASSERT_TRUE(header.ok()) << header.status();
+  ASSERT_THAT(header, testing::IsOk());
   EXPECT_EQ(header->data_bytes(), 8u);
 }
 
@@ -280,7 +281,7 @@ TEST(VolumeHeader, WholePayloadCheckFindsWhatTheSizeTrailerHides) {
   const auto good = (dir / "good.nii.gz").string();
   ASSERT_TRUE(testing::write_gzip(good, bytes));
   auto header = check_volume_header(good);
-  ASSERT_TRUE(header.ok()) << header.status();
+  ASSERT_THAT(header, testing::IsOk());
   EXPECT_TRUE(check_whole_payload(*header).ok());
 
   const std::string compressed = testing::read_bytes(good);
@@ -298,7 +299,7 @@ TEST(VolumeHeader, WholePayloadCheckFindsWhatTheSizeTrailerHides) {
     auto damaged = check_volume_header(path);
     ASSERT_TRUE(damaged.ok()) << "the header check alone was expected to pass";
     const absl::Status whole = check_whole_payload(*damaged);
-    EXPECT_EQ(whole.code(), absl::StatusCode::kInvalidArgument);
+    EXPECT_THAT(whole, testing::StatusIs(absl::StatusCode::kInvalidArgument));
     EXPECT_NE(std::string(whole.message()).find(path), std::string::npos) << whole.message();
   }
 }

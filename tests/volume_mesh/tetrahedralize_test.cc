@@ -3,6 +3,7 @@
 // exactly the enclosed volume, all are positive, and with keep_boundary the mesh's boundary is
 // the input surface, triangle for triangle and with the same winding.
 #include "core/volume_mesh/tetrahedralize.h"
+#include "support/status_matchers.h"
 
 #include <gtest/gtest.h>
 
@@ -175,7 +176,7 @@ TEST(Tetrahedralize, CubeFillsItsVolumeAndKeepsItsTriangles) {
   ASSERT_DOUBLE_EQ(enclosed_volume(surface), 1000);
   TetgenFigures figures;
   const auto mesh = tetrahedralize(surface, 7, TetgenParams{}, RunContext{}, figures);
-  ASSERT_TRUE(mesh.ok()) << mesh.status();
+  ASSERT_THAT(mesh, testing::IsOk());
   EXPECT_NEAR(check_mesh(*mesh, 7, figures), 1000, 1e-9 * 1000);
   EXPECT_EQ(figures.input_points, 8u);
   EXPECT_EQ(figures.input_triangles, 12u);
@@ -193,7 +194,7 @@ TEST(Tetrahedralize, IcosphereFillsItsVolumeAndKeepsItsTriangles) {
   ASSERT_LT(volume, 4.0 / 3.0 * std::numbers::pi * 1000);
   TetgenFigures figures;
   const auto mesh = tetrahedralize(surface, 1, TetgenParams{}, RunContext{}, figures);
-  ASSERT_TRUE(mesh.ok()) << mesh.status();
+  ASSERT_THAT(mesh, testing::IsOk());
   EXPECT_NEAR(check_mesh(*mesh, 1, figures), volume, 1e-9 * volume);
   EXPECT_EQ(figures.input_points, 162u);
   EXPECT_EQ(figures.input_triangles, 320u);
@@ -211,7 +212,7 @@ TEST(Tetrahedralize, VolumeBoundRefinesAndMayMoveTheBoundary) {
   params.keep_boundary = false;
   TetgenFigures figures;
   const auto mesh = tetrahedralize(surface, 1, params, RunContext{}, figures);
-  ASSERT_TRUE(mesh.ok()) << mesh.status();
+  ASSERT_THAT(mesh, testing::IsOk());
   EXPECT_NEAR(check_mesh(*mesh, 1, figures), volume, 1e-9 * volume);
   EXPECT_GT(figures.steiner_points, 0u);
   // At least volume / bound tetrahedra. Refinement keeps every tetrahedron
@@ -228,7 +229,7 @@ TEST(Tetrahedralize, InnerShellWoundInwardsIsACavity) {
   ASSERT_DOUBLE_EQ(enclosed_volume(surface), 1000 - 64);
   TetgenFigures figures;
   const auto mesh = tetrahedralize(surface, 2, TetgenParams{}, RunContext{}, figures);
-  ASSERT_TRUE(mesh.ok()) << mesh.status();
+  ASSERT_THAT(mesh, testing::IsOk());
   EXPECT_NEAR(check_mesh(*mesh, 2, figures), 936, 1e-9 * 936);
   EXPECT_EQ(mesh_boundary(*mesh), surface_triangles(surface));
   for (const auto& t : mesh->tetrahedra) {
@@ -248,7 +249,7 @@ TEST(Tetrahedralize, IslandInsideACavityIsMaterial) {
   ASSERT_DOUBLE_EQ(enclosed_volume(surface), expected);
   TetgenFigures figures;
   const auto mesh = tetrahedralize(surface, 3, TetgenParams{}, RunContext{}, figures);
-  ASSERT_TRUE(mesh.ok()) << mesh.status();
+  ASSERT_THAT(mesh, testing::IsOk());
   EXPECT_NEAR(check_mesh(*mesh, 3, figures), expected, 1e-9 * expected);
   EXPECT_EQ(mesh_boundary(*mesh), surface_triangles(surface));
 }
@@ -257,7 +258,7 @@ TEST(Tetrahedralize, SeparateBodiesAreBothMeshed) {
   const TriangleMesh surface = combined({cube({0, 0, 0}, 10), cube({20, 0, 0}, 5)});
   TetgenFigures figures;
   const auto mesh = tetrahedralize(surface, 4, TetgenParams{}, RunContext{}, figures);
-  ASSERT_TRUE(mesh.ok()) << mesh.status();
+  ASSERT_THAT(mesh, testing::IsOk());
   EXPECT_NEAR(check_mesh(*mesh, 4, figures), 1125, 1e-9 * 1125);
   EXPECT_EQ(mesh_boundary(*mesh), surface_triangles(surface));
 }
@@ -283,7 +284,7 @@ TEST(Tetrahedralize, OutOfRangeParametersNameTheOption) {
     TetgenFigures figures;
     const auto mesh = tetrahedralize(surface, 1, c.params, RunContext{}, figures);
     ASSERT_FALSE(mesh.ok()) << c.option;
-    EXPECT_EQ(mesh.status().code(), absl::StatusCode::kInvalidArgument) << mesh.status();
+    EXPECT_THAT(mesh, testing::StatusIs(absl::StatusCode::kInvalidArgument)) << mesh.status();
     EXPECT_EQ(std::string(mesh.status().message()).rfind(c.option + ": ", 0), 0u) << mesh.status();
   }
 }
@@ -302,7 +303,7 @@ TEST(Tetrahedralize, TooSmallOrBrokenSurfacesAreInvalid) {
     TetgenFigures figures;
     const auto mesh = tetrahedralize(*surface, 5, TetgenParams{}, RunContext{}, figures);
     ASSERT_FALSE(mesh.ok());
-    EXPECT_EQ(mesh.status().code(), absl::StatusCode::kInvalidArgument) << mesh.status();
+    EXPECT_THAT(mesh, testing::StatusIs(absl::StatusCode::kInvalidArgument)) << mesh.status();
     EXPECT_NE(std::string(mesh.status().message()).find("label 5"), std::string::npos)
         << mesh.status();
   }
@@ -313,7 +314,7 @@ TEST(Tetrahedralize, SelfIntersectingSurfaceIsAnErrorNotACrash) {
   TetgenFigures figures;
   const auto mesh = tetrahedralize(surface, 9, TetgenParams{}, RunContext{}, figures);
   ASSERT_FALSE(mesh.ok());
-  EXPECT_EQ(mesh.status().code(), absl::StatusCode::kFailedPrecondition) << mesh.status();
+  EXPECT_THAT(mesh, testing::StatusIs(absl::StatusCode::kFailedPrecondition)) << mesh.status();
   EXPECT_NE(std::string(mesh.status().message()).find("label 9 intersects itself"),
             std::string::npos)
       << mesh.status();
@@ -326,12 +327,12 @@ TEST(Tetrahedralize, InwardSurfaceIsRefused) {
   const auto single =
       tetrahedralize(cube({0, 0, 0}, 10, true), 6, TetgenParams{}, RunContext{}, figures);
   ASSERT_FALSE(single.ok());
-  EXPECT_EQ(single.status().code(), absl::StatusCode::kFailedPrecondition) << single.status();
+  EXPECT_THAT(single, testing::StatusIs(absl::StatusCode::kFailedPrecondition)) << single.status();
   // An inward outer shell around an outward inner one encloses a negative volume.
   const auto nested = tetrahedralize(combined({cube({0, 0, 0}, 10, true), cube({3, 3, 3}, 4)}), 6,
                                      TetgenParams{}, RunContext{}, figures);
   ASSERT_FALSE(nested.ok());
-  EXPECT_EQ(nested.status().code(), absl::StatusCode::kFailedPrecondition) << nested.status();
+  EXPECT_THAT(nested, testing::StatusIs(absl::StatusCode::kFailedPrecondition)) << nested.status();
 }
 
 TEST(Tetrahedralize, StopRequestCancelsAndProgressReachesOne) {
@@ -342,7 +343,7 @@ TEST(Tetrahedralize, StopRequestCancelsAndProgressReachesOne) {
   TetgenFigures figures;
   const auto cancelled = tetrahedralize(surface, 1, TetgenParams{}, stopped, figures);
   ASSERT_FALSE(cancelled.ok());
-  EXPECT_EQ(cancelled.status().code(), absl::StatusCode::kCancelled);
+  EXPECT_THAT(cancelled, testing::StatusIs(absl::StatusCode::kCancelled));
 
   std::vector<double> fractions;
   RunContext watched;

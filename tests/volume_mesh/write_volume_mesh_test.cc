@@ -26,6 +26,7 @@
 #include <vtkXMLUnstructuredGridReader.h>
 
 #include "core/volume_mesh/tetrahedralize.h"
+#include "support/status_matchers.h"
 #include "support/test_files.h"
 
 namespace labelmesh::volume_mesh {
@@ -81,7 +82,7 @@ const TetMesh& two_labels() {
       params.max_volume_mm3 = 20;
       auto piece =
           tetrahedralize(cube({10.0 * (label - 1), 0, 0}), label, params, RunContext{}, figures);
-      EXPECT_TRUE(piece.ok()) << piece.status();
+      EXPECT_THAT(piece, testing::IsOk());
       if (piece.ok()) both.append(*piece);
     }
     return both;
@@ -509,7 +510,7 @@ TEST(WriteVolumeMesh, BadInputsAndPathsAreErrorsNamingTheFile) {
   const std::string msh = (dir / "x.msh").string();
 
   const auto short_quality = write_volume_mesh(mesh, {1.0}, msh, VolumeFormat::kMsh);
-  EXPECT_EQ(short_quality.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(short_quality, testing::StatusIs(absl::StatusCode::kInvalidArgument));
   EXPECT_EQ(std::string(short_quality.message()).rfind(msh + ": ", 0), 0u) << short_quality;
 
   TetMesh unlabelled = mesh;
@@ -517,7 +518,7 @@ TEST(WriteVolumeMesh, BadInputsAndPathsAreErrorsNamingTheFile) {
   for (VolumeFormat format : {VolumeFormat::kMsh, VolumeFormat::kAbaqus}) {
     const std::string path = path_in(dir, format);
     const auto status = write_volume_mesh(unlabelled, {}, path, format);
-    EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument) << status;
+    EXPECT_THAT(status, testing::StatusIs(absl::StatusCode::kInvalidArgument)) << status;
     EXPECT_EQ(std::string(status.message()).rfind(path + ": label 0", 0), 0u) << status;
   }
   // Zero is fine where nothing needs a positive tag.
@@ -540,7 +541,7 @@ TEST(WriteVolumeMesh, BadInputsAndPathsAreErrorsNamingTheFile) {
   for (VolumeFormat format : all_volume_formats()) {
     const std::string path = "/nonexistent/dir/x." + std::string(volume_format_name(format));
     const auto status = write_volume_mesh(mesh, {}, path, format);
-    EXPECT_EQ(status.code(), absl::StatusCode::kInternal) << status;
+    EXPECT_THAT(status, testing::StatusIs(absl::StatusCode::kInternal)) << status;
     EXPECT_NE(std::string(status.message()).find("/nonexistent/dir/x."), std::string::npos)
         << status;
   }
