@@ -82,9 +82,9 @@ TEST(Spool, UnreadableRecordsAreQuarantinedNotDeleted) {
                     other = server::new_job_id(), unrecorded = server::new_job_id();
   for (const auto& id : {empty, garbage, other, unrecorded})
     fs::create_directories(spool->job_dir(id));
-  std::ofstream(fs::path(spool->job_dir(empty)) / "job.pb");
-  std::ofstream(fs::path(spool->job_dir(garbage)) / "job.pb") << "\xff\xff\xff not a record";
-  ASSERT_TRUE(spool->save(record_with(good, v1::JOB_STATE_QUEUED, 10)).ok());
+  testing::write_file(fs::path(spool->job_dir(empty)) / "job.pb", "");
+  testing::write_file(fs::path(spool->job_dir(garbage)) / "job.pb", "\xff\xff\xff not a record");
+  ASSERT_THAT(spool->save(record_with(good, v1::JOB_STATE_QUEUED, 10)), testing::IsOk());
   fs::copy_file(fs::path(spool->job_dir(good)) / "job.pb",
                 fs::path(spool->job_dir(other)) / "job.pb");
   std::ofstream(fs::path(spool->job_dir(other)) / "input.nii") << "kept";
