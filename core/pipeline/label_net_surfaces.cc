@@ -3,6 +3,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
+#include <memory>
+#include <mutex>
 #include <optional>
 
 #include "core/conforming/label_interfaces.h"
@@ -73,6 +76,89 @@ double anisotropy(const volume::ImageGeometry& geometry) {
   return std::max({s[0], s[1], s[2]}) / std::min({s[0], s[1], s[2]});
 }
 
+// One layer's net of `here`, on the layer's grid or on thinner slices of it.
+struct LayerNet {
+  conforming::InterfaceSurface net;
+  volume::ImageGeometry geometry;
+  // The layer's own unsmoothed net, where the net was made on thinner slices.
+  std::optional<conforming::InterfaceSurface> staircase;
+};
+
+absl::StatusOr<LayerNet> layer_net(const volume::LabelVolume& layer,
+                                   const std::vector<int32_t>& here, const NetOptions& options,
+                                   const RunContext& context, std::vector<StageTiming>& stages) {
+  LayerNet made;
+  conforming::InterfaceFigures figures;
+  const auto cut = thick_slices(layer.geometry, options);
+  if (cut.axis < 0) {
+    made.geometry = layer.geometry;
+    made.net = conforming::label_interfaces(layer, here, interface_params(options), figures);
+    return made;
+  }
+  absl::StatusOr<volume::LabelVolume> thin;
+  {
+    StageTimer thick_timer(stages, "thick_slices");
+    thin = conforming::interpolate_thick_slices(layer, here, cut, context);
+  }
+  if (!thin.ok()) return thin.status();
+  made.geometry = thin->geometry;
+  // Points of the thinner grid may move as far as the thick slices'.
+  auto thin_params = interface_params(options);
+  thin_params.box_scale[cut.axis] = cut.parts;
+  made.net = conforming::label_interfaces(*thin, here, thin_params, figures);
+  conforming::InterfaceParams flat = interface_params(options);
+  flat.smoothing_rounds = 0;
+  made.staircase = conforming::label_interfaces(layer, here, flat, figures);
+  return made;
+}
+
+}  // namespace
+
+// A layer's net smoothed half as many rounds, with its crossing pairs.
+struct LighterNet {
+  conforming::InterfaceSurface net;
+  surface::TrianglePairs crossings;
+};
+
+// The lighter nets of a run, each made once, by the first label that asks;
+// labels on other threads wait for it.
+class LighterNets {
+ public:
+  explicit LighterNets(size_t layers) : built_(layers) {}
+
+  absl::StatusOr<const LighterNet*> get(size_t layer, const volume::LabelVolume& volume,
+                                        const std::vector<int32_t>& here, NetOptions options,
+                                        const RunContext& context,
+                                        std::vector<StageTiming>& stages) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (built_[layer] != nullptr) return built_[layer].get();
+    options.smoothing_rounds /= 2;
+    absl::StatusOr<LayerNet> made;
+    {
+      StageTimer timer(stages, "surface_net");
+      made = layer_net(volume, here, options, context, stages);
+    }
+    if (!made.ok()) return made.status();
+    auto lighter = std::make_unique<LighterNet>();
+    lighter->net = std::move(made->net);
+    {
+      StageTimer timer(stages, "self_intersections");
+      lighter->crossings = surface::crossing_triangles(lighter->net.points, lighter->net.triangles);
+    }
+    built_[layer] = std::move(lighter);
+    return built_[layer].get();
+  }
+
+ private:
+  std::mutex mutex_;
+  std::vector<std::unique_ptr<LighterNet>> built_;
+};
+
+namespace {
+
+// Makes the lighter net of the label's layer when first asked.
+using LighterNetSource = std::function<absl::StatusOr<const LighterNet*>()>;
+
 // What one label's guard made: the delivered surface and the attempts.
 struct LabelOutcome {
   std::vector<SurfaceResult> surfaces;
@@ -86,14 +172,15 @@ class LabelGuard {
   LabelGuard(const volume::LabelVolume& layer, const conforming::InterfaceSurface& net,
              const volume::ImageGeometry& net_geometry,
              const conforming::InterfaceSurface* staircase,
-             const surface::TrianglePairs& net_crossings, const volume::LabelStatistics& label,
-             const SurfaceTolerance& tolerance, const MeshParams& params, const RunContext& context,
-             LabelOutcome& outcome)
+             const surface::TrianglePairs& net_crossings, LighterNetSource lighter,
+             const volume::LabelStatistics& label, const SurfaceTolerance& tolerance,
+             const MeshParams& params, const RunContext& context, LabelOutcome& outcome)
       : layer_(layer),
         net_(net),
         net_crossings_(net_crossings),
         net_geometry_(net_geometry),
         staircase_net_(staircase),
+        lighter_source_(std::move(lighter)),
         label_(label),
         tolerance_(tolerance),
         params_(params),
@@ -127,6 +214,7 @@ class LabelGuard {
       const auto* corresponding = staircase_net_ == nullptr ? &cut_.staircase : nullptr;
       LABELMESH_RETURN_IF_ERROR(measure(SurfaceAttemptMethod::kNet, net, corresponding));
     }
+    if (!delivered() && lighter_source_) LABELMESH_RETURN_IF_ERROR(try_lighter_net());
     if (fall_back && !delivered() && !poisson_first) {
       LABELMESH_RETURN_IF_ERROR(try_poisson());
     }
@@ -176,6 +264,28 @@ class LabelGuard {
     fidelity_.attempts.push_back(std::move(attempt));
     candidates_.push_back(std::move(candidate));
     return absl::OkStatus();
+  }
+
+  // The label's part of the net smoothed half as many rounds.
+  absl::Status try_lighter_net() {
+    auto lighter = lighter_source_();
+    if (!lighter.ok()) {
+      if (lighter.status().code() == absl::StatusCode::kCancelled) return lighter.status();
+      SurfaceAttempt failed;
+      failed.method = SurfaceAttemptMethod::kNetLighter;
+      failed.error = std::string(lighter.status().message());
+      fidelity_.attempts.push_back(std::move(failed));
+      candidates_.push_back({});
+      return absl::OkStatus();
+    }
+    lighter_net_ = *lighter;
+    {
+      StageTimer timer(outcome_.stages, "net_label_surface");
+      lighter_cut_ = conforming::net_label_surface(lighter_net_->net, label_.label, net_geometry_);
+    }
+    Candidate candidate{lighter_cut_.mesh, {}};
+    const auto* corresponding = staircase_net_ == nullptr ? &lighter_cut_.staircase : nullptr;
+    return measure(SurfaceAttemptMethod::kNetLighter, candidate, corresponding);
   }
 
   // The Poisson path (with its own guard against Marching Cubes); its output
@@ -230,22 +340,28 @@ class LabelGuard {
       outcome_.surfaces.push_back(std::move(output));
       return absl::OkStatus();
     }
-    if (chosen.method != SurfaceAttemptMethod::kNet)
+    const bool from_net = chosen.method == SurfaceAttemptMethod::kNet ||
+                          chosen.method == SurfaceAttemptMethod::kNetLighter;
+    if (!from_net)
       for (auto& stage : poisson_stages_) outcome_.surfaces.push_back(std::move(stage));
     output.mesh = std::move(candidates_[best].mesh);
     output.statistics = candidates_[best].statistics;
     output.components->kept = output.statistics.components;
     output.axis_aligned_share = chosen.voxels->axis_aligned_share;
-    if (chosen.method != SurfaceAttemptMethod::kNet) output.poisson = poisson_figures_;
+    if (!from_net) output.poisson = poisson_figures_;
     output.fidelity = std::move(fidelity_);
     output.is_output = true;
     {
       StageTimer timer(outcome_.stages, "self_intersections");
       context_.report("self_intersections", 0);
-      output.self_intersections =
-          chosen.method == SurfaceAttemptMethod::kNet
-              ? conforming::net_label_self_intersections(net_, net_crossings_, cut_, label_.label)
-              : surface::count_self_intersections(output.mesh);
+      if (chosen.method == SurfaceAttemptMethod::kNet)
+        output.self_intersections =
+            conforming::net_label_self_intersections(net_, net_crossings_, cut_, label_.label);
+      else if (chosen.method == SurfaceAttemptMethod::kNetLighter)
+        output.self_intersections = conforming::net_label_self_intersections(
+            lighter_net_->net, lighter_net_->crossings, lighter_cut_, label_.label);
+      else
+        output.self_intersections = surface::count_self_intersections(output.mesh);
     }
     outcome_.surfaces.push_back(std::move(output));
     return absl::OkStatus();
@@ -256,12 +372,15 @@ class LabelGuard {
   const surface::TrianglePairs& net_crossings_;
   const volume::ImageGeometry& net_geometry_;
   const conforming::InterfaceSurface* staircase_net_;
+  LighterNetSource lighter_source_;
   const volume::LabelStatistics& label_;
   const SurfaceTolerance& tolerance_;
   const MeshParams& params_;
   const RunContext& context_;
   LabelOutcome& outcome_;
   conforming::NetLabelSurface cut_;
+  const LighterNet* lighter_net_ = nullptr;
+  conforming::NetLabelSurface lighter_cut_;
   surface::TriangleMesh voxel_boundary_;
   SurfaceFidelity fidelity_;
   std::vector<Candidate> candidates_;
@@ -291,42 +410,28 @@ absl::StatusOr<LabelNets> smoothed_nets(const std::vector<volume::LabelVolume>& 
   built.staircases.resize(layers.size());
   built.poisson_first.assign(count, false);
   built.crossings.resize(layers.size());
+  built.layer_labels.resize(layers.size());
+  built.touches_another.assign(count, false);
+  built.lighter = std::make_shared<LighterNets>(layers.size());
   StageTimer timer(stages, "surface_net");
   context.report("surface_net", 0);
   for (size_t layer = 0; layer < layers.size(); ++layer) {
-    std::vector<int32_t> here;
+    std::vector<int32_t>& here = built.layer_labels[layer];
     for (size_t i = 0; i < count; ++i)
       if (layer_of[i] == layer) here.push_back(labels[i]);
     if (here.empty()) continue;
-    conforming::InterfaceFigures figures;
-    const auto cut = thick_slices(layers[layer].geometry, params.net);
-    if (cut.axis < 0) {
-      built.geometry[layer] = layers[layer].geometry;
-      built.nets[layer] =
-          conforming::label_interfaces(layers[layer], here, interface_params(params.net), figures);
-    } else {
-      absl::StatusOr<volume::LabelVolume> thin;
-      {
-        StageTimer thick_timer(stages, "thick_slices");
-        thin = conforming::interpolate_thick_slices(layers[layer], here, cut, context);
-      }
-      if (!thin.ok()) return thin.status();
-      built.geometry[layer] = thin->geometry;
-      // Points of the thinner grid may move as far as the thick slices'.
-      auto thin_params = interface_params(params.net);
-      thin_params.box_scale[cut.axis] = cut.parts;
-      built.nets[layer] = conforming::label_interfaces(*thin, here, thin_params, figures);
-      conforming::InterfaceParams flat = interface_params(params.net);
-      flat.smoothing_rounds = 0;
-      built.staircases[layer] = conforming::label_interfaces(layers[layer], here, flat, figures);
-    }
+    auto made = layer_net(layers[layer], here, params.net, context, stages);
+    if (!made.ok()) return made.status();
+    built.nets[layer] = std::move(made->net);
+    built.geometry[layer] = std::move(made->geometry);
+    built.staircases[layer] = std::move(made->staircase);
     LABELMESH_RETURN_IF_ERROR(context.check_stop());
     const auto touching = touching_labels(built.nets[layer]);
     const bool fine_grid = anisotropy(layers[layer].geometry) <= params.net.poisson_max_anisotropy;
     for (size_t i = 0; i < count; ++i) {
       if (layer_of[i] != layer) continue;
-      built.poisson_first[i] =
-          fine_grid && !std::binary_search(touching.begin(), touching.end(), labels[i]);
+      built.touches_another[i] = std::binary_search(touching.begin(), touching.end(), labels[i]);
+      built.poisson_first[i] = fine_grid && !built.touches_another[i];
     }
   }
   context.report("surface_net", 1);
@@ -356,17 +461,26 @@ absl::StatusOr<LabelNets> build_label_nets(const std::vector<volume::LabelVolume
   return built;
 }
 
-absl::Status add_net_label_surface(const LabelNets& nets, size_t layer, bool poisson_first,
+absl::Status add_net_label_surface(const LabelNets& nets, size_t layer, size_t index,
                                    const volume::LabelVolume& volume,
                                    const volume::LabelStatistics& label,
                                    const SurfaceTolerance& tolerance, const MeshParams& params,
                                    const RunContext& context, std::vector<SurfaceResult>& surfaces,
                                    std::vector<StageTiming>& stages) {
   LabelOutcome outcome;
+  // A label alone may take the lighter net: no neighbour's surface is cut
+  // from the other one.
+  LighterNetSource lighter;
+  if (!nets.touches_another[index] && params.net.smoothing_rounds >= 2 && nets.lighter)
+    lighter = [&]() {
+      return nets.lighter->get(layer, volume, nets.layer_labels[layer], params.net, context,
+                               outcome.stages);
+    };
   LabelGuard guard(volume, nets.nets[layer], nets.geometry[layer],
                    nets.staircases[layer] ? &*nets.staircases[layer] : nullptr,
-                   nets.crossings[layer], label, tolerance, params, context, outcome);
-  LABELMESH_RETURN_IF_ERROR(guard.run(poisson_first));
+                   nets.crossings[layer], std::move(lighter), label, tolerance, params, context,
+                   outcome);
+  LABELMESH_RETURN_IF_ERROR(guard.run(nets.poisson_first[index]));
   for (auto& surface : outcome.surfaces) surfaces.push_back(std::move(surface));
   for (const auto& stage : outcome.stages) add_stage_time(stages, stage.name, stage.seconds);
   return absl::OkStatus();

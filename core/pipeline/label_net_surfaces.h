@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstddef>
+#include <memory>
 #include <optional>
 #include <vector>
 
@@ -20,6 +21,8 @@
 
 namespace labelmesh {
 
+class LighterNets;
+
 // The shared nets of a run: one per layer, of that layer's selected labels,
 // built once before the labels are meshed.
 struct LabelNets {
@@ -34,6 +37,14 @@ struct LabelNets {
   // Per layer: the net's crossing triangle pairs, found once for all its
   // labels (every label's surface is made of the net's triangles).
   std::vector<surface::TrianglePairs> crossings;
+  // Per layer: its selected labels.
+  std::vector<std::vector<int32_t>> layer_labels;
+  // Per label: whether it shares triangles with another selected label.
+  std::vector<bool> touches_another;
+  // Per layer, made when a label first needs it: the net smoothed half as
+  // many rounds, for labels alone that the full smoothing takes outside the
+  // voxel tolerance (thin tubes on thick slices).
+  std::shared_ptr<LighterNets> lighter;
 };
 
 // The smoothing of the shared net for `options`.
@@ -48,20 +59,23 @@ absl::StatusOr<LabelNets> build_label_nets(const std::vector<volume::LabelVolume
                                            const MeshParams& params, const RunContext& context,
                                            std::vector<StageTiming>& stages);
 
-// Appends `label`'s output surface (and, when Poisson is delivered, its
-// repaired stage). The guard's ladder, in order:
-//   1. poisson, when `poisson_first` and the label is at least
+// Appends the output surface of `label`, labels[index] of build_label_nets
+// (and, when Poisson is delivered, its repaired stage). The guard's ladder,
+// in order:
+//   1. poisson, when nets.poisson_first[index] and the label is at least
 //      params.poisson.min_thickness_voxels thick (the Poisson path with its
 //      own guard, label_surfaces.h);
 //   2. net: the label's part of the shared net of `layer`;
-//   3. the Poisson path with its mask fallbacks, when neither is within the
+//   3. net_lighter: for a label that touches no other selected label, its
+//      part of the same net smoothed half as many rounds;
+//   4. the Poisson path with its mask fallbacks, when none is within the
 //      tolerance.
 // Every attempt is measured against the label's voxels in `volume`
 // (volume, misclassified voxel centres, Hausdorff distance to the voxels'
 // boundary); the first within `tolerance` is delivered, else the one least
 // outside it. Errors: CANCELLED; INTERNAL when the net has no triangle of
 // the label.
-absl::Status add_net_label_surface(const LabelNets& nets, size_t layer, bool poisson_first,
+absl::Status add_net_label_surface(const LabelNets& nets, size_t layer, size_t index,
                                    const volume::LabelVolume& volume,
                                    const volume::LabelStatistics& label,
                                    const SurfaceTolerance& tolerance, const MeshParams& params,

@@ -225,9 +225,9 @@ absl::Status add_every_label_surface(const std::vector<volume::LabelVolume>& lay
       label_context.label = &in_progress[i];
       absl::Status status;
       try {
-        status = nets ? add_net_label_surface(*nets, layer_of[i], nets->poisson_first[i],
-                                              layers[layer_of[i]], *statistics, tolerance, params,
-                                              label_context, label_surfaces[i], label_stages[i])
+        status = nets ? add_net_label_surface(*nets, layer_of[i], i, layers[layer_of[i]],
+                                              *statistics, tolerance, params, label_context,
+                                              label_surfaces[i], label_stages[i])
                       : add_label_surfaces(layers[layer_of[i]], *statistics, params, tolerance,
                                            label_context, label_surfaces[i], label_stages[i]);
       } catch (const std::bad_alloc&) {

@@ -23,6 +23,8 @@ const char* method_name(SurfaceAttemptMethod method) {
   switch (method) {
     case SurfaceAttemptMethod::kNet:
       return "net";
+    case SurfaceAttemptMethod::kNetLighter:
+      return "net_lighter";
     case SurfaceAttemptMethod::kPoisson:
       return "poisson";
     case SurfaceAttemptMethod::kPoissonRefined:

@@ -34,6 +34,7 @@ struct SurfaceTolerance {
 // The surfaces the delivery guard can build, in the order it tries them.
 enum class SurfaceAttemptMethod {
   kNet,             // the labels' shared surface net, smoothed within each voxel
+  kNetLighter,      // the same net smoothed half as many rounds (labels alone)
   kPoisson,         // repaired Marching Cubes, CGAL Poisson reconstruction
   kPoissonRefined,  // the same at half the edge and distance bounds
   kMask,            // the smoothed voxel mask meshed by CGAL just under one half
