@@ -423,7 +423,7 @@ absl::StatusOr<LabelNets> smoothed_nets(const std::vector<volume::LabelVolume>& 
     auto made = layer_net(layers[layer], here, params.net, context, stages);
     if (!made.ok()) return made.status();
     built.nets[layer] = std::move(made->net);
-    built.geometry[layer] = std::move(made->geometry);
+    built.geometry[layer] = made->geometry;
     built.staircases[layer] = std::move(made->staircase);
     LABELMESH_RETURN_IF_ERROR(context.check_stop());
     const auto touching = touching_labels(built.nets[layer]);
