@@ -76,7 +76,8 @@ double anisotropy(const volume::ImageGeometry& geometry) {
   return std::max({s[0], s[1], s[2]}) / std::min({s[0], s[1], s[2]});
 }
 
-// One layer's net of `here`, on the layer's grid or on thinner slices of it.
+// One layer's net of `here`, on the layer's grid or on thinner slices of it
+// (then with the layer's own staircase when `with_staircase`).
 struct LayerNet {
   conforming::InterfaceSurface net;
   volume::ImageGeometry geometry;
@@ -86,7 +87,8 @@ struct LayerNet {
 
 absl::StatusOr<LayerNet> layer_net(const volume::LabelVolume& layer,
                                    const std::vector<int32_t>& here, const NetOptions& options,
-                                   const RunContext& context, std::vector<StageTiming>& stages) {
+                                   bool with_staircase, const RunContext& context,
+                                   std::vector<StageTiming>& stages) {
   LayerNet made;
   conforming::InterfaceFigures figures;
   const auto cut = thick_slices(layer.geometry, options);
@@ -106,6 +108,7 @@ absl::StatusOr<LayerNet> layer_net(const volume::LabelVolume& layer,
   auto thin_params = interface_params(options);
   thin_params.box_scale[cut.axis] = cut.parts;
   made.net = conforming::label_interfaces(*thin, here, thin_params, figures);
+  if (!with_staircase) return made;
   conforming::InterfaceParams flat = interface_params(options);
   flat.smoothing_rounds = 0;
   made.staircase = conforming::label_interfaces(layer, here, flat, figures);
@@ -136,7 +139,8 @@ class LighterNets {
     absl::StatusOr<LayerNet> made;
     {
       StageTimer timer(stages, "surface_net");
-      made = layer_net(volume, here, options, context, stages);
+      // The staircase is the full net's: the same voxels.
+      made = layer_net(volume, here, options, /*with_staircase=*/false, context, stages);
     }
     if (!made.ok()) return made.status();
     auto lighter = std::make_unique<LighterNet>();
@@ -266,16 +270,21 @@ class LabelGuard {
     return absl::OkStatus();
   }
 
+  // An attempt that made no surface, kept with its reason.
+  void add_failed(SurfaceAttemptMethod method, std::string error) {
+    SurfaceAttempt failed;
+    failed.method = method;
+    failed.error = std::move(error);
+    fidelity_.attempts.push_back(std::move(failed));
+    candidates_.push_back({});
+  }
+
   // The label's part of the net smoothed half as many rounds.
   absl::Status try_lighter_net() {
     auto lighter = lighter_source_();
     if (!lighter.ok()) {
       if (lighter.status().code() == absl::StatusCode::kCancelled) return lighter.status();
-      SurfaceAttempt failed;
-      failed.method = SurfaceAttemptMethod::kNetLighter;
-      failed.error = std::string(lighter.status().message());
-      fidelity_.attempts.push_back(std::move(failed));
-      candidates_.push_back({});
+      add_failed(SurfaceAttemptMethod::kNetLighter, std::string(lighter.status().message()));
       return absl::OkStatus();
     }
     lighter_net_ = *lighter;
@@ -301,12 +310,9 @@ class LabelGuard {
     for (auto& s : made)
       if (s.is_output) output = &s;
     if (!status.ok() || output == nullptr) {
-      SurfaceAttempt failed;
-      failed.method = SurfaceAttemptMethod::kPoisson;
-      failed.error = status.ok() ? "no surface was left once small components were dropped"
-                                 : std::string(status.message());
-      fidelity_.attempts.push_back(std::move(failed));
-      candidates_.push_back({});
+      add_failed(SurfaceAttemptMethod::kPoisson,
+                 status.ok() ? "no surface was left once small components were dropped"
+                             : std::string(status.message()));
       return absl::OkStatus();
     }
     // The repaired stage before it stays in the report (Table 2's columns).
@@ -420,7 +426,8 @@ absl::StatusOr<LabelNets> smoothed_nets(const std::vector<volume::LabelVolume>& 
     for (size_t i = 0; i < count; ++i)
       if (layer_of[i] == layer) here.push_back(labels[i]);
     if (here.empty()) continue;
-    auto made = layer_net(layers[layer], here, params.net, context, stages);
+    auto made =
+        layer_net(layers[layer], here, params.net, /*with_staircase=*/true, context, stages);
     if (!made.ok()) return made.status();
     built.nets[layer] = std::move(made->net);
     built.geometry[layer] = made->geometry;

@@ -156,6 +156,20 @@ const SurfaceResult* output_of(const MeshResult& result, int32_t label) {
   return nullptr;
 }
 
+// Label 1 of `v` by our default pipeline and by the Slicer-like one.
+struct BothSurfaces {
+  absl::StatusOr<MeshResult> result;
+  std::vector<surface::LabelSurface> slicer;
+  const SurfaceResult* ours() const { return result.ok() ? output_of(*result, 1) : nullptr; }
+};
+
+BothSurfaces both_surfaces(const volume::LabelVolume& v) {
+  BothSurfaces both;
+  both.slicer = testing::slicer_like_surfaces(v, volume::compute_label_statistics(v), {1});
+  both.result = run_pipeline_on_volume(v, MeshParams{}, {});
+  return both;
+}
+
 TEST(NetSurfaces, NestedLabelsShareTheirInterfacesWithoutOverlap) {
   auto result = run_pipeline_on_volume(
       volume::make_phantom(volume::PhantomShape::kNestedSpheres).volume, MeshParams{}, {});
@@ -201,14 +215,12 @@ TEST(NetSurfaces, ThickSliceShapesAreTruerThanTheSlicerLikePipeline) {
   const std::vector<testing::AnalyticShape> shapes{
       testing::sphere_shape(25), testing::ellipsoid_shape(32, 22, 15), testing::torus_shape(25, 9)};
   for (const auto& shape : shapes) {
-    const auto v = testing::sample_shape(shape, {0.6, 0.6, 4});
-    const auto statistics = volume::compute_label_statistics(v);
-    const auto slicer = testing::slicer_like_surfaces(v, statistics, {1});
-    ASSERT_EQ(slicer.size(), 1u);
-    auto result = run_pipeline_on_volume(v, MeshParams{}, {});
-    ASSERT_THAT(result, testing::IsOk());
-    const auto* ours = output_of(*result, 1);
+    const auto both = both_surfaces(testing::sample_shape(shape, {0.6, 0.6, 4}));
+    ASSERT_EQ(both.slicer.size(), 1u);
+    ASSERT_THAT(both.result, testing::IsOk());
+    const auto* ours = both.ours();
     ASSERT_NE(ours, nullptr);
+    const auto& slicer = both.slicer;
     // The shared net, smoothed fully or (the torus) half as much.
     EXPECT_EQ(ours->stage.rfind("net", 0), 0u) << shape.name << ": " << ours->stage;
     const auto mine = testing::shape_error(ours->mesh, shape);
@@ -231,14 +243,12 @@ TEST(NetSurfaces, ThinTubesOnThickSlicesTakeTheLighterNet) {
     double degrees;
   };
   for (const Grid& grid : {Grid{{0.6, 0.6, 4}, 0}, Grid{{1, 1, 3}, 25}}) {
-    const auto v = testing::sample_shape(tube, grid.spacing, grid.degrees);
-    const auto statistics = volume::compute_label_statistics(v);
-    const auto slicer = testing::slicer_like_surfaces(v, statistics, {1});
-    ASSERT_EQ(slicer.size(), 1u);
-    auto result = run_pipeline_on_volume(v, MeshParams{}, {});
-    ASSERT_THAT(result, testing::IsOk());
-    const auto* ours = output_of(*result, 1);
+    const auto both = both_surfaces(testing::sample_shape(tube, grid.spacing, grid.degrees));
+    ASSERT_EQ(both.slicer.size(), 1u);
+    ASSERT_THAT(both.result, testing::IsOk());
+    const auto* ours = both.ours();
     ASSERT_NE(ours, nullptr);
+    const auto& slicer = both.slicer;
     EXPECT_EQ(ours->stage, "net_lighter") << grid.spacing[2];
     const auto& fidelity = *ours->fidelity;
     ASSERT_GE(fidelity.attempts.size(), 2u);
