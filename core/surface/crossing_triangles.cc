@@ -64,6 +64,10 @@ class CrossingTest {
       const Point& u = points_[t_far];
       return CGAL::coplanar(p, q, r, u) && CGAL::coplanar_orientation(p, q, r, u) == CGAL::POSITIVE;
     }
+    // Most pairs a net's boxes give are neighbours, one wholly on one side
+    // of the other's plane but for the shared point: two orientations (cheap
+    // under CGAL's static filters) settle those without building triangles.
+    if (apart(s, t) || apart(t, s)) return false;
     const Kernel::Triangle_3 st(points_[s[0]], points_[s[1]], points_[s[2]]);
     const Kernel::Triangle_3 tt(points_[t[0]], points_[t[1]], points_[t[2]]);
     if (shared == 1) {
@@ -77,6 +81,23 @@ class CrossingTest {
   }
 
  private:
+  // Whether t's corners that are not s's lie strictly on one side of s's
+  // plane: then t meets that plane at most in a corner both share, so
+  // neither t nor its edges cross s (s is not degenerate).
+  bool apart(const Triangle& s, const Triangle& t) const {
+    const Point& a = points_[s[0]];
+    const Point& b = points_[s[1]];
+    const Point& c = points_[s[2]];
+    CGAL::Orientation side = CGAL::COPLANAR;
+    for (const uint32_t v : t) {
+      if (v == s[0] || v == s[1] || v == s[2]) continue;
+      const CGAL::Orientation o = CGAL::orientation(a, b, c, points_[v]);
+      if (o == CGAL::COPLANAR || (side != CGAL::COPLANAR && o != side)) return false;
+      side = o;
+    }
+    return side != CGAL::COPLANAR;
+  }
+
   const std::vector<Triangle>& triangles_;
   std::vector<Point> points_;
 };
@@ -120,20 +141,40 @@ class BoxGrid {
   template <typename Visit>
   void for_each_meeting(uint32_t t, Visit visit) const {
     const auto c = cell_of(t);
-    const CGAL::Bbox_3& box = boxes_[t];
     for (int64_t dz = -1; dz <= 1; ++dz)
       for (int64_t dy = -1; dy <= 1; ++dy)
-        for (int64_t dx = -1; dx <= 1; ++dx) {
-          const auto found = cells_.find(key({c[0] + dx, c[1] + dy, c[2] + dz}));
-          if (found == cells_.end()) continue;
-          for (uint32_t i = found->second.first; i < found->second.second; ++i) {
-            const uint32_t u = order_[i];
-            if (u != t && CGAL::do_overlap(box, boxes_[u])) visit(u);
-          }
-        }
+        for (int64_t dx = -1; dx <= 1; ++dx)
+          visit_cell(t, {c[0] + dx, c[1] + dy, c[2] + dz}, visit);
+  }
+
+  // Calls visit(u) for the triangles u whose box meets t's, such that over
+  // all t each meeting pair comes once: u later in t's own cell, or in one of
+  // the 13 neighbouring cells that come after it (half the work of visiting
+  // both ways).
+  template <typename Visit>
+  void for_each_meeting_once(uint32_t t, Visit visit) const {
+    const auto c = cell_of(t);
+    visit_cell(t, c, [&](uint32_t u) {
+      if (u > t) visit(u);
+    });
+    for (int64_t dz = 0; dz <= 1; ++dz)
+      for (int64_t dy = dz == 0 ? 0 : -1; dy <= 1; ++dy)
+        for (int64_t dx = (dz == 0 && dy == 0) ? 1 : -1; dx <= 1; ++dx)
+          visit_cell(t, {c[0] + dx, c[1] + dy, c[2] + dz}, visit);
   }
 
  private:
+  template <typename Visit>
+  void visit_cell(uint32_t t, const std::array<int64_t, 3>& cell, Visit&& visit) const {
+    const auto found = cells_.find(key(cell));
+    if (found == cells_.end()) return;
+    const CGAL::Bbox_3& box = boxes_[t];
+    for (uint32_t i = found->second.first; i < found->second.second; ++i) {
+      const uint32_t u = order_[i];
+      if (u != t && CGAL::do_overlap(box, boxes_[u])) visit(u);
+    }
+  }
+
   std::array<int64_t, 3> cell_of(uint32_t t) const {
     std::array<int64_t, 3> c;
     for (int a = 0; a < 3; ++a) c[a] = int64_t((boxes_[t].min(a) - low_[a]) / cell_[a]);
@@ -165,10 +206,15 @@ TrianglePairs crossings_from(const CrossingTest& test, const BoxGrid& grid,
       pairs.emplace_back(s, s);
       continue;
     }
-    grid.for_each_meeting(s, [&](uint32_t t) {
+    const auto visit = [&](uint32_t t) {
       if (!keep(s, t) || std::binary_search(degenerate.begin(), degenerate.end(), t)) return;
       if (test.cross(s, t)) pairs.emplace_back(std::min(s, t), std::max(s, t));
-    });
+    };
+    if (from == nullptr) {
+      grid.for_each_meeting_once(s, visit);
+    } else {
+      grid.for_each_meeting(s, visit);
+    }
   }
   return pairs;
 }
@@ -193,14 +239,12 @@ TrianglePairs crossing_triangles(const std::vector<std::array<double, 3>>& point
   const uint32_t count = static_cast<uint32_t>(triangles.size());
   const std::vector<uint32_t> degenerate = degenerate_triangles(test, count);
   const BoxGrid grid(test, count);
-  // Two halves on two threads; a pair is kept from its smaller triangle.
-  const auto smaller_first = [](uint32_t s, uint32_t t) { return s < t; };
+  // Two halves on two threads; the grid gives each meeting pair once.
+  const auto every = [](uint32_t, uint32_t) { return true; };
   TrianglePairs low, high;
   side_by_side(
-      [&] { low = crossings_from(test, grid, degenerate, 0, count / 2, nullptr, smaller_first); },
-      [&] {
-        high = crossings_from(test, grid, degenerate, count / 2, count, nullptr, smaller_first);
-      });
+      [&] { low = crossings_from(test, grid, degenerate, 0, count / 2, nullptr, every); },
+      [&] { high = crossings_from(test, grid, degenerate, count / 2, count, nullptr, every); });
   low.insert(low.end(), high.begin(), high.end());
   sort_pairs(low);
   return low;
