@@ -112,60 +112,93 @@ uint8_t distinct_labels(const PaddedLabels& labels, int64_t a, int64_t b, int64_
   return count;
 }
 
+// The face-neighbouring voxel pairs with different labels, as the padded
+// linear index of the first voxel and the axis to the second, axis by axis
+// and each axis in index order.
+std::vector<std::pair<int, size_t>> differing_pairs(const PaddedLabels& labels) {
+  std::vector<std::pair<int, size_t>> pairs;
+  const auto& dims = labels.dims;
+  const std::array<size_t, 3> stride{1, static_cast<size_t>(dims[0]),
+                                     static_cast<size_t>(dims[0] * dims[1])};
+  for (int axis = 0; axis < 3; ++axis) {
+    for (int64_t z = 0; z < dims[2] - (axis == 2 ? 1 : 0); ++z) {
+      for (int64_t y = 0; y < dims[1] - (axis == 1 ? 1 : 0); ++y) {
+        size_t i = static_cast<size_t>((z * dims[1] + y) * dims[0]);
+        const size_t end = i + static_cast<size_t>(dims[0]) - (axis == 0 ? 1 : 0);
+        for (; i < end; ++i)
+          if (labels.labels[i] != labels.labels[i + stride[axis]]) pairs.emplace_back(axis, i);
+      }
+    }
+  }
+  return pairs;
+}
+
+// The padded voxel (x, y, z) of a padded linear index.
+std::array<int64_t, 3> padded_voxel(const PaddedLabels& labels, size_t i) {
+  const auto v = static_cast<int64_t>(i);
+  return {v % labels.dims[0], (v / labels.dims[0]) % labels.dims[1],
+          v / (labels.dims[0] * labels.dims[1])};
+}
+
+// The cube at `offset` (as in the quads: {1, 1}, {0, 1}, {0, 0}, {1, 0}
+// along u and v) around the segment from padded voxel p along `axis`.
+std::array<int64_t, 3> cube_around(std::array<int64_t, 3> p, int axis, std::array<int, 2> offset) {
+  p[(axis + 1) % 3] -= offset[0];
+  p[(axis + 2) % 3] -= offset[1];
+  return p;
+}
+
+constexpr std::array<std::array<int, 2>, 4> kQuadOffsets{{{1, 1}, {0, 1}, {0, 0}, {1, 0}}};
+
 Net build_net(const PaddedLabels& labels, const std::array<double, 3>& spacing, Cubes& cubes) {
   Net net;
   cubes.dims = {labels.dims[0] - 1, labels.dims[1] - 1, labels.dims[2] - 1};
   cubes.point.assign(static_cast<size_t>(cubes.dims[0] * cubes.dims[1] * cubes.dims[2]), kNoPoint);
+  // A cube's corners hold more than one label exactly when one of its edges
+  // joins two different labels, and every such edge's quad uses the four
+  // cubes around it: mark those, then number them in index order.
+  const auto pairs = differing_pairs(labels);
+  constexpr uint32_t kMarked = 0;
+  for (const auto& [axis, i] : pairs) {
+    const auto p = padded_voxel(labels, i);
+    for (const auto& offset : kQuadOffsets) {
+      const auto cube = cube_around(p, axis, offset);
+      cubes.point[cubes.index(cube[0], cube[1], cube[2])] = kMarked;
+    }
+  }
+  size_t i = 0;
   for (int64_t c = 0; c < cubes.dims[2]; ++c) {
     for (int64_t b = 0; b < cubes.dims[1]; ++b) {
-      for (int64_t a = 0; a < cubes.dims[0]; ++a) {
-        const uint8_t count = distinct_labels(labels, a, b, c);
-        if (count < 2) continue;
-        cubes.point[cubes.index(a, b, c)] = static_cast<uint32_t>(net.centre.size());
+      for (int64_t a = 0; a < cubes.dims[0]; ++a, ++i) {
+        if (cubes.point[i] == kNoPoint) continue;
+        cubes.point[i] = static_cast<uint32_t>(net.centre.size());
         // Padded voxel a is voxel a + first; the cube's centre is half a
         // voxel on.
         const auto& f = labels.first;
         net.centre.push_back({(double(a + f[0]) + 0.5) * spacing[0],
                               (double(b + f[1]) + 0.5) * spacing[1],
                               (double(c + f[2]) + 0.5) * spacing[2]});
-        net.label_count.push_back(count);
+        net.label_count.push_back(distinct_labels(labels, a, b, c));
       }
     }
   }
   // One quad per pair of face neighbours with different labels, wound so its
   // normal points from the first voxel to the second: the four cubes around
   // their common axis, counter-clockwise seen from the second voxel.
-  for (int axis = 0; axis < 3; ++axis) {
-    const int u = (axis + 1) % 3;
-    const int v = (axis + 2) % 3;
-    std::array<int64_t, 3> p{};
-    for (p[2] = 0; p[2] < labels.dims[2]; ++p[2]) {
-      for (p[1] = 0; p[1] < labels.dims[1]; ++p[1]) {
-        for (p[0] = 0; p[0] < labels.dims[0]; ++p[0]) {
-          if (p[axis] + 1 >= labels.dims[axis]) continue;
-          std::array<int64_t, 3> q = p;
-          ++q[axis];
-          const int32_t behind = labels.at(p[0], p[1], p[2]);
-          const int32_t front = labels.at(q[0], q[1], q[2]);
-          if (behind == front) continue;
-          constexpr std::array<std::array<int, 2>, 4> kOffsets{{{1, 1}, {0, 1}, {0, 0}, {1, 0}}};
-          std::array<uint32_t, 4> quad{};
-          for (int k = 0; k < 4; ++k) {
-            std::array<int64_t, 3> cube = p;
-            cube[u] -= kOffsets[k][0];
-            cube[v] -= kOffsets[k][1];
-            quad[k] = cubes.point[cubes.index(cube[0], cube[1], cube[2])];
-          }
-          net.quads.push_back(quad);
-          net.quad_sides.push_back({behind, front});
-          net.quad_axis.push_back(static_cast<uint8_t>(axis));
-          const auto linear = [&](const std::array<int64_t, 3>& v) {
-            return static_cast<uint64_t>((v[2] * labels.dims[1] + v[1]) * labels.dims[0] + v[0]);
-          };
-          net.quad_voxels.push_back({linear(p), linear(q)});
-        }
-      }
+  const std::array<uint64_t, 3> stride{1, static_cast<uint64_t>(labels.dims[0]),
+                                       static_cast<uint64_t>(labels.dims[0] * labels.dims[1])};
+  net.quads.reserve(pairs.size());
+  for (const auto& [axis, i] : pairs) {
+    const auto p = padded_voxel(labels, i);
+    std::array<uint32_t, 4> quad{};
+    for (int k = 0; k < 4; ++k) {
+      const auto cube = cube_around(p, axis, kQuadOffsets[k]);
+      quad[k] = cubes.point[cubes.index(cube[0], cube[1], cube[2])];
     }
+    net.quads.push_back(quad);
+    net.quad_sides.push_back({labels.labels[i], labels.labels[i + stride[axis]]});
+    net.quad_axis.push_back(static_cast<uint8_t>(axis));
+    net.quad_voxels.push_back({i, i + stride[axis]});
   }
   return net;
 }
@@ -178,35 +211,56 @@ struct Stencil {
   std::vector<uint32_t> neighbours;
 };
 
-Stencil smoothing_stencil(const Net& net, InterfaceFigures& figures) {
-  std::vector<std::pair<uint32_t, uint32_t>> edges;
-  edges.reserve(8 * net.quads.size());
-  for (const auto& quad : net.quads) {
-    for (int k = 0; k < 4; ++k) {
-      edges.push_back({quad[k], quad[(k + 1) % 4]});
-      edges.push_back({quad[(k + 1) % 4], quad[k]});
-    }
-  }
-  std::sort(edges.begin(), edges.end());
-  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
-
+// Two points are neighbours when their cubes share a face whose four voxels
+// do not all hold one label: a quad then has both as consecutive corners.
+// The six directions in this order give each point's neighbours in
+// increasing index, as the points are numbered in cube index order.
+Stencil smoothing_stencil(const Net& net, const PaddedLabels& labels, const Cubes& cubes,
+                          InterfaceFigures& figures) {
+  constexpr std::array<std::array<int, 2>, 6> kDirections{
+      {{2, -1}, {1, -1}, {0, -1}, {0, 1}, {1, 1}, {2, 1}}};  // axis, sign
   const size_t n = net.centre.size();
   Stencil stencil;
   stencil.start.assign(n + 1, 0);
-  size_t e = 0;
-  for (uint32_t p = 0; p < n; ++p) {
-    stencil.start[p] = static_cast<uint32_t>(stencil.neighbours.size());
-    const size_t first = stencil.neighbours.size();
-    const bool junction = net.label_count[p] > 2;
-    for (; e < edges.size() && edges[e].first == p; ++e) {
-      if (!junction || net.label_count[edges[e].second] > 2)
-        stencil.neighbours.push_back(edges[e].second);
-    }
-    if (junction) {
-      ++figures.junction_points;
-      if (stencil.neighbours.size() - first != 2) {
-        stencil.neighbours.resize(first);
-        ++figures.fixed_points;
+  stencil.neighbours.reserve(4 * n);
+  size_t i = 0;
+  for (int64_t c = 0; c < cubes.dims[2]; ++c) {
+    for (int64_t b = 0; b < cubes.dims[1]; ++b) {
+      for (int64_t a = 0; a < cubes.dims[0]; ++a, ++i) {
+        const uint32_t p = cubes.point[i];
+        if (p == kNoPoint) continue;
+        stencil.start[p] = static_cast<uint32_t>(stencil.neighbours.size());
+        const size_t first = stencil.neighbours.size();
+        const bool junction = net.label_count[p] > 2;
+        const std::array<int64_t, 3> cube{a, b, c};
+        for (const auto& [axis, sign] : kDirections) {
+          std::array<int64_t, 3> next = cube;
+          next[axis] += sign;
+          if (next[axis] < 0 || next[axis] >= cubes.dims[axis]) continue;
+          const uint32_t q = cubes.point[cubes.index(next[0], next[1], next[2])];
+          if (q == kNoPoint || (junction && net.label_count[q] <= 2)) continue;
+          // The shared face's voxels: along `axis` at the far side of
+          // whichever cube comes first, both ways along the other two.
+          std::array<int64_t, 3> corner = cube;
+          corner[axis] += sign > 0 ? 1 : 0;
+          const int u = (axis + 1) % 3, v = (axis + 2) % 3;
+          const int32_t label = labels.at(corner[0], corner[1], corner[2]);
+          bool uniform = true;
+          for (int k = 1; k < 4 && uniform; ++k) {
+            std::array<int64_t, 3> other = corner;
+            other[u] += k & 1;
+            other[v] += k >> 1;
+            uniform = labels.at(other[0], other[1], other[2]) == label;
+          }
+          if (!uniform) stencil.neighbours.push_back(q);
+        }
+        if (junction) {
+          ++figures.junction_points;
+          if (stencil.neighbours.size() - first != 2) {
+            stencil.neighbours.resize(first);
+            ++figures.fixed_points;
+          }
+        }
       }
     }
   }
@@ -422,10 +476,10 @@ InterfaceSurface label_interfaces(const volume::LabelVolume& volume,
   const PaddedLabels padded = padded_labels(volume, labels);
   Cubes cubes;
   Net net = build_net(padded, geometry.spacing, cubes);
+  const Stencil stencil = smoothing_stencil(net, padded, cubes, figures);
   cubes.point.clear();
   cubes.point.shrink_to_fit();
 
-  const Stencil stencil = smoothing_stencil(net, figures);
   const double half = 0.5 * params.cube_fraction;
   const Vec3 half_box{half * geometry.spacing[0] * params.box_scale[0],
                       half * geometry.spacing[1] * params.box_scale[1],
