@@ -1,10 +1,11 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-// An early return for a step that failed: the calling function returns the
+// Early returns for a step that failed: the calling function returns the
 // step's status (absl::Status, an absl::StatusOr's status, or grpc::Status)
 // when it is not ok.
 #pragma once
 
 #include <type_traits>
+#include <utility>
 
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
@@ -34,3 +35,15 @@ const auto& status_of(const S& status) {
     if (const auto& labelmesh_status = (expr); !labelmesh_status.ok())  \
       return ::labelmesh::status_internal::status_of(labelmesh_status); \
   } while (false)
+
+#define LABELMESH_STATUS_CONCAT_INNER(a, b) a##b
+#define LABELMESH_STATUS_CONCAT(a, b) LABELMESH_STATUS_CONCAT_INNER(a, b)
+
+// LABELMESH_ASSIGN_OR_RETURN(auto job, store.get(id)); declares (or assigns)
+// `job` from a StatusOr's value, or returns its status unless ok.
+#define LABELMESH_ASSIGN_OR_RETURN(lhs, expr) \
+  LABELMESH_ASSIGN_OR_RETURN_IMPL(LABELMESH_STATUS_CONCAT(labelmesh_or_, __LINE__), lhs, expr)
+#define LABELMESH_ASSIGN_OR_RETURN_IMPL(or_value, lhs, expr) \
+  auto or_value = (expr);                                    \
+  if (!or_value.ok()) return std::move(or_value).status();   \
+  lhs = *std::move(or_value)
