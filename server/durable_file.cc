@@ -12,6 +12,7 @@
 #include <algorithm>
 
 #include "absl/strings/str_cat.h"
+#include "server/refusal.h"
 #include "spdlog/spdlog.h"
 
 namespace labelmesh::server {
@@ -41,10 +42,13 @@ std::string spool_relative(std::string_view text) {
 absl::Status spool_io_error(const std::string& what, int error_number) {
   spdlog::warn("spool: {}: {}", what, std::strerror(error_number));
   const std::string shown = spool_relative(what);
-  if (error_number == ENOSPC || error_number == EDQUOT || error_number == EFBIG)
-    return absl::ResourceExhaustedError(
-        absl::StrCat("spool disk full: ", shown, ": ", std::strerror(error_number)));
-  return absl::InternalError(absl::StrCat("spool: ", shown, ": ", std::strerror(error_number)));
+  if (error_number == ENOSPC || error_number == EDQUOT || error_number == EFBIG) {
+    return refused(Refusal::kDiskFull,
+                   absl::ResourceExhaustedError(absl::StrCat("spool disk full: ", shown, ": ",
+                                                             std::strerror(error_number))));
+  }
+  return refused(Refusal::kSpoolError, absl::InternalError(absl::StrCat(
+                                           "spool: ", shown, ": ", std::strerror(error_number))));
 }
 
 FileWriter::~FileWriter() {

@@ -5,6 +5,7 @@
 #include <thread>
 
 #include "absl/strings/str_cat.h"
+#include "server/refusal.h"
 #include "spdlog/spdlog.h"
 
 namespace labelmesh::server {
@@ -16,9 +17,10 @@ absl::StatusOr<uint64_t> output_room(const absl::StatusOr<uint64_t>& free_bytes,
   const uint64_t over_reserve =
       free > config.spool_reserve_bytes ? free - config.spool_reserve_bytes : 0;
   if (over_reserve < kLeastOutputRoom) {
-    return absl::ResourceExhaustedError(
-        absl::StrCat("spool disk full: ", free, " bytes free, no room over the reserve of ",
-                     config.spool_reserve_bytes, " bytes for the job's results"));
+    return refused(Refusal::kDiskFull,
+                   absl::ResourceExhaustedError(absl::StrCat(
+                       "spool disk full: ", free, " bytes free, no room over the reserve of ",
+                       config.spool_reserve_bytes, " bytes for the job's results")));
   }
   return config.max_job_output_bytes > 0 ? std::min(config.max_job_output_bytes, over_reserve)
                                          : over_reserve;

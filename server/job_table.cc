@@ -9,6 +9,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "server/client_identity.h"
+#include "server/refusal.h"
 #include "spdlog/spdlog.h"
 
 namespace labelmesh::server {
@@ -137,8 +138,9 @@ absl::StatusOr<uint32_t> JobTable::accept(v1::JobRecord record, const std::strin
   std::lock_guard lock(mutex_);
   if (closed_) return absl::UnavailableError("the server is shutting down");
   if (queue_.size() >= queue_capacity_) {
-    return absl::ResourceExhaustedError(
-        absl::StrCat("the job queue is full (", queue_capacity_, " jobs); try again later"));
+    return refused(Refusal::kQueueFull,
+                   absl::ResourceExhaustedError(absl::StrCat(
+                       "the job queue is full (", queue_capacity_, " jobs); try again later")));
   }
   const std::string id = record.job().job_id();
   record.mutable_job()->set_state(v1::JOB_STATE_QUEUED);

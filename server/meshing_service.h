@@ -5,7 +5,6 @@
 
 #include <atomic>
 #include <mutex>
-#include <set>
 #include <string>
 
 #include "labelmesh/v1/service.grpc.pb.h"
@@ -15,6 +14,7 @@
 #include "server/metrics.h"
 #include "server/server_config.h"
 #include "server/stream_limits.h"
+#include "server/submit_upload.h"
 
 namespace labelmesh::server {
 
@@ -51,33 +51,26 @@ class MeshingService final
   absl::StatusOr<ClientIdentity> identify(const grpc::ServerContextBase& context, const char* call);
   // NOT_FOUND unless the id is well formed, the job exists and the caller
   // owns it or is an admin: other clients' jobs are not even named.
-  grpc::Status authorize(const ClientIdentity& identity, const std::string& job_id) const;
-  // Submit without its audit line; `reason` says why it refused.
-  grpc::Status submit(grpc::ServerContext& context, grpc::ServerReader<v1::SubmitRequest>& reader,
-                      const ClientIdentity& identity, v1::SubmitReply& reply, std::string& reason);
-  grpc::Status receive_upload(grpc::ServerReader<v1::SubmitRequest>& reader,
-                              const v1::JobSpec& spec, const std::string& path,
-                              StreamWatchdog::Ticket& ticket, std::string& reason);
+  absl::Status authorize(const ClientIdentity& identity, const std::string& job_id) const;
+  // identify, then authorize for `job_id`.
+  absl::StatusOr<ClientIdentity> authorized(const grpc::ServerContextBase& context,
+                                            const char* call, const std::string& job_id);
+  absl::Status fetch(grpc::ServerContext& context, const v1::FetchRequest& request,
+                     grpc::ServerWriter<v1::FetchChunk>& writer);
   // A place among the client's streams, or RESOURCE_EXHAUSTED (counted).
   absl::StatusOr<std::unique_ptr<StreamCounts::Slot>> open_stream(
       const grpc::ServerContextBase& context, const ClientIdentity& identity);
   // The least an upload or a fetch must move, from the config.
   TransferRate transfer_rate() const;
-  // RESOURCE_EXHAUSTED "spool disk full" when an upload of this size would
-  // leave less than the reserve free.
-  absl::Status check_spool_space(uint64_t upload_bytes) const;
 
   JobStore& store_;
   const ServerConfig& config_;
   Metrics& metrics_;
   ClientAuthenticator& authenticator_;
   AuditLog& audit_;
-  // Submits in progress by (owner, request_id), so that a retry that races
-  // its first try waits instead of making a second job.
-  std::mutex requests_mutex_;
+  RequestsInFlight requests_;
   // Held while a worker reads an upload the server cannot decode itself.
   std::timed_mutex volume_reader_;
-  std::set<std::pair<std::string, std::string>> requests_in_flight_;
   std::atomic<bool> accepting_{true};
   StreamCounts streams_;
   StreamCounts uploads_;

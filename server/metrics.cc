@@ -138,8 +138,8 @@ void Metrics::stage_finished(const std::string& stage, double seconds) {
   families_->stage_duration.Add({{"stage", stage}}, seconds_buckets()).Observe(seconds);
 }
 
-void Metrics::rejected(const std::string& reason) {
-  families_->rejections.Add({{"reason", reason}}).Increment();
+void Metrics::rejected(Refusal why) {
+  families_->rejections.Add({{"reason", std::string(refusal_code(why))}}).Increment();
 }
 
 void Metrics::upload_bytes(uint64_t bytes) {

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "absl/status/statusor.h"
+#include "server/refusal.h"
 
 namespace prometheus {
 class Registry;
@@ -33,9 +34,8 @@ class Metrics {
   void job_ended(const std::string& outcome);
   void queue_wait(double seconds);
   void stage_finished(const std::string& stage, double seconds);
-  // reason: queue_full, too_many_uploads, too_large, bad_request, bad_digest,
-  // bad_volume, unauthenticated, disk_full, spool_error, stalled, too_slow.
-  void rejected(const std::string& reason);
+  // Counted under the refusal's code (refusal.h).
+  void rejected(Refusal why);
   void upload_bytes(uint64_t bytes);
   void set_spool_space(uint64_t free_bytes, bool under_reserve);
   void spool_write_failed();

@@ -28,19 +28,20 @@ absl::StatusOr<std::unique_ptr<StreamCounts::Slot>> StreamCounts::open(const std
     return it == counts.end() ? 0 : it->second;
   };
   std::lock_guard lock(mutex_);
+  const auto full = [&](const std::string& message) {
+    return refused(when_full_, absl::ResourceExhaustedError(message));
+  };
   if (open_ >= limits_.total) {
-    return absl::ResourceExhaustedError(absl::StrCat("the server holds its most ", what_, " (",
-                                                     limits_.total, "); try again later"));
+    return full(absl::StrCat("the server holds its most ", what_, " (", limits_.total,
+                             "); try again later"));
   }
   if (held(by_client_, client) >= limits_.per_client) {
-    return absl::ResourceExhaustedError(absl::StrCat("this client holds its most ", what_,
-                                                     " at once (", limits_.per_client,
-                                                     "); close one first"));
+    return full(absl::StrCat("this client holds its most ", what_, " at once (", limits_.per_client,
+                             "); close one first"));
   }
   if (held(by_host_, host) >= limits_.per_host) {
-    return absl::ResourceExhaustedError(absl::StrCat("this client's host holds its most ", what_,
-                                                     " at once (", limits_.per_host,
-                                                     "); try again later"));
+    return full(absl::StrCat("this client's host holds its most ", what_, " at once (",
+                             limits_.per_host, "); try again later"));
   }
   ++by_client_[client];
   ++by_host_[host];
@@ -96,10 +97,10 @@ void StreamWatchdog::Ticket::end_transfer() {
   if (it != watchdog_.entries_.end()) it->second.transfer.rate.bytes_per_second = 0;
 }
 
-std::string StreamWatchdog::Ticket::cancelled_because() const {
+absl::Status StreamWatchdog::Ticket::cancellation() const {
   std::lock_guard lock(watchdog_.mutex_);
   auto it = watchdog_.entries_.find(id_);
-  return it == watchdog_.entries_.end() ? std::string() : it->second.cancelled_because;
+  return it == watchdog_.entries_.end() ? absl::OkStatus() : it->second.cancellation;
 }
 
 std::unique_ptr<StreamWatchdog::Ticket> StreamWatchdog::watch(grpc::ServerContextBase* context,
@@ -140,7 +141,7 @@ void StreamWatchdog::loop() {
     const absl::Time now = absl::Now();
     std::vector<uint64_t> to_cancel;
     for (auto& [id, entry] : entries_) {
-      if (!entry.cancelled_because.empty()) continue;
+      if (!entry.cancellation.ok()) continue;
       absl::Time busy_since = entry.last_touch;
       if (entry.write_started) {
         const int64_t started = entry.write_started();
@@ -148,11 +149,15 @@ void StreamWatchdog::loop() {
       }
       Entry::Transfer& transfer = entry.transfer;
       if (now - busy_since > entry.idle) {
-        entry.cancelled_because =
-            absl::StrCat(entry.what, " stalled for more than ", absl::FormatDuration(entry.idle));
+        entry.cancellation =
+            refused(Refusal::kStalled,
+                    absl::DeadlineExceededError(absl::StrCat(entry.what, " stalled for more than ",
+                                                             absl::FormatDuration(entry.idle))));
       } else if (now > entry.deadline) {
-        entry.cancelled_because = absl::StrCat(entry.what, " ran past its deadline of ",
-                                               absl::FormatDuration(entry.total));
+        entry.cancellation = refused(
+            Refusal::kStalled,
+            absl::DeadlineExceededError(absl::StrCat(entry.what, " ran past its deadline of ",
+                                                     absl::FormatDuration(entry.total))));
       } else if (transfer.rate.bytes_per_second > 0 && transfer.started &&
                  now - transfer.window_start >= transfer.rate.window) {
         // Window by window, not on average since the start: a fast start
@@ -164,14 +169,16 @@ void StreamWatchdog::loop() {
           transfer.window_bytes = transfer.bytes;
           continue;
         }
-        entry.cancelled_because = absl::StrFormat(
-            "%s too slow: %.1f KiB/s over the last %s, under the minimum of %.1f KiB/s", entry.what,
-            moved / 1024.0 / seconds, absl::FormatDuration(transfer.rate.window),
-            transfer.rate.bytes_per_second / 1024.0);
+        entry.cancellation = refused(
+            Refusal::kTooSlow,
+            absl::DeadlineExceededError(absl::StrFormat(
+                "%s too slow: %.1f KiB/s over the last %s, under the minimum of %.1f KiB/s",
+                entry.what, moved / 1024.0 / seconds, absl::FormatDuration(transfer.rate.window),
+                transfer.rate.bytes_per_second / 1024.0)));
       } else {
         continue;
       }
-      spdlog::warn("{}: cancelled", entry.cancelled_because);
+      spdlog::warn("{}: cancelled", std::string(entry.cancellation.message()));
       entry.cancelling = true;
       to_cancel.push_back(id);
     }

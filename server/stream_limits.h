@@ -20,8 +20,12 @@
 
 #include "absl/status/statusor.h"
 #include "absl/time/time.h"
+#include "server/refusal.h"
 
 namespace labelmesh::server {
+
+// The largest chunk of an upload, and the size of a fetch's chunks.
+inline constexpr size_t kChunkBytes = 1 << 20;
 
 // The client part of a gRPC peer ("ipv4:10.0.0.7:53211" -> "ipv4:10.0.0.7").
 std::string peer_host(const std::string& peer);
@@ -36,8 +40,10 @@ class StreamCounts {
     int per_host;
     int total;
   };
-  // `what` names the resource in refusals: "streams", "uploads".
-  StreamCounts(Limits limits, std::string what) : limits_(limits), what_(std::move(what)) {}
+  // `what` names the resource in refusals ("streams", "uploads"), which are
+  // marked `when_full`.
+  StreamCounts(Limits limits, std::string what, Refusal when_full)
+      : limits_(limits), what_(std::move(what)), when_full_(when_full) {}
 
   // Holds one place until destroyed.
   class Slot {
@@ -61,6 +67,7 @@ class StreamCounts {
  private:
   const Limits limits_;
   const std::string what_;
+  const Refusal when_full_;
   std::mutex mutex_;
   // Only keys with a place held: a key is erased when its count drops to 0.
   std::map<std::string, int> by_client_;
@@ -96,8 +103,9 @@ class StreamWatchdog {
     void touch(uint64_t transferred);
     // The bytes are all in: no minimum rate from now on.
     void end_transfer();
-    // Why the watchdog cancelled the stream; empty if it did not.
-    std::string cancelled_because() const;
+    // DEADLINE_EXCEEDED saying why, marked stalled or too_slow, when the
+    // watchdog cancelled the stream; OK otherwise.
+    absl::Status cancellation() const;
 
    private:
     friend class StreamWatchdog;
@@ -126,7 +134,7 @@ class StreamWatchdog {
     absl::Time deadline;
     absl::Time last_touch;
     std::string what;
-    std::string cancelled_because;
+    absl::Status cancellation;
     std::function<int64_t()> write_started;
     // The watchdog is cancelling this stream with its lock released.
     bool cancelling = false;

@@ -9,6 +9,7 @@
 #include "core/digest/sha256.h"
 #include "core/pipeline/job_options.h"
 #include "core/volume/volume_header.h"
+#include "server/refusal.h"
 
 namespace labelmesh::server {
 
@@ -31,9 +32,10 @@ absl::Status check_spec(const v1::JobSpec& spec, const ServerConfig& config) {
   if (spec.size_bytes() == 0)
     return absl::InvalidArgumentError("spec.size_bytes: must be positive");
   if (spec.size_bytes() > config.max_upload_bytes) {
-    return absl::InvalidArgumentError(absl::StrCat("spec.size_bytes: ", spec.size_bytes(),
-                                                   " is over the server's upload limit of ",
-                                                   config.max_upload_bytes, " bytes"));
+    return refused(Refusal::kTooLarge,
+                   absl::InvalidArgumentError(absl::StrCat("spec.size_bytes: ", spec.size_bytes(),
+                                                           " is over the server's upload limit of ",
+                                                           config.max_upload_bytes, " bytes")));
   }
   if (!digest::is_sha256_hex(spec.sha256())) {
     return absl::InvalidArgumentError("spec.sha256: must be 64 lowercase hex digits");

@@ -16,7 +16,8 @@ namespace labelmesh::server {
 // held in one file. INVALID_ARGUMENT naming spec.file_name otherwise.
 absl::StatusOr<std::string> upload_extension(const std::string& file_name);
 
-// INVALID_ARGUMENT naming the spec field or option at fault.
+// INVALID_ARGUMENT naming the spec field or option at fault; a size over the
+// server's limit is marked too_large.
 absl::Status check_spec(const v1::JobSpec& spec, const ServerConfig& config);
 
 // The stored upload, before it becomes a job: its header, with the job's

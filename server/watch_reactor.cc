@@ -77,9 +77,8 @@ void WatchReactor::OnCancel() {
 }
 
 grpc::Status WatchReactor::left_or_stalled() const {
-  const std::string reason = ticket_ ? ticket_->cancelled_because() : std::string();
-  if (!reason.empty()) return grpc::Status(grpc::StatusCode::DEADLINE_EXCEEDED, reason);
-  return grpc::Status(grpc::StatusCode::CANCELLED, "watcher left");
+  absl::Status stalled = ticket_ ? ticket_->cancellation() : absl::OkStatus();
+  return to_grpc(stalled.ok() ? absl::CancelledError("watcher left") : stalled);
 }
 
 void WatchReactor::finish(const grpc::Status& status) {
