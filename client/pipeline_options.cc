@@ -5,13 +5,14 @@
 
 #include <cstdio>
 
+#include "core/pipeline/job_options.h"
 #include "core/volume/label_table.h"
 
 namespace labelmesh::client {
 
 void add_pipeline_flags(CLI::App& command, PipelineFlags& flags) {
   command
-      .add_option("--labels", flags.labels,
+      .add_option("--labels", flags.params.labels,
                   "Labels to mesh, e.g. 1,3 (default: every non-zero label)")
       ->delimiter(',');
   command
@@ -21,7 +22,7 @@ void add_pipeline_flags(CLI::App& command, PipelineFlags& flags) {
                   "(MC repaired with CGAL), poisson (repaired MC, then CGAL Poisson "
                   "reconstruction; the default under --volume tet, mixed or hex)")
       ->check(CLI::IsMember({"net", "mc", "repaired", "poisson"}));
-  auto& poisson = flags.poisson;
+  auto& poisson = flags.params.poisson;
   command
       .add_option("--min-angle", poisson.min_angle_deg,
                   "Poisson: smallest triangle angle, degrees, at most 30")
@@ -62,7 +63,7 @@ void add_pipeline_flags(CLI::App& command, PipelineFlags& flags) {
                      "Label names and colours: an ITK-SNAP label file, a FreeSurfer colour table "
                      "or a JSON map {\"5\": \"liver\"}; they name the surface files and the "
                      "report's labels");
-  auto& guard = flags.guard;
+  auto& guard = flags.params.guard;
   command
       .add_option("--volume-tolerance", guard.volume_percent,
                   "Delivery guard: largest volume change against Marching Cubes, percent")
@@ -133,23 +134,23 @@ void add_pipeline_flags(CLI::App& command, PipelineFlags& flags) {
       ->check(CLI::IsMember({"none", "tet", "mixed", "hex", "conforming"}))
       ->capture_default_str();
   command
-      .add_option("--hex-size", flags.hex_size_mm,
+      .add_option("--hex-size", flags.params.hex_size_mm,
                   "Mixed and hex: the hexahedra's edge, mm; 0 for three voxels")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   command
-      .add_option("--hex-interior-size", flags.hex_interior_size_mm,
+      .add_option("--hex-interior-size", flags.params.hex_interior_size_mm,
                   "Mixed: the largest octant's edge inside each label, mm (an octree: cubes of "
                   "--hex-size under the surface, coarser deeper in); 0 for one size throughout")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   command
-      .add_option("--conforming-max-faces", flags.conforming_max_interface_faces,
+      .add_option("--conforming-max-faces", flags.params.conforming_max_interface_faces,
                   "Conforming: voxel faces between labels above which blocks of voxels are "
                   "merged (each keeping its most common label) so the mesh fits in about 1 GiB; "
                   "0 for no bound")
       ->capture_default_str();
-  auto& tetgen = flags.tetgen;
+  auto& tetgen = flags.params.tetgen;
   command
       .add_option("--tet-radius-edge", tetgen.radius_edge_ratio,
                   "Tet: largest circumradius / shortest edge (TetGen -q), at least 1")
@@ -168,7 +169,7 @@ void add_pipeline_flags(CLI::App& command, PipelineFlags& flags) {
                   "above this, degrees in [90, 179]")
       ->capture_default_str();
   command
-      .add_option("--tet-improve-quality", flags.improve.target_quality,
+      .add_option("--tet-improve-quality", flags.params.improve.target_quality,
                   "Tet: the improvement pass after TetGen (flips, smoothing of interior points) "
                   "works on tetrahedra with quality Q below this; 0 turns it off")
       ->capture_default_str();
@@ -197,12 +198,15 @@ void add_pipeline_flags(CLI::App& command, PipelineFlags& flags) {
                   "separate: mesh each segment on its own")
       ->check(CLI::IsMember({"refuse", "separate"}))
       ->capture_default_str();
-  command.add_option("--max-voxels", flags.max_voxels, "Refuse volumes with more voxels than this")
+  command
+      .add_option("--max-voxels", flags.params.limits.max_voxels,
+                  "Refuse volumes with more voxels than this")
       ->capture_default_str();
 }
 
 absl::StatusOr<v1::MeshOptions> to_mesh_options(const PipelineFlags& flags) {
-  v1::MeshOptions proto;
+  MeshParams params = flags.params;
+  auto& poisson = params.poisson;
   for (const auto& text : flags.label_sizing) {
     int label = 0;
     double edge = 0, distance = 0;
@@ -211,77 +215,38 @@ absl::StatusOr<v1::MeshOptions> to_mesh_options(const PipelineFlags& flags) {
     if (read != 2 && read != 3)
       return absl::InvalidArgumentError("--label-sizing: '" + text +
                                         "' is not LABEL:EDGE_MM[:DISTANCE_MM]");
-    auto* entry = proto.add_label_sizing();
-    entry->set_label(label);
-    entry->set_max_edge_mm(edge);
-    entry->set_max_distance_mm(distance);
+    poisson.label_sizing.push_back({label, edge, distance});
   }
   if (!flags.label_names.empty()) {
     auto table = volume::read_label_table(flags.label_names);
     if (!table.ok()) return table.status();
-    for (const auto& named : *table) {
-      auto* entry = proto.add_label_names();
-      entry->set_label(named.label);
-      entry->set_name(named.name);
-      if (named.colour) {
-        for (uint8_t c : *named.colour) entry->add_colour_rgb(c);
-      }
-    }
+    params.label_names = *std::move(table);
   }
-  proto.set_coordinates(flags.coordinates == "ras" ? v1::COORDINATE_FRAME_RAS
-                                                   : v1::COORDINATE_FRAME_LPS);
-  proto.set_overlapping_segments(flags.overlapping == "separate" ? v1::OVERLAPPING_SEGMENTS_SEPARATE
-                                                                 : v1::OVERLAPPING_SEGMENTS_REFUSE);
-  if (flags.poisson.max_edge_mm > 0) proto.set_max_edge_mm(flags.poisson.max_edge_mm);
-  if (flags.poisson.max_distance_mm > 0) proto.set_max_distance_mm(flags.poisson.max_distance_mm);
-  proto.set_adapt_to_thickness(!flags.no_adapt_to_thickness);
-  proto.set_poisson_min_thickness_voxels(flags.poisson.min_thickness_voxels);
-  proto.set_volume_tolerance_percent(flags.guard.volume_percent);
-  proto.set_small_volume_tolerance_percent(flags.guard.small_volume_percent);
-  proto.set_hausdorff_tolerance_mm(flags.guard.hausdorff_mm);
-  proto.set_fall_back(!flags.no_fall_back);
-  proto.set_strict(flags.guard.strict);
-  for (int32_t label : flags.labels) proto.add_labels(label);
-  proto.set_surface(flags.surface == "mc"         ? v1::SURFACE_METHOD_MARCHING_CUBES
-                    : flags.surface == "repaired" ? v1::SURFACE_METHOD_REPAIRED
-                    : flags.surface == "poisson"  ? v1::SURFACE_METHOD_POISSON
-                    : flags.surface == "net"      ? v1::SURFACE_METHOD_NET
-                                                  : v1::SURFACE_METHOD_UNSPECIFIED);
-  const auto& poisson = flags.poisson;
-  proto.set_min_angle_deg(poisson.min_angle_deg);
-  proto.set_max_edge_voxels(poisson.max_edge_voxels);
-  proto.set_max_distance_voxels(poisson.max_distance_voxels);
-  proto.set_min_component_voxels(poisson.min_component_voxels);
-  proto.set_point_cell_voxels(poisson.point_cell_voxels);
-  proto.set_point_cluster_size(poisson.point_cluster_size);
-  proto.set_max_points(poisson.max_points);
-  proto.set_split_points(poisson.split_points);
-  proto.set_prune_strands(!flags.keep_strands);
-  proto.set_smoothing_iterations(poisson.smoothing.iterations);
-  proto.set_smoothing_pass_band(poisson.smoothing.pass_band);
-
-  proto.set_normals(flags.normals == "area" ? v1::NORMAL_WEIGHTING_AREA
-                                            : v1::NORMAL_WEIGHTING_UNIFORM);
-  proto.set_point_reduction(flags.point_reduction == "hierarchy" ? v1::POINT_REDUCTION_HIERARCHY
-                            : flags.point_reduction == "none"    ? v1::POINT_REDUCTION_NONE
-                                                                 : v1::POINT_REDUCTION_GRID);
-  if (flags.volume != "none") {
-    proto.set_volume(flags.volume == "mixed"        ? v1::VOLUME_METHOD_MIXED
-                     : flags.volume == "hex"        ? v1::VOLUME_METHOD_HEX
-                     : flags.volume == "conforming" ? v1::VOLUME_METHOD_CONFORMING
-                                                    : v1::VOLUME_METHOD_TETGEN);
-    proto.set_hex_size_mm(flags.hex_size_mm);
-    proto.set_conforming_max_interface_faces(flags.conforming_max_interface_faces);
-    proto.set_hex_interior_size_mm(flags.hex_interior_size_mm);
-    proto.set_tet_radius_edge(flags.tetgen.radius_edge_ratio);
-    proto.set_tet_min_dihedral_deg(flags.tetgen.min_dihedral_deg);
-    proto.set_tet_max_volume_mm3(flags.tetgen.max_volume_mm3);
-    proto.set_tet_keep_boundary(!flags.tet_split_boundary);
-    proto.set_tet_max_dihedral_deg(flags.tetgen.max_dihedral_deg);
-    proto.set_tet_improve_quality(flags.improve.target_quality);
-  }
+  params.frame = flags.coordinates == "ras" ? CoordinateFrame::kRas : CoordinateFrame::kLps;
+  params.limits.separate_overlapping = flags.overlapping == "separate";
+  poisson.adapt_to_thickness = !flags.no_adapt_to_thickness;
+  poisson.prune_strands = !flags.keep_strands;
+  params.guard.fall_back = !flags.no_fall_back;
+  params.tetgen.keep_boundary = !flags.tet_split_boundary;
+  poisson.normals = flags.normals == "area" ? surface::NormalWeighting::kArea
+                                            : surface::NormalWeighting::kUniform;
+  poisson.point_reduction = flags.point_reduction == "hierarchy"
+                                ? surface::PointReduction::kHierarchy
+                            : flags.point_reduction == "none" ? surface::PointReduction::kNone
+                                                              : surface::PointReduction::kGrid;
+  params.volume = flags.volume == "tet"          ? VolumeMethod::kTetgen
+                  : flags.volume == "mixed"      ? VolumeMethod::kMixed
+                  : flags.volume == "hex"        ? VolumeMethod::kHex
+                  : flags.volume == "conforming" ? VolumeMethod::kConforming
+                                                 : VolumeMethod::kNone;
+  params.surface = flags.surface == "mc"         ? SurfaceMethod::kMarchingCubes
+                   : flags.surface == "repaired" ? SurfaceMethod::kRepaired
+                   : flags.surface == "poisson"  ? SurfaceMethod::kPoisson
+                                                 : SurfaceMethod::kNet;
+  v1::MeshOptions proto = make_options(params);
+  if (flags.surface.empty()) proto.set_surface(v1::SURFACE_METHOD_UNSPECIFIED);
+  proto.clear_formats();
   for (const auto& format : flags.formats) proto.add_formats(format);
-  proto.set_max_voxels(flags.max_voxels);
   return proto;
 }
 

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 // The pipeline options of `labelmesh mesh` and `labelmesh submit`: one set of
-// flags, turned into the one job-options message both paths run with.
+// flags, bound to the pipeline's own parameters where they are values, and
+// written into the one job-options message both paths run with by the
+// pipeline's own writer (make_options).
 #pragma once
 
 #include <string>
@@ -17,31 +19,28 @@ class App;
 namespace labelmesh::client {
 
 struct PipelineFlags {
-  std::vector<int32_t> labels;
-  // Empty: the job options' default (net, or poisson under a volume mesh).
+  // The values the flags set directly, defaults and all.
+  MeshParams params;
+  // Choices by name, read into `params` by to_mesh_options. An empty
+  // surface is the job options' default (net, or poisson under a volume
+  // mesh).
   std::string surface;
-  PoissonOptions poisson;
   std::string normals = "uniform";
   std::string point_reduction = "grid";
-  bool keep_strands = false;
   std::string volume = "none";
-  double hex_size_mm = 0;
-  double hex_interior_size_mm = 0;
-  uint64_t conforming_max_interface_faces = conforming::kDefaultMaxInterfaceFaces;
-  volume_mesh::TetgenParams tetgen;
-  volume_mesh::ImproveParams improve;
+  std::string coordinates = "lps";
+  std::string overlapping = "refuse";
+  // Flags that turn a default off.
+  bool keep_strands = false;
   bool tet_split_boundary = false;
   bool no_adapt_to_thickness = false;
+  bool no_fall_back = false;
   // LABEL:EDGE_MM[:DISTANCE_MM], one per label.
   std::vector<std::string> label_sizing;
   // A label table: ITK-SNAP, FreeSurfer or JSON (volume/label_table.h).
   std::string label_names;
-  GuardOptions guard;
-  bool no_fall_back = false;
+  // Passed on as given: the job options' reader sorts them by kind.
   std::vector<std::string> formats{"stl", "vtp"};
-  std::string coordinates = "lps";
-  std::string overlapping = "refuse";
-  uint64_t max_voxels = volume::ReadLimits{}.max_voxels;
 };
 
 void add_pipeline_flags(CLI::App& command, PipelineFlags& flags);

@@ -153,8 +153,10 @@ absl::Status SubmitUpload::run(v1::SubmitReply& reply) {
     return stalled_or(*ticket, bad_request("the first message must hold the job spec"));
   ticket->touch();
   v1::JobSpec spec = first.spec();
-  if (auto status = check_spec(spec, config); !status.ok())
-    return refused(refusal_of(status, Refusal::kBadRequest), status);
+  auto checked = check_spec(spec, config);
+  if (!checked.ok())
+    return refused(refusal_of(checked.status(), Refusal::kBadRequest), checked.status());
+  MeshParams params = *std::move(checked);
   // A retried Submit gets the job its first try made.
   RequestsInFlight::Claim claim(services_.requests, {identity_.name, spec.request_id()});
   if (!claim.claimed()) {
@@ -181,15 +183,13 @@ absl::Status SubmitUpload::run(v1::SubmitReply& reply) {
   }
   LABELMESH_RETURN_IF_ERROR(check_spool_space(spec.size_bytes()));
   // The job's voxel limit is the smaller of the client's and the server's.
-  auto& options = *spec.mutable_options();
-  const uint64_t voxel_limit = options.max_voxels() == 0
-                                   ? config.max_voxels
-                                   : std::min<uint64_t>(options.max_voxels(), config.max_voxels);
-  options.set_max_voxels(voxel_limit);
+  const uint64_t asked = spec.options().max_voxels();
+  const uint64_t voxel_limit =
+      asked == 0 ? config.max_voxels : std::min<uint64_t>(asked, config.max_voxels);
+  params.limits.max_voxels = voxel_limit;
   // The job keeps its options as the pipeline reads them, defaults filled in,
-  // so that GetJob shows what the job runs with. check_spec parsed them.
-  const MeshParams params = *params_from_options(options);
-  options = make_options(params);
+  // so that GetJob shows what the job runs with.
+  *spec.mutable_options() = make_options(params);
 
   const std::string job_id = store.new_job_id_for(identity_.name, spec.request_id());
   const std::string extension = *upload_extension(spec.file_name());

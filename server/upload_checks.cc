@@ -25,7 +25,7 @@ absl::StatusOr<std::string> upload_extension(const std::string& file_name) {
       ".nii.gz, .mha, .nrrd, .inr, .inr.gz, .vti or .dcm (DICOM SEG)");
 }
 
-absl::Status check_spec(const v1::JobSpec& spec, const ServerConfig& config) {
+absl::StatusOr<MeshParams> check_spec(const v1::JobSpec& spec, const ServerConfig& config) {
   if (auto extension = upload_extension(spec.file_name()); !extension.ok()) {
     return extension.status();
   }
@@ -46,10 +46,10 @@ absl::Status check_spec(const v1::JobSpec& spec, const ServerConfig& config) {
     return absl::InvalidArgumentError(
         "spec.request_id: must be at most 128 printable ASCII characters, no spaces");
   }
-  if (auto params = params_from_options(spec.options()); !params.ok()) {
+  auto params = params_from_options(spec.options());
+  if (!params.ok())
     return absl::InvalidArgumentError(absl::StrCat("spec.options: ", params.status().message()));
-  }
-  return absl::OkStatus();
+  return params;
 }
 
 absl::StatusOr<volume::ImageGeometry> check_uploaded_volume(const std::string& path,

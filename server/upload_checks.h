@@ -6,6 +6,7 @@
 #include <string>
 
 #include "absl/status/statusor.h"
+#include "core/pipeline/mesh_params.h"
 #include "core/volume/image_geometry.h"
 #include "labelmesh/v1/service.pb.h"
 #include "server/server_config.h"
@@ -16,9 +17,10 @@ namespace labelmesh::server {
 // held in one file. INVALID_ARGUMENT naming spec.file_name otherwise.
 absl::StatusOr<std::string> upload_extension(const std::string& file_name);
 
-// INVALID_ARGUMENT naming the spec field or option at fault; a size over the
-// server's limit is marked too_large.
-absl::Status check_spec(const v1::JobSpec& spec, const ServerConfig& config);
+// The job's options as the pipeline reads them (the one parse of them in the
+// server), or INVALID_ARGUMENT naming the spec field or option at fault; a
+// size over the server's limit is marked too_large.
+absl::StatusOr<MeshParams> check_spec(const v1::JobSpec& spec, const ServerConfig& config);
 
 // The stored upload, before it becomes a job: its header, with the job's
 // voxel limit; the least memory a worker needs for it, against the worker

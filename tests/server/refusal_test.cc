@@ -79,9 +79,9 @@ TEST(Refusal, TheLayersThatKnowWhyMarkTheirStatuses) {
   spec.set_file_name("seg.nii.gz");
   spec.set_sha256(std::string(64, 'a'));
   spec.set_size_bytes(101);
-  EXPECT_EQ(refusal_of(check_spec(spec, config)), Refusal::kTooLarge);
+  EXPECT_EQ(refusal_of(check_spec(spec, config).status()), Refusal::kTooLarge);
   spec.set_size_bytes(0);
-  const absl::Status empty = check_spec(spec, config);
+  const absl::Status empty = check_spec(spec, config).status();
   EXPECT_EQ(empty.code(), absl::StatusCode::kInvalidArgument);
   EXPECT_EQ(refusal_of(empty), Refusal::kRefused);
 }
