@@ -70,8 +70,9 @@ struct LabelSizing {
 
 struct PoissonOptions {
   double min_angle_deg = 30;
-  // 8 voxels and half a voxel give the liver about 26,000 triangles; halving
-  // both doubles fidelity to curvature and triples the meshing time.
+  // Longest edge and surface distance, voxels (docs/benchmarks.md has what
+  // they give on the liver); halving both follows curvature twice as closely
+  // and takes several times as long.
   double max_edge_voxels = 8;
   double max_distance_voxels = 0.5;
   // The same in mm; when set (> 0) they replace the voxel figures.
