@@ -42,7 +42,7 @@ void AuditLog::record(const AuditEntry& entry) {
   const std::string time =
       absl::FormatTime("%Y-%m-%dT%H:%M:%E3SZ", absl::Now(), absl::UTCTimeZone());
   const std::string line = audit_json(entry, time) + "\n";
-  std::lock_guard lock(mutex_);
+  absl::MutexLock lock(&mutex_);
   if (std::fwrite(line.data(), 1, line.size(), file_) != line.size() || std::fflush(file_) != 0) {
     spdlog::error("audit log: a line could not be written: {}", std::strerror(errno));
   }

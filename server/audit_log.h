@@ -7,10 +7,11 @@
 
 #include <cstdio>
 #include <memory>
-#include <mutex>
 #include <string>
 
+#include "absl/base/thread_annotations.h"
 #include "absl/status/statusor.h"
+#include "absl/synchronization/mutex.h"
 
 namespace labelmesh::server {
 
@@ -42,8 +43,9 @@ class AuditLog {
 
  private:
   explicit AuditLog(std::FILE* file) : file_(file) {}
-  std::mutex mutex_;
-  std::FILE* file_;
+  absl::Mutex mutex_;
+  // Lines are written whole, one writer at a time.
+  std::FILE* const file_ ABSL_PT_GUARDED_BY(mutex_);
 };
 
 }  // namespace labelmesh::server

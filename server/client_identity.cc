@@ -118,7 +118,7 @@ ShareKeys share_keys(const ClientIdentity& identity, const std::string& peer) {
 
 absl::Status AuthBackoff::check(const std::string& peer, absl::Time now) {
   const std::string host = host_key(peer);
-  std::lock_guard lock(mutex_);
+  absl::MutexLock lock(&mutex_);
   auto it = hosts_.find(host);
   if (it == hosts_.end() || it->second.blocked_until <= now) return absl::OkStatus();
   return absl::ResourceExhaustedError(absl::StrCat(
@@ -128,7 +128,7 @@ absl::Status AuthBackoff::check(const std::string& peer, absl::Time now) {
 
 void AuthBackoff::failed(const std::string& peer, absl::Time now) {
   const std::string host = host_key(peer);
-  std::lock_guard lock(mutex_);
+  absl::MutexLock lock(&mutex_);
   if (hosts_.size() >= kMaxTrackedHosts && hosts_.find(host) == hosts_.end()) {
     std::erase_if(hosts_, [now](const auto& entry) {
       return entry.second.blocked_until <= now && now - entry.second.last_failure > kForgetAfter;

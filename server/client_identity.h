@@ -8,12 +8,13 @@
 #include <grpcpp/grpcpp.h>
 
 #include <map>
-#include <mutex>
 #include <set>
 #include <string>
 #include <vector>
 
+#include "absl/base/thread_annotations.h"
 #include "absl/status/statusor.h"
+#include "absl/synchronization/mutex.h"
 #include "absl/time/time.h"
 #include "server/server_config.h"
 
@@ -82,8 +83,8 @@ class AuthBackoff {
   const int allowed_failures_;
   const absl::Duration first_backoff_;
   const absl::Duration longest_backoff_;
-  std::mutex mutex_;
-  std::map<std::string, Host> hosts_;
+  absl::Mutex mutex_;
+  std::map<std::string, Host> hosts_ ABSL_GUARDED_BY(mutex_);
 };
 
 class ClientAuthenticator {

@@ -87,7 +87,7 @@ void JobTable::recover(absl::Duration result_ttl) {
     return a.job().created_at() < b.job().created_at();
   });
   const double now = unix_now();
-  std::lock_guard lock(mutex_);
+  absl::MutexLock lock(&mutex_);
   int requeued = 0, kept = 0, expired = 0;
   for (auto& record : records) {
     v1::Job& job = *record.mutable_job();
@@ -126,16 +126,17 @@ void JobTable::recover(absl::Duration result_ttl) {
   update_gauges();
   spdlog::info("spool: {} jobs queued again, {} ended jobs kept, {} expired jobs deleted", requeued,
                kept, expired);
-  queue_changed_.notify_all();
 }
 
+bool JobTable::ready_to_dispatch() const { return closed_ || (dispatching_ && !queue_.empty()); }
+
 bool JobTable::queue_full() const {
-  std::lock_guard lock(mutex_);
+  absl::MutexLock lock(&mutex_);
   return queue_.size() >= queue_capacity_;
 }
 
 absl::StatusOr<uint32_t> JobTable::accept(v1::JobRecord record, const std::string& upload_path) {
-  std::lock_guard lock(mutex_);
+  absl::MutexLock lock(&mutex_);
   if (closed_) return absl::UnavailableError("the server is shutting down");
   if (queue_.size() >= queue_capacity_) {
     return refused(Refusal::kQueueFull,
@@ -154,13 +155,12 @@ absl::StatusOr<uint32_t> JobTable::accept(v1::JobRecord record, const std::strin
   add_event(entry, std::move(event));
   update_gauges();
   spdlog::info("job {} queued at position {}", id, position);
-  queue_changed_.notify_one();
   return position;
 }
 
 std::optional<v1::JobRecord> JobTable::take_next() {
-  std::unique_lock lock(mutex_);
-  queue_changed_.wait(lock, [this] { return closed_ || (dispatching_ && !queue_.empty()); });
+  absl::MutexLock lock(&mutex_);
+  mutex_.Await(absl::Condition(this, &JobTable::ready_to_dispatch));
   if (closed_) return std::nullopt;
   const std::string id = queue_.front();
   queue_.pop_front();
@@ -184,7 +184,7 @@ std::optional<v1::JobRecord> JobTable::take_next() {
 }
 
 void JobTable::publish(const std::string& job_id, v1::JobEvent event) {
-  std::lock_guard lock(mutex_);
+  absl::MutexLock lock(&mutex_);
   Entry* entry = find(job_id);
   if (entry == nullptr || entry->record.job().state() != v1::JOB_STATE_RUNNING) return;
   v1::Job& job = *entry->record.mutable_job();
@@ -229,7 +229,7 @@ absl::Status JobTable::end_job(Entry& entry, v1::JobState state, v1::JobEvent ev
 
 void JobTable::succeed(const std::string& job_id, const v1::Report& report,
                        std::vector<v1::Artifact> artifacts) {
-  std::lock_guard lock(mutex_);
+  absl::MutexLock lock(&mutex_);
   Entry* entry = find(job_id);
   if (entry == nullptr) return;
   *entry->record.mutable_job()->mutable_report() = report;
@@ -245,7 +245,7 @@ void JobTable::succeed(const std::string& job_id, const v1::Report& report,
 }
 
 void JobTable::fail(const std::string& job_id, int code, const std::string& message) {
-  std::lock_guard lock(mutex_);
+  absl::MutexLock lock(&mutex_);
   Entry* entry = find(job_id);
   if (entry == nullptr) return;
   v1::JobError& error = *entry->record.mutable_job()->mutable_error();
@@ -272,7 +272,7 @@ absl::Status JobTable::end_cancelled(Entry& entry, Unsaved unsaved) {
 }
 
 void JobTable::mark_cancelled(const std::string& job_id) {
-  std::lock_guard lock(mutex_);
+  absl::MutexLock lock(&mutex_);
   Entry* entry = find(job_id);
   if (entry == nullptr || has_ended(entry->record.job().state())) return;
   (void)end_cancelled(*entry, Unsaved::kApply);
@@ -289,7 +289,7 @@ bool JobTable::remove_if_requested(const std::string& job_id) {
 }
 
 void JobTable::requeue_interrupted(const std::string& job_id) {
-  std::lock_guard lock(mutex_);
+  absl::MutexLock lock(&mutex_);
   Entry* entry = find(job_id);
   if (entry == nullptr || entry->record.job().state() != v1::JOB_STATE_RUNNING) return;
   if (entry->remove_when_ended) {
@@ -306,7 +306,7 @@ void JobTable::requeue_interrupted(const std::string& job_id) {
 }
 
 void JobTable::give_back(const std::string& job_id) {
-  std::lock_guard lock(mutex_);
+  absl::MutexLock lock(&mutex_);
   Entry* entry = find(job_id);
   if (entry == nullptr || entry->record.job().state() != v1::JOB_STATE_RUNNING) return;
   // A cancel (or delete) that came while it was taken ends it now.
@@ -332,12 +332,11 @@ void JobTable::give_back(const std::string& job_id) {
   event.mutable_queued()->set_position(0);  // next
   add_event(*entry, std::move(event));
   update_gauges();
-  queue_changed_.notify_one();
   spdlog::info("job {} given back to the queue: no room for its results", job_id);
 }
 
 bool JobTable::dispatching() const {
-  std::lock_guard lock(mutex_);
+  absl::MutexLock lock(&mutex_);
   return dispatching_ && !closed_;
 }
 
@@ -348,14 +347,14 @@ v1::Job JobTable::view(const std::string& job_id, const v1::Job& stored) const {
 }
 
 absl::StatusOr<v1::Job> JobTable::get(const std::string& job_id) const {
-  std::lock_guard lock(mutex_);
+  absl::MutexLock lock(&mutex_);
   const Entry* entry = find_visible(job_id);
   if (entry == nullptr) return absl::NotFoundError(absl::StrCat("no job ", job_id));
   return view(job_id, entry->record.job());
 }
 
 absl::StatusOr<std::string> JobTable::owner(const std::string& job_id) const {
-  std::lock_guard lock(mutex_);
+  absl::MutexLock lock(&mutex_);
   const Entry* entry = find_visible(job_id);
   if (entry == nullptr) return absl::NotFoundError(absl::StrCat("no job ", job_id));
   return entry->record.job().owner();
@@ -364,7 +363,7 @@ absl::StatusOr<std::string> JobTable::owner(const std::string& job_id) const {
 absl::StatusOr<JobTable::JobPage> JobTable::list(const JobQuery& query) const {
   std::vector<v1::Job> jobs;
   {
-    std::lock_guard lock(mutex_);
+    absl::MutexLock lock(&mutex_);
     for (const auto& [id, entry] : jobs_) {
       if (entry.remove_when_ended) continue;
       if (!query.owner.empty() && entry.record.job().owner() != query.owner) continue;
@@ -390,7 +389,7 @@ std::string JobTable::artifact_path(const v1::Job& job, const std::string& name)
 
 std::optional<JobTable::PriorRequest> JobTable::find_request(const std::string& owner,
                                                              const std::string& request_id) const {
-  std::lock_guard lock(mutex_);
+  absl::MutexLock lock(&mutex_);
   for (const auto& [id, entry] : jobs_) {
     const v1::JobRecord& record = entry.record;
     if (entry.remove_when_ended || record.spec().request_id() != request_id ||
@@ -403,7 +402,7 @@ std::optional<JobTable::PriorRequest> JobTable::find_request(const std::string& 
 }
 
 absl::StatusOr<v1::JobState> JobTable::remove(const std::string& job_id) {
-  std::lock_guard lock(mutex_);
+  absl::MutexLock lock(&mutex_);
   Entry* entry = find_visible(job_id);
   if (entry == nullptr) return absl::NotFoundError(absl::StrCat("no job ", job_id));
   const v1::JobState state = entry->record.job().state();
@@ -429,7 +428,7 @@ absl::StatusOr<v1::JobState> JobTable::remove(const std::string& job_id) {
 }
 
 absl::StatusOr<v1::Job> JobTable::cancel(const std::string& job_id) {
-  std::lock_guard lock(mutex_);
+  absl::MutexLock lock(&mutex_);
   Entry* entry = find_visible(job_id);
   if (entry == nullptr) return absl::NotFoundError(absl::StrCat("no job ", job_id));
   const v1::JobState state = entry->record.job().state();
@@ -450,13 +449,13 @@ absl::StatusOr<v1::Job> JobTable::cancel(const std::string& job_id) {
 }
 
 bool JobTable::cancel_requested(const std::string& job_id) const {
-  std::lock_guard lock(mutex_);
+  absl::MutexLock lock(&mutex_);
   const Entry* entry = find(job_id);
   return entry != nullptr && entry->cancel_requested;
 }
 
 absl::StatusOr<std::vector<v1::Artifact>> JobTable::artifacts(const std::string& job_id) const {
-  std::lock_guard lock(mutex_);
+  absl::MutexLock lock(&mutex_);
   const Entry* entry = find_visible(job_id);
   if (entry == nullptr) return absl::NotFoundError(absl::StrCat("no job ", job_id));
   if (entry->record.job().state() != v1::JOB_STATE_SUCCEEDED) {
@@ -468,7 +467,7 @@ absl::StatusOr<std::vector<v1::Artifact>> JobTable::artifacts(const std::string&
 }
 
 std::vector<std::string> JobTable::expire(absl::Duration result_ttl, size_t max_ended) {
-  std::lock_guard lock(mutex_);
+  absl::MutexLock lock(&mutex_);
   const double cutoff = unix_now() - absl::ToDoubleSeconds(result_ttl);
   // Ended jobs, oldest end first: past the TTL, or past the cap in number.
   std::vector<std::pair<double, std::string>> ended;
@@ -501,7 +500,7 @@ void JobTable::erase_entry(const std::string& job_id) {
 }
 
 absl::Status JobTable::listen(const std::string& job_id, uint64_t from, EventListener* listener) {
-  std::lock_guard lock(mutex_);
+  absl::MutexLock lock(&mutex_);
   Entry* entry = find_visible(job_id);
   if (entry == nullptr) return absl::NotFoundError(absl::StrCat("no job ", job_id));
   const bool ended = has_ended(entry->record.job().state());
@@ -521,23 +520,22 @@ absl::Status JobTable::listen(const std::string& job_id, uint64_t from, EventLis
 }
 
 void JobTable::unlisten(const std::string& job_id, EventListener* listener) {
-  std::lock_guard lock(mutex_);
+  absl::MutexLock lock(&mutex_);
   if (Entry* entry = find(job_id)) std::erase(entry->listeners, listener);
 }
 
 void JobTable::close() {
-  std::lock_guard lock(mutex_);
+  absl::MutexLock lock(&mutex_);
   closed_ = true;
   const absl::Status closing = absl::UnavailableError("the server is shutting down");
   for (auto& [id, entry] : jobs_) {
     for (EventListener* listener : entry.listeners) listener->on_closed(closing);
     entry.listeners.clear();
   }
-  queue_changed_.notify_all();
 }
 
 void JobTable::stop_dispatch() {
-  std::lock_guard lock(mutex_);
+  absl::MutexLock lock(&mutex_);
   dispatching_ = false;
 }
 

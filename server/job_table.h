@@ -4,16 +4,16 @@
 // it is visible to anyone.
 #pragma once
 
-#include <condition_variable>
 #include <cstdint>
 #include <deque>
 #include <map>
-#include <mutex>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "absl/base/thread_annotations.h"
 #include "absl/status/statusor.h"
+#include "absl/synchronization/mutex.h"
 #include "absl/time/time.h"
 #include "labelmesh/v1/service.pb.h"
 #include "server/job_store.h"
@@ -90,13 +90,13 @@ class JobTable final : public JobStore {
     std::vector<EventListener*> listeners;
   };
 
-  Entry* find(const std::string& job_id);
-  const Entry* find(const std::string& job_id) const;
+  Entry* find(const std::string& job_id) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_);
+  const Entry* find(const std::string& job_id) const ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_);
   // As clients see the table: a job deleted while it runs is gone already.
-  Entry* find_visible(const std::string& job_id);
-  const Entry* find_visible(const std::string& job_id) const;
+  Entry* find_visible(const std::string& job_id) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_);
+  const Entry* find_visible(const std::string& job_id) const ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_);
   // Appends an event (sequence and time set here) and wakes watchers.
-  void add_event(Entry& entry, v1::JobEvent event);
+  void add_event(Entry& entry, v1::JobEvent event) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_);
   // Saves to the spool; a failure is logged and counted, and returned.
   absl::Status persist(const v1::JobRecord& record);
   // What an end does when its record cannot be saved: a client's request is
@@ -106,29 +106,33 @@ class JobTable final : public JobStore {
   // the job's error with the same save.
   enum class Unsaved { kRefuse, kApply };
   absl::Status end_job(Entry& entry, v1::JobState state, v1::JobEvent event, Unsaved unsaved,
-                       const v1::JobError* error = nullptr);
-  absl::Status end_cancelled(Entry& entry, Unsaved unsaved);
+                       const v1::JobError* error = nullptr) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_);
+  absl::Status end_cancelled(Entry& entry, Unsaved unsaved) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_);
   // Deletes the job if a client asked while it ran. Returns true if it did.
-  bool remove_if_requested(const std::string& job_id);
+  bool remove_if_requested(const std::string& job_id) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_);
   // The job as clients see it: queue position and timestamps filled in.
-  v1::Job view(const std::string& job_id, const v1::Job& job) const;
-  uint32_t position_of(const std::string& job_id) const;
+  v1::Job view(const std::string& job_id, const v1::Job& job) const
+      ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_);
+  uint32_t position_of(const std::string& job_id) const ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_);
   // Removes the job from the table (not the spool), closing its listeners.
-  void erase_entry(const std::string& job_id);
-  void update_gauges();
+  void erase_entry(const std::string& job_id) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_);
+  void update_gauges() ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_);
+  // take_next's wait: a job to hand out, or the table closed.
+  bool ready_to_dispatch() const ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_);
 
   const Spool& spool_;
   const size_t queue_capacity_;
   Metrics& metrics_;
 
-  mutable std::mutex mutex_;
-  std::condition_variable queue_changed_;
-  std::map<std::string, Entry> jobs_;
-  std::deque<std::string> queue_;
-  size_t running_ = 0;
-  uint64_t next_sequence_ = 1;
-  bool closed_ = false;
-  bool dispatching_ = true;
+  // Waits (take_next) are on conditions the mutex re-checks as it is
+  // released: no condition variable to signal.
+  mutable absl::Mutex mutex_;
+  std::map<std::string, Entry> jobs_ ABSL_GUARDED_BY(mutex_);
+  std::deque<std::string> queue_ ABSL_GUARDED_BY(mutex_);
+  size_t running_ ABSL_GUARDED_BY(mutex_) = 0;
+  uint64_t next_sequence_ ABSL_GUARDED_BY(mutex_) = 1;
+  bool closed_ ABSL_GUARDED_BY(mutex_) = false;
+  bool dispatching_ ABSL_GUARDED_BY(mutex_) = true;
 };
 
 }  // namespace labelmesh::server

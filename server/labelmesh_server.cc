@@ -206,10 +206,12 @@ void LabelmeshServer::housekeeping_loop() {
   // The cluster's expiry reads every job's record from NATS: every 15th
   // round (30 s) is enough, where the job table's is a look in memory.
   const int expiry_rounds = cluster_store_ ? 15 : 1;
-  std::unique_lock lock(mutex_);
-  for (int round = 0; !stopping_.wait_for(lock, period, [this] { return stopped_; }); ++round) {
-    // Unlocked: a cluster's calls may wait on NATS, and shutdown must not.
-    lock.unlock();
+  // Locked and unlocked by hand: a cluster's calls may wait on NATS, and
+  // shutdown must not.
+  mutex_.Lock();
+  for (int round = 0;
+       !mutex_.AwaitWithTimeout(absl::Condition(&stopped_), absl::FromChrono(period)); ++round) {
+    mutex_.Unlock();
     if (store_ != nullptr && round % expiry_rounds == 0) {
       for (const auto& id : store_->expire(config_.result_ttl, size_t(config_.max_ended_jobs))) {
         audit_->record({.event = "expired", .job_id = id, .identity = "labelmeshd"});
@@ -223,17 +225,17 @@ void LabelmeshServer::housekeeping_loop() {
       (void)cluster_store_->remove_abandoned_uploads(config_.abandoned_upload_age);
     }
     update_health();
-    lock.lock();
+    mutex_.Lock();
   }
+  mutex_.Unlock();
 }
 
 void LabelmeshServer::shutdown() {
   {
-    std::lock_guard lock(mutex_);
+    absl::MutexLock lock(&mutex_);
     if (stopped_) return;
     stopped_ = true;
   }
-  stopping_.notify_all();
   spdlog::info("shutting down: no new uploads or jobs; running jobs have {} s to finish",
                absl::ToDoubleSeconds(config_.shutdown_grace));
   if (!server_) return;  // start() failed half way: nothing runs yet.

@@ -5,12 +5,12 @@
 // health, reflection), metrics and the expiry of old results.
 #pragma once
 
-#include <condition_variable>
 #include <memory>
-#include <mutex>
 #include <thread>
 
+#include "absl/base/thread_annotations.h"
 #include "absl/status/statusor.h"
+#include "absl/synchronization/mutex.h"
 #include "server/server_config.h"
 
 namespace grpc {
@@ -86,9 +86,8 @@ class LabelmeshServer {
 
   std::thread housekeeper_;
   bool under_reserve_ = false;
-  std::mutex mutex_;
-  std::condition_variable stopping_;
-  bool stopped_ = false;
+  absl::Mutex mutex_;
+  bool stopped_ ABSL_GUARDED_BY(mutex_) = false;
 };
 
 }  // namespace labelmesh::server

@@ -15,7 +15,7 @@ std::string peer_host(const std::string& peer) {
 }
 
 StreamCounts::Slot::~Slot() {
-  std::lock_guard lock(counts_.mutex_);
+  absl::MutexLock lock(&counts_.mutex_);
   if (--counts_.by_client_[client_] == 0) counts_.by_client_.erase(client_);
   if (--counts_.by_host_[host_] == 0) counts_.by_host_.erase(host_);
   --counts_.open_;
@@ -27,7 +27,7 @@ absl::StatusOr<std::unique_ptr<StreamCounts::Slot>> StreamCounts::open(const std
     auto it = counts.find(key);
     return it == counts.end() ? 0 : it->second;
   };
-  std::lock_guard lock(mutex_);
+  absl::MutexLock lock(&mutex_);
   const auto full = [&](const std::string& message) {
     return refused(when_full_, absl::ResourceExhaustedError(message));
   };
@@ -53,32 +53,35 @@ StreamWatchdog::StreamWatchdog() : thread_([this] { loop(); }) {}
 
 StreamWatchdog::~StreamWatchdog() {
   {
-    std::lock_guard lock(mutex_);
+    absl::MutexLock lock(&mutex_);
     stopping_ = true;
   }
-  wake_.notify_all();
   thread_.join();
 }
 
+bool StreamWatchdog::may_erase(uint64_t id) const {
+  auto it = entries_.find(id);
+  return it == entries_.end() || !it->second.cancelling ||
+         std::this_thread::get_id() == thread_.get_id();
+}
+
+bool StreamWatchdog::Ticket::may_end() const { return watchdog_.may_erase(id_); }
+
 StreamWatchdog::Ticket::~Ticket() {
-  std::unique_lock lock(watchdog_.mutex_);
+  absl::MutexLock lock(&watchdog_.mutex_);
   // The stream's context must outlive a TryCancel in flight on it.
-  watchdog_.cancelled_.wait(lock, [this] {
-    auto it = watchdog_.entries_.find(id_);
-    return it == watchdog_.entries_.end() || !it->second.cancelling ||
-           std::this_thread::get_id() == watchdog_.thread_.get_id();
-  });
+  watchdog_.mutex_.Await(absl::Condition(this, &Ticket::may_end));
   watchdog_.entries_.erase(id_);
 }
 
 void StreamWatchdog::Ticket::touch() {
-  std::lock_guard lock(watchdog_.mutex_);
+  absl::MutexLock lock(&watchdog_.mutex_);
   auto it = watchdog_.entries_.find(id_);
   if (it != watchdog_.entries_.end()) it->second.last_touch = absl::Now();
 }
 
 void StreamWatchdog::Ticket::touch(uint64_t transferred) {
-  std::lock_guard lock(watchdog_.mutex_);
+  absl::MutexLock lock(&watchdog_.mutex_);
   auto it = watchdog_.entries_.find(id_);
   if (it == watchdog_.entries_.end()) return;
   Entry& entry = it->second;
@@ -92,13 +95,13 @@ void StreamWatchdog::Ticket::touch(uint64_t transferred) {
 }
 
 void StreamWatchdog::Ticket::end_transfer() {
-  std::lock_guard lock(watchdog_.mutex_);
+  absl::MutexLock lock(&watchdog_.mutex_);
   auto it = watchdog_.entries_.find(id_);
   if (it != watchdog_.entries_.end()) it->second.transfer.rate.bytes_per_second = 0;
 }
 
 absl::Status StreamWatchdog::Ticket::cancellation() const {
-  std::lock_guard lock(watchdog_.mutex_);
+  absl::MutexLock lock(&watchdog_.mutex_);
   auto it = watchdog_.entries_.find(id_);
   return it == watchdog_.entries_.end() ? absl::OkStatus() : it->second.cancellation;
 }
@@ -108,7 +111,7 @@ std::unique_ptr<StreamWatchdog::Ticket> StreamWatchdog::watch(grpc::ServerContex
                                                               absl::Duration total,
                                                               std::string what, TransferRate rate) {
   const absl::Time now = absl::Now();
-  std::lock_guard lock(mutex_);
+  absl::MutexLock lock(&mutex_);
   const uint64_t id = next_id_++;
   Entry entry{context, idle, total, now + total, now, std::move(what), {}, nullptr, false, {}};
   entry.transfer.rate = rate;
@@ -120,7 +123,7 @@ std::unique_ptr<StreamWatchdog::Ticket> StreamWatchdog::watch_writes(
     grpc::ServerContextBase* context, absl::Duration idle, std::function<int64_t()> write_started,
     std::string what) {
   const absl::Time now = absl::Now();
-  std::lock_guard lock(mutex_);
+  absl::MutexLock lock(&mutex_);
   const uint64_t id = next_id_++;
   entries_[id] = Entry{context,
                        idle,
@@ -136,8 +139,9 @@ std::unique_ptr<StreamWatchdog::Ticket> StreamWatchdog::watch_writes(
 }
 
 void StreamWatchdog::loop() {
-  std::unique_lock lock(mutex_);
-  while (!wake_.wait_for(lock, std::chrono::milliseconds(100), [this] { return stopping_; })) {
+  // Locked and unlocked by hand: each cancel runs with the lock released.
+  mutex_.Lock();
+  while (!mutex_.AwaitWithTimeout(absl::Condition(&stopping_), absl::Milliseconds(100))) {
     const absl::Time now = absl::Now();
     std::vector<uint64_t> to_cancel;
     for (auto& [id, entry] : entries_) {
@@ -186,13 +190,13 @@ void StreamWatchdog::loop() {
     // on other threads meanwhile, and those may end the stream.
     for (uint64_t id : to_cancel) {
       grpc::ServerContextBase* context = entries_.at(id).context;
-      lock.unlock();
+      mutex_.Unlock();
       context->TryCancel();
-      lock.lock();
+      mutex_.Lock();
       if (auto it = entries_.find(id); it != entries_.end()) it->second.cancelling = false;
     }
-    if (!to_cancel.empty()) cancelled_.notify_all();
   }
+  mutex_.Unlock();
 }
 
 }  // namespace labelmesh::server

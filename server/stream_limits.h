@@ -9,16 +9,16 @@
 #include <grpcpp/grpcpp.h>
 
 #include <atomic>
-#include <condition_variable>
 #include <cstdint>
 #include <functional>
 #include <map>
 #include <memory>
-#include <mutex>
 #include <string>
 #include <thread>
 
+#include "absl/base/thread_annotations.h"
 #include "absl/status/statusor.h"
+#include "absl/synchronization/mutex.h"
 #include "absl/time/time.h"
 #include "server/refusal.h"
 
@@ -68,11 +68,11 @@ class StreamCounts {
   const Limits limits_;
   const std::string what_;
   const Refusal when_full_;
-  std::mutex mutex_;
+  absl::Mutex mutex_;
   // Only keys with a place held: a key is erased when its count drops to 0.
-  std::map<std::string, int> by_client_;
-  std::map<std::string, int> by_host_;
-  int open_ = 0;
+  std::map<std::string, int> by_client_ ABSL_GUARDED_BY(mutex_);
+  std::map<std::string, int> by_host_ ABSL_GUARDED_BY(mutex_);
+  int open_ ABSL_GUARDED_BY(mutex_) = 0;
 };
 
 // The least a transfer must move, in every window of its own once its
@@ -110,6 +110,7 @@ class StreamWatchdog {
    private:
     friend class StreamWatchdog;
     Ticket(StreamWatchdog& watchdog, uint64_t id) : watchdog_(watchdog), id_(id) {}
+    bool may_end() const ABSL_EXCLUSIVE_LOCKS_REQUIRED(watchdog_.mutex_);
     StreamWatchdog& watchdog_;
     uint64_t id_;
   };
@@ -149,13 +150,15 @@ class StreamWatchdog {
     } transfer;
   };
   void loop();
+  // A ticket's end may go on: its entry is gone, not being cancelled, or the
+  // end runs on the watchdog's own thread.
+  bool may_erase(uint64_t id) const ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_);
 
-  std::mutex mutex_;
-  std::condition_variable wake_;
-  std::condition_variable cancelled_;
-  std::map<uint64_t, Entry> entries_;
-  uint64_t next_id_ = 1;
-  bool stopping_ = false;
+  // Waits are on conditions the mutex re-checks as it is released.
+  mutable absl::Mutex mutex_;
+  std::map<uint64_t, Entry> entries_ ABSL_GUARDED_BY(mutex_);
+  uint64_t next_id_ ABSL_GUARDED_BY(mutex_) = 1;
+  bool stopping_ ABSL_GUARDED_BY(mutex_) = false;
   std::thread thread_;
 };
 

@@ -58,13 +58,13 @@ class UploadFile {
 
 RequestsInFlight::Claim::Claim(RequestsInFlight& requests, std::pair<std::string, std::string> key)
     : requests_(requests), key_(std::move(key)) {
-  std::lock_guard lock(requests_.mutex_);
+  absl::MutexLock lock(&requests_.mutex_);
   claimed_ = key_.second.empty() || requests_.claims_.insert(key_).second;
 }
 
 RequestsInFlight::Claim::~Claim() {
   if (!claimed_ || key_.second.empty()) return;
-  std::lock_guard lock(requests_.mutex_);
+  absl::MutexLock lock(&requests_.mutex_);
   requests_.claims_.erase(key_);
 }
 

@@ -13,7 +13,9 @@
 #include <string>
 #include <utility>
 
+#include "absl/base/thread_annotations.h"
 #include "absl/status/status.h"
+#include "absl/synchronization/mutex.h"
 #include "labelmesh/v1/service.grpc.pb.h"
 #include "server/client_identity.h"
 #include "server/job_store.h"
@@ -44,8 +46,8 @@ class RequestsInFlight {
   };
 
  private:
-  std::mutex mutex_;
-  std::set<std::pair<std::string, std::string>> claims_;
+  absl::Mutex mutex_;
+  std::set<std::pair<std::string, std::string>> claims_ ABSL_GUARDED_BY(mutex_);
 };
 
 // What a Submit uses of the server, which outlives it.

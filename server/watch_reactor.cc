@@ -14,7 +14,7 @@ WatchReactor* WatchReactor::start(JobStore& store, StreamWatchdog& watchdog,
       context, idle_timeout, [reactor] { return reactor->write_started_.load(); }, "watch");
   // Replays what happened so far, then follows; events may arrive at once.
   const absl::Status listening = store.listen(reactor->job_id_, 0, reactor);
-  std::lock_guard lock(reactor->mutex_);
+  absl::MutexLock lock(&reactor->mutex_);
   reactor->listening_ = listening.ok();
   if (!listening.ok()) reactor->finish(to_grpc(listening));
   // An end that came while listen() ran (events may come on another
@@ -29,7 +29,7 @@ WatchReactor::WatchReactor(JobStore& store, std::string job_id,
     : store_(store), job_id_(std::move(job_id)), slot_(std::move(slot)) {}
 
 void WatchReactor::on_event(const v1::JobEvent& event, bool last) {
-  std::lock_guard lock(mutex_);
+  absl::MutexLock lock(&mutex_);
   if (finished_ || end_queued_) return;  // nothing follows a job's end
   pending_.push_back(event);
   if (last) {
@@ -40,7 +40,7 @@ void WatchReactor::on_event(const v1::JobEvent& event, bool last) {
 }
 
 void WatchReactor::on_closed(const absl::Status& status) {
-  std::lock_guard lock(mutex_);
+  absl::MutexLock lock(&mutex_);
   if (finished_ || end_queued_) return;
   end_queued_ = true;
   end_status_ = to_grpc(status);
@@ -62,7 +62,7 @@ void WatchReactor::write_next() {
 }
 
 void WatchReactor::OnWriteDone(bool ok) {
-  std::lock_guard lock(mutex_);
+  absl::MutexLock lock(&mutex_);
   write_outstanding_ = false;
   write_started_ = 0;
   if (!ok) cancelled_ = true;
@@ -70,7 +70,7 @@ void WatchReactor::OnWriteDone(bool ok) {
 }
 
 void WatchReactor::OnCancel() {
-  std::lock_guard lock(mutex_);
+  absl::MutexLock lock(&mutex_);
   cancelled_ = true;
   // An outstanding write completes (not ok) and finishes the stream then.
   write_next();
@@ -95,7 +95,7 @@ void WatchReactor::finish(const grpc::Status& status) {
 void WatchReactor::OnDone() {
   bool listening = false;
   {
-    std::lock_guard lock(mutex_);
+    absl::MutexLock lock(&mutex_);
     listening = listening_;
   }
   // After unlisten returns, the store never calls this reactor again.

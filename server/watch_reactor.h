@@ -10,9 +10,10 @@
 #include <atomic>
 #include <deque>
 #include <memory>
-#include <mutex>
 #include <string>
 
+#include "absl/base/thread_annotations.h"
+#include "absl/synchronization/mutex.h"
 #include "labelmesh/v1/service.pb.h"
 #include "server/job_store.h"
 #include "server/stream_limits.h"
@@ -37,11 +38,11 @@ class WatchReactor final : public grpc::ServerWriteReactor<v1::JobEvent>,
   void OnCancel() override;
   void OnDone() override;
 
-  // With mutex_ held: starts the next write, or finishes the stream when
-  // nothing is left to write and the end has come.
-  void write_next();
-  void finish(const grpc::Status& status);
-  grpc::Status left_or_stalled() const;
+  // Starts the next write, or finishes the stream when nothing is left to
+  // write and the end has come.
+  void write_next() ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_);
+  void finish(const grpc::Status& status) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_);
+  grpc::Status left_or_stalled() const ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_);
 
   JobStore& store_;
   const std::string job_id_;
@@ -52,19 +53,19 @@ class WatchReactor final : public grpc::ServerWriteReactor<v1::JobEvent>,
   // Declared after what it reads, so that it goes first.
   std::unique_ptr<StreamWatchdog::Ticket> ticket_;
 
-  std::mutex mutex_;
-  bool listening_ = false;
+  absl::Mutex mutex_;
+  bool listening_ ABSL_GUARDED_BY(mutex_) = false;
   // Until start() has recorded whether it listens: a finish waits for it.
-  bool starting_ = true;
-  bool finish_deferred_ = false;
-  grpc::Status deferred_status_;
-  std::deque<v1::JobEvent> pending_;
-  v1::JobEvent writing_;
-  bool write_outstanding_ = false;
-  bool end_queued_ = false;
-  grpc::Status end_status_;
-  bool cancelled_ = false;
-  bool finished_ = false;
+  bool starting_ ABSL_GUARDED_BY(mutex_) = true;
+  bool finish_deferred_ ABSL_GUARDED_BY(mutex_) = false;
+  grpc::Status deferred_status_ ABSL_GUARDED_BY(mutex_);
+  std::deque<v1::JobEvent> pending_ ABSL_GUARDED_BY(mutex_);
+  v1::JobEvent writing_ ABSL_GUARDED_BY(mutex_);
+  bool write_outstanding_ ABSL_GUARDED_BY(mutex_) = false;
+  bool end_queued_ ABSL_GUARDED_BY(mutex_) = false;
+  grpc::Status end_status_ ABSL_GUARDED_BY(mutex_);
+  bool cancelled_ ABSL_GUARDED_BY(mutex_) = false;
+  bool finished_ ABSL_GUARDED_BY(mutex_) = false;
 };
 
 }  // namespace labelmesh::server

@@ -29,13 +29,12 @@ void WorkerPool::run_thread() {
     auto record = table_.take_next();
     if (!record) break;
     {
-      std::lock_guard lock(mutex_);
+      absl::MutexLock lock(&mutex_);
       ++busy_;
     }
     run_job(*record);
-    std::lock_guard lock(mutex_);
+    absl::MutexLock lock(&mutex_);
     --busy_;
-    idle_.notify_all();
   }
 }
 
@@ -98,11 +97,11 @@ void WorkerPool::run_job(const v1::JobRecord& record) {
 }
 
 void WorkerPool::drain(absl::Duration grace) {
-  std::unique_lock lock(mutex_);
-  if (!idle_.wait_for(lock, absl::ToChronoMilliseconds(grace), [this] { return busy_ == 0; })) {
+  absl::MutexLock lock(&mutex_);
+  if (!mutex_.AwaitWithTimeout(absl::Condition(this, &WorkerPool::idle), grace)) {
     spdlog::warn("shutdown: {} jobs still running after the grace period; stopping them", busy_);
     interrupt_ = true;
-    idle_.wait(lock, [this] { return busy_ == 0; });
+    mutex_.Await(absl::Condition(this, &WorkerPool::idle));
   }
 }
 

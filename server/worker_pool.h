@@ -3,13 +3,13 @@
 #pragma once
 
 #include <atomic>
-#include <condition_variable>
 #include <cstdint>
-#include <mutex>
 #include <thread>
 #include <vector>
 
+#include "absl/base/thread_annotations.h"
 #include "absl/status/statusor.h"
+#include "absl/synchronization/mutex.h"
 #include "absl/time/time.h"
 #include "server/job_table.h"
 #include "server/server_config.h"
@@ -39,9 +39,11 @@ class WorkerPool {
   std::string executable_;
   std::vector<std::thread> threads_;
 
-  std::mutex mutex_;
-  std::condition_variable idle_;
-  int busy_ = 0;
+  // No job running: what drain waits for.
+  bool idle() const ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_) { return busy_ == 0; }
+
+  mutable absl::Mutex mutex_;
+  int busy_ ABSL_GUARDED_BY(mutex_) = 0;
   std::atomic<bool> interrupt_{false};
 };
 

@@ -5,9 +5,10 @@
 #include <cmath>
 #include <functional>
 #include <memory>
-#include <mutex>
 #include <optional>
 
+#include "absl/base/thread_annotations.h"
+#include "absl/synchronization/mutex.h"
 #include "core/conforming/label_interfaces.h"
 #include "core/conforming/net_label_surface.h"
 #include "core/conforming/thick_slices.h"
@@ -133,7 +134,7 @@ class LighterNets {
                                         const std::vector<int32_t>& here, NetOptions options,
                                         const RunContext& context,
                                         std::vector<StageTiming>& stages) {
-    std::lock_guard<std::mutex> lock(mutex_);
+    absl::MutexLock lock(&mutex_);
     if (built_[layer] != nullptr) return built_[layer].get();
     options.smoothing_rounds /= 2;
     absl::StatusOr<LayerNet> made;
@@ -154,8 +155,9 @@ class LighterNets {
   }
 
  private:
-  std::mutex mutex_;
-  std::vector<std::unique_ptr<LighterNet>> built_;
+  // Held while a net is built: the labels that want it wait for it.
+  absl::Mutex mutex_;
+  std::vector<std::unique_ptr<LighterNet>> built_ ABSL_GUARDED_BY(mutex_);
 };
 
 namespace {

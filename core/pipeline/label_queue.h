@@ -6,11 +6,12 @@
 // the others busy meanwhile.
 #pragma once
 
-#include <condition_variable>
 #include <cstddef>
-#include <mutex>
 #include <optional>
 #include <vector>
+
+#include "absl/base/thread_annotations.h"
+#include "absl/synchronization/mutex.h"
 
 namespace labelmesh {
 
@@ -29,12 +30,16 @@ class LabelQueue {
   void end();
 
  private:
-  std::vector<bool> large_;
+  // take() has an answer: a label a thread may run, or none left to wait for.
+  bool answer_ready() const ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_);
+
+  const std::vector<bool> large_;
   std::vector<size_t> large_order_, small_order_;
-  size_t next_large_ = 0, next_small_ = 0;
-  bool large_running_ = false, ended_ = false;
-  std::mutex mutex_;
-  std::condition_variable changed_;
+  mutable absl::Mutex mutex_;
+  size_t next_large_ ABSL_GUARDED_BY(mutex_) = 0;
+  size_t next_small_ ABSL_GUARDED_BY(mutex_) = 0;
+  bool large_running_ ABSL_GUARDED_BY(mutex_) = false;
+  bool ended_ ABSL_GUARDED_BY(mutex_) = false;
 };
 
 }  // namespace labelmesh

@@ -9,9 +9,9 @@
 #include <atomic>
 #include <filesystem>
 #include <limits>
-#include <mutex>
 #include <thread>
 
+#include "absl/synchronization/mutex.h"
 #include "core/dicom/dicom_source.h"
 #include "core/digest/sha256.h"
 #include "core/pipeline/label_conforming_mesh.h"
@@ -194,11 +194,11 @@ absl::Status add_every_label_surface(const std::vector<volume::LabelVolume>& lay
   std::vector<LabelInProgress> in_progress(count);
   std::atomic<uint32_t> labels_done{0};
   // Progress callbacks expect one caller at a time.
-  std::mutex progress_mutex;
+  absl::Mutex progress_mutex;
   RunContext shared = context;
   if (context.progress) {
     shared.progress = [&](const ProgressUpdate& update) {
-      std::lock_guard<std::mutex> lock(progress_mutex);
+      absl::MutexLock lock(&progress_mutex);
       if (update.label == nullptr) return context.progress(update);
       LabelInProgress now = *update.label;
       now.done = labels_done.load();

@@ -214,7 +214,7 @@ absl::Status ClusterJobStore::replay_ended(const v1::JobRecord& record, uint64_t
 absl::Status ClusterJobStore::listen(const std::string& job_id, uint64_t from,
                                      EventListener* listener) {
   {
-    std::lock_guard lock(mutex_);
+    absl::MutexLock lock(&mutex_);
     if (closed_) return absl::UnavailableError("the server is shutting down");
   }
   auto found = record(job_id);
@@ -229,22 +229,26 @@ absl::Status ClusterJobStore::listen(const std::string& job_id, uint64_t from,
         if (last) *heard_last = true;
       });
   if (!subscription.ok()) return subscription.status();
-  std::unique_lock lock(mutex_);
-  if (closed_) {
-    lock.unlock();
-    subscription->reset();
-    return absl::UnavailableError("the server is shutting down");
+  {
+    absl::MutexLock lock(&mutex_);
+    if (!closed_) {
+      follows_[listener] = Follow{job_id, std::move(*subscription), heard_last};
+      return absl::OkStatus();
+    }
   }
-  follows_[listener] = Follow{job_id, std::move(*subscription), heard_last};
-  return absl::OkStatus();
+  subscription->reset();
+  return absl::UnavailableError("the server is shutting down");
 }
 
 void ClusterJobStore::unlisten(const std::string&, EventListener* listener) {
   Follow follow;
   {
-    std::unique_lock lock(mutex_);
+    absl::MutexLock lock(&mutex_);
     // A listener being told its end is not gone until it has been told.
-    ended_.wait(lock, [&] { return !ending_.contains(listener); });
+    const auto told = [&]() ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_) {
+      return !ending_.contains(listener);
+    };
+    mutex_.Await(absl::Condition(&told));
     auto it = follows_.find(listener);
     if (it == follows_.end()) return;
     follow = std::move(it->second);
@@ -265,9 +269,8 @@ void ClusterJobStore::end_follows(std::vector<Ending> endings) {
         ending.listener->on_closed(ending.status);
       }
     }
-    std::lock_guard lock(mutex_);
+    absl::MutexLock lock(&mutex_);
     ending_.erase(ending.listener);
-    ended_.notify_all();
   }
 }
 
@@ -275,7 +278,7 @@ void ClusterJobStore::check_follows() {
   // Job ids read under the lock, records without it (NATS calls).
   std::vector<std::pair<EventListener*, std::string>> watched;
   {
-    std::lock_guard lock(mutex_);
+    absl::MutexLock lock(&mutex_);
     for (const auto& [listener, follow] : follows_) {
       if (!*follow.heard_last) watched.emplace_back(listener, follow.job_id);
     }
@@ -286,7 +289,7 @@ void ClusterJobStore::check_follows() {
   const double now = unix_now();
   std::vector<Ending> endings;
   {
-    std::lock_guard lock(mutex_);
+    absl::MutexLock lock(&mutex_);
     for (auto& [listener, checked] : records) {
       auto& [job_id, found] = checked;
       auto it = follows_.find(listener);
@@ -362,7 +365,7 @@ size_t ClusterJobStore::remove_abandoned_uploads(absl::Duration age) const {
 void ClusterJobStore::close() {
   std::vector<Ending> endings;
   {
-    std::lock_guard lock(mutex_);
+    absl::MutexLock lock(&mutex_);
     closed_ = true;
     const absl::Status closing = absl::UnavailableError("the server is shutting down");
     for (auto& [listener, follow] : follows_) {

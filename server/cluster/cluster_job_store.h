@@ -6,14 +6,14 @@
 #pragma once
 
 #include <atomic>
-#include <condition_variable>
 #include <map>
 #include <memory>
-#include <mutex>
 #include <optional>
 #include <set>
 #include <string>
 
+#include "absl/base/thread_annotations.h"
+#include "absl/synchronization/mutex.h"
 #include "server/cluster/cluster_connection.h"
 #include "server/cluster/shared_artifacts.h"
 #include "server/job_store.h"
@@ -114,12 +114,11 @@ class ClusterJobStore final : public JobStore {
   const uint64_t queue_capacity_;
   const absl::Duration abandoned_after_;
 
-  std::mutex mutex_;
-  bool closed_ = false;
-  std::map<EventListener*, Follow> follows_;
+  absl::Mutex mutex_;
+  bool closed_ ABSL_GUARDED_BY(mutex_) = false;
+  std::map<EventListener*, Follow> follows_ ABSL_GUARDED_BY(mutex_);
   // Listeners being told their follow ended; unlisten waits for them.
-  std::set<EventListener*> ending_;
-  std::condition_variable ended_;
+  std::set<EventListener*> ending_ ABSL_GUARDED_BY(mutex_);
 };
 
 // The event a logged one is to a watcher: its sequence is its place in the

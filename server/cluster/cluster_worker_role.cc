@@ -69,16 +69,15 @@ void ClusterWorkerRole::run_slot(cluster::ClusterConnection& connection) {
       [this, &connection](const v1::JobRecord& record, const cluster::Claim& claim,
                           const std::atomic<bool>& cancelled) {
         {
-          std::lock_guard lock(mutex_);
+          absl::MutexLock lock(&mutex_);
           metrics_.set_running(++busy_);
         }
         cluster::JobOutcome outcome = run_job(connection, record, claim, cancelled);
         // A job given back at shutdown has not ended.
         static const char* const kOutcome[] = {"", "", "", "succeeded", "failed", "cancelled"};
         if (outcome.state != v1::JOB_STATE_QUEUED) metrics_.job_ended(kOutcome[outcome.state]);
-        std::lock_guard lock(mutex_);
+        absl::MutexLock lock(&mutex_);
         metrics_.set_running(--busy_);
-        idle_.notify_all();
         return outcome;
       },
       loop_,
@@ -106,8 +105,9 @@ void ClusterWorkerRole::run_slot(cluster::ClusterConnection& connection) {
   if (failing) --failing_slots_;
 }
 
+// The record itself is not read: the worker process reads the job's files.
 cluster::JobOutcome ClusterWorkerRole::run_job(cluster::ClusterConnection& connection,
-                                               const v1::JobRecord& record,
+                                               const v1::JobRecord& /*record*/,
                                                const cluster::Claim& claim,
                                                const std::atomic<bool>& cancelled) {
   const std::string& id = claim.job_id;
@@ -212,8 +212,8 @@ void ClusterWorkerRole::job_ended(cluster::ClusterConnection& connection,
 void ClusterWorkerRole::drain(absl::Duration grace) {
   stopping_ = true;
   {
-    std::unique_lock lock(mutex_);
-    if (!idle_.wait_for(lock, absl::ToChronoMilliseconds(grace), [this] { return busy_ == 0; })) {
+    absl::MutexLock lock(&mutex_);
+    if (!mutex_.AwaitWithTimeout(absl::Condition(this, &ClusterWorkerRole::idle), grace)) {
       spdlog::warn("shutdown: {} jobs still running after the grace period; giving them back",
                    busy_);
     }

@@ -6,13 +6,13 @@
 #pragma once
 
 #include <atomic>
-#include <condition_variable>
 #include <memory>
-#include <mutex>
 #include <thread>
 #include <vector>
 
+#include "absl/base/thread_annotations.h"
 #include "absl/status/statusor.h"
+#include "absl/synchronization/mutex.h"
 #include "server/cluster/cluster_connection.h"
 #include "server/cluster/cluster_worker.h"
 #include "server/cluster/shared_artifacts.h"
@@ -59,9 +59,11 @@ class ClusterWorkerRole {
   std::atomic<bool> stopping_{false};
   std::atomic<bool> interrupt_{false};
   std::atomic<int> failing_slots_{0};
-  std::mutex mutex_;
-  std::condition_variable idle_;
-  int busy_ = 0;
+  // No job running: what drain waits for.
+  bool idle() const ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_) { return busy_ == 0; }
+
+  mutable absl::Mutex mutex_;
+  int busy_ ABSL_GUARDED_BY(mutex_) = 0;
 };
 
 }  // namespace labelmesh::server

@@ -1,11 +1,10 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 #include "server/cluster/event_log.h"
 
-#include "core/util/status_macros.h"
-
-#include <mutex>
-
+#include "absl/base/thread_annotations.h"
 #include "absl/strings/str_cat.h"
+#include "absl/synchronization/mutex.h"
+#include "core/util/status_macros.h"
 
 namespace labelmesh::cluster {
 
@@ -29,14 +28,14 @@ LoggedEvent logged_event(natsMsg* message) {
 // Shared by the subscription and the client's delivery thread; the client
 // frees it once the subscription is closed and its last callback returned.
 struct EventSubscription::Delivery {
-  std::mutex mutex;
-  bool active = true;
+  absl::Mutex mutex;
+  bool active ABSL_GUARDED_BY(mutex) = true;
   std::function<void(LoggedEvent)> on_event;
 
   static void on_message(natsConnection*, natsSubscription*, natsMsg* message, void* closure) {
     auto* delivery = static_cast<Delivery*>(closure);
     LoggedEvent event = logged_event(message);
-    std::lock_guard lock(delivery->mutex);
+    absl::MutexLock lock(&delivery->mutex);
     if (delivery->active) delivery->on_event(std::move(event));
   }
   static void on_complete(void* closure) { delete static_cast<Delivery*>(closure); }
@@ -44,7 +43,7 @@ struct EventSubscription::Delivery {
 
 EventSubscription::~EventSubscription() {
   {
-    std::lock_guard lock(delivery_->mutex);
+    absl::MutexLock lock(&delivery_->mutex);
     delivery_->active = false;
   }
   natsSubscription_Unsubscribe(subscription_);
@@ -147,7 +146,7 @@ absl::StatusOr<std::unique_ptr<EventSubscription>> EventLog::subscribe(
       // The client never frees the delivery now, and a callback may still
       // hold it: it is stopped and left, never freed.
       {
-        std::lock_guard lock(delivery->mutex);
+        absl::MutexLock lock(&delivery->mutex);
         delivery->active = false;
       }
       natsSubscription_Unsubscribe(subscription);
