@@ -15,7 +15,7 @@ packages=(
   # jobs shared between machines: the NATS client, and the server the tests start
   libnats-dev nats-server
   # command line, tests and the static checks CI runs
-  libcli11-dev libgtest-dev libgmock-dev clang-tidy
+  libcli11-dev libgtest-dev libgmock-dev clang-tidy clang
   # tests that prove our files with tools we did not write
   python3 python3-numpy python3-nibabel python3-meshio python3-grpcio python3-protobuf
   python3-pydicom python3-h5py  # h5py: meshio imports it to read any XDMF
