@@ -10,6 +10,7 @@
 #include "absl/status/status.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/strip.h"
+#include "core/util/status_macros.h"
 
 namespace labelmesh::client {
 namespace {
@@ -39,9 +40,8 @@ void add_connection_flags(CLI::App& command, ConnectionFlags& flags) {
 absl::StatusOr<ServerConnection> ServerConnection::open(const ConnectionFlags& flags) {
   ServerConnection connection;
   if (!flags.token_file.empty()) {
-    auto token = read_file(flags.token_file, "token-file");
-    if (!token.ok()) return token.status();
-    connection.token_ = std::string(absl::StripAsciiWhitespace(*token));
+    LABELMESH_ASSIGN_OR_RETURN(auto token, read_file(flags.token_file, "token-file"));
+    connection.token_ = std::string(absl::StripAsciiWhitespace(token));
   } else if (const char* token = std::getenv("LABELMESH_TOKEN")) {
     connection.token_ = std::string(absl::StripAsciiWhitespace(token));
   }
@@ -49,16 +49,14 @@ absl::StatusOr<ServerConnection> ServerConnection::open(const ConnectionFlags& f
   if (flags.tls || !flags.tls_ca.empty() || !flags.tls_cert.empty()) {
     grpc::SslCredentialsOptions options;
     if (!flags.tls_ca.empty()) {
-      auto ca = read_file(flags.tls_ca, "tls-ca");
-      if (!ca.ok()) return ca.status();
-      options.pem_root_certs = *ca;
+      LABELMESH_ASSIGN_OR_RETURN(auto ca, read_file(flags.tls_ca, "tls-ca"));
+      options.pem_root_certs = ca;
     }
     if (!flags.tls_cert.empty()) {
-      auto cert = read_file(flags.tls_cert, "tls-cert");
-      if (!cert.ok()) return cert.status();
+      LABELMESH_ASSIGN_OR_RETURN(auto cert, read_file(flags.tls_cert, "tls-cert"));
       auto key = read_file(flags.tls_key, "tls-key");
       if (!key.ok()) return key.status();
-      options.pem_cert_chain = *cert;
+      options.pem_cert_chain = cert;
       options.pem_private_key = *key;
     }
     credentials = grpc::SslCredentials(options);

@@ -22,6 +22,7 @@
 #include "core/digest/sha256.h"
 #include "core/pipeline/job_options.h"
 #include "core/pipeline/report.h"
+#include "core/util/status_macros.h"
 #include "core/volume/volume_header.h"
 #include "labelmesh/v1/service.grpc.pb.h"
 
@@ -80,8 +81,7 @@ void print_upload_progress(uint64_t sent, uint64_t total, double seconds) {
 absl::StatusOr<v1::SubmitReply> upload_once(const ServerConnection& connection,
                                             const SubmitFlags& flags,
                                             const std::string& request_id) {
-  auto digest = digest::sha256_file(flags.path);
-  if (!digest.ok()) return digest.status();
+  LABELMESH_ASSIGN_OR_RETURN(auto digest, digest::sha256_file(flags.path));
   std::error_code error;
   const uint64_t size = std::filesystem::file_size(flags.path, error);
   if (error) return absl::NotFoundError(absl::StrCat(flags.path, ": ", error.message()));
@@ -102,7 +102,7 @@ absl::StatusOr<v1::SubmitReply> upload_once(const ServerConnection& connection,
     file_name += ".dcm";
   spec.set_file_name(file_name);
   spec.set_size_bytes(size);
-  spec.set_sha256(*digest);
+  spec.set_sha256(digest);
   spec.set_keep_input(flags.keep_input);
   spec.set_request_id(request_id);
   const auto start = std::chrono::steady_clock::now();

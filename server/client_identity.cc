@@ -150,9 +150,8 @@ absl::StatusOr<std::unique_ptr<ClientAuthenticator>> ClientAuthenticator::from_c
     const ServerConfig& config) {
   std::vector<TokenHolder> tokens;
   if (!config.clients_file.empty()) {
-    auto holders = read_clients_file(config.clients_file);
-    if (!holders.ok()) return holders.status();
-    tokens = std::move(*holders);
+    LABELMESH_ASSIGN_OR_RETURN(auto holders, read_clients_file(config.clients_file));
+    tokens = std::move(holders);
   }
   if (!config.auth_token_file.empty()) {
     auto token = read_single_token(config.auth_token_file);

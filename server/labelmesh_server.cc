@@ -38,12 +38,11 @@ absl::StatusOr<std::string> read_text_file(const std::string& path, const std::s
 
 absl::StatusOr<std::shared_ptr<grpc::ServerCredentials>> credentials(const ServerConfig& config) {
   if (!config.tls()) return grpc::InsecureServerCredentials();
-  auto cert = read_text_file(config.tls_cert, "tls-cert");
-  if (!cert.ok()) return cert.status();
+  LABELMESH_ASSIGN_OR_RETURN(auto cert, read_text_file(config.tls_cert, "tls-cert"));
   auto key = read_text_file(config.tls_key, "tls-key");
   if (!key.ok()) return key.status();
   grpc::SslServerCredentialsOptions options;
-  options.pem_key_cert_pairs.push_back({*key, *cert});
+  options.pem_key_cert_pairs.push_back({*key, cert});
   if (!config.client_ca.empty()) {
     auto ca = read_text_file(config.client_ca, "client-ca");
     if (!ca.ok()) return ca.status();
@@ -79,9 +78,8 @@ absl::StatusOr<std::unique_ptr<LabelmeshServer>> LabelmeshServer::start(ServerCo
   server->config_ = std::move(config);
   const ServerConfig& c = server->config_;
 
-  auto authenticator = ClientAuthenticator::from_config(c);
-  if (!authenticator.ok()) return authenticator.status();
-  server->authenticator_ = std::move(*authenticator);
+  LABELMESH_ASSIGN_OR_RETURN(auto authenticator, ClientAuthenticator::from_config(c));
+  server->authenticator_ = std::move(authenticator);
   auto creds = credentials(c);
   if (!creds.ok()) return creds.status();
 
@@ -128,9 +126,8 @@ absl::StatusOr<std::unique_ptr<LabelmeshServer>> LabelmeshServer::start(ServerCo
 
 absl::Status LabelmeshServer::open_spool() {
   const ServerConfig& c = config_;
-  auto spool = Spool::open(c.spool_dir);
-  if (!spool.ok()) return spool.status();
-  spool_ = std::make_unique<Spool>(std::move(*spool));
+  LABELMESH_ASSIGN_OR_RETURN(auto spool, Spool::open(c.spool_dir));
+  spool_ = std::make_unique<Spool>(std::move(spool));
   kill_stale_workers(spool_->root());
   auto audit = AuditLog::open(c.audit_log.empty() ? spool_->root() + "/audit.log" : c.audit_log);
   if (!audit.ok()) return audit.status();
@@ -143,9 +140,8 @@ absl::Status LabelmeshServer::open_spool() {
 
 absl::Status LabelmeshServer::open_cluster() {
   const ServerConfig& c = config_;
-  auto files = cluster::SharedArtifacts::open(c.artifact_dir);
-  if (!files.ok()) return files.status();
-  files_ = std::make_unique<cluster::SharedArtifacts>(std::move(*files));
+  LABELMESH_ASSIGN_OR_RETURN(auto files, cluster::SharedArtifacts::open(c.artifact_dir));
+  files_ = std::make_unique<cluster::SharedArtifacts>(std::move(files));
   cluster::ClusterSettings settings;
   settings.nats_url = c.nats_url;
   settings.connection_name = absl::StrCat("labelmeshd ", c.role);

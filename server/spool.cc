@@ -12,6 +12,7 @@
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 #include "core/digest/sha256.h"
+#include "core/util/status_macros.h"
 #include "server/durable_file.h"
 #include "spdlog/spdlog.h"
 
@@ -189,9 +190,8 @@ absl::StatusOr<std::vector<v1::Artifact>> list_artifacts(const std::string& dir)
     v1::Artifact artifact;
     artifact.set_name(entry.path().lexically_relative(out).string());
     artifact.set_size_bytes(size);
-    auto digest = digest::sha256_file(entry.path().string());
-    if (!digest.ok()) return digest.status();
-    artifact.set_sha256(*digest);
+    LABELMESH_ASSIGN_OR_RETURN(auto digest, digest::sha256_file(entry.path().string()));
+    artifact.set_sha256(digest);
     artifacts.push_back(std::move(artifact));
   }
   if (error) return io_error("cannot list the results", error);

@@ -244,11 +244,10 @@ absl::Status SubmitUpload::run(v1::SubmitReply& reply) {
     return stalled_or(*ticket, refused(Refusal::kStalled, absl::CancelledError("the client left")));
   }
   // The store's refusals come marked queue_full or disk_full.
-  auto position = store.accept(std::move(record), upload.path());
-  if (!position.ok()) return position.status();
+  LABELMESH_ASSIGN_OR_RETURN(auto position, store.accept(std::move(record), upload.path()));
   upload.keep();
   reply.set_job_id(job_id);
-  reply.set_queue_position(*position);
+  reply.set_queue_position(position);
   services_.metrics.upload_bytes(spec.size_bytes());
   return absl::OkStatus();
 }

@@ -145,22 +145,21 @@ absl::Status run_job(const std::string& job_dir, const std::string& out_dir, int
       return absl::InternalError("the worker cannot read its job record");
     }
   }
-  auto params = params_from_options(record.spec().options());
-  if (!params.ok()) return params.status();
+  LABELMESH_ASSIGN_OR_RETURN(auto params, params_from_options(record.spec().options()));
   // The server's share of the cores for each worker (kJobThreadsVariable).
   if (const char* threads = std::getenv(kJobThreadsVariable)) {
-    params->threads = static_cast<unsigned>(std::clamp(std::atoi(threads), 1, 256));
+    params.threads = static_cast<unsigned>(std::clamp(std::atoi(threads), 1, 256));
   }
   StageEvents events(fd);
   RunContext context;
   context.progress = [&events](const ProgressUpdate& update) { events.update(update); };
   auto result =
-      run_pipeline(absl::StrCat(job_dir, "/input", record.input_extension()), *params, context);
+      run_pipeline(absl::StrCat(job_dir, "/input", record.input_extension()), params, context);
   if (!result.ok()) return result.status();
-  LABELMESH_RETURN_IF_ERROR(write_results(*result, *params, out_dir, context));
+  LABELMESH_RETURN_IF_ERROR(write_results(*result, params, out_dir, context));
   events.finish_stage();
   v1::JobEvent finished;
-  *finished.mutable_finished()->mutable_report() = make_report(*result, *params);
+  *finished.mutable_finished()->mutable_report() = make_report(*result, params);
   if (!write_event(fd, finished)) return absl::InternalError("the server stopped listening");
   return absl::OkStatus();
 }

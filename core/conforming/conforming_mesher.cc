@@ -32,9 +32,8 @@ absl::Status remove_crossings(InterfaceSurface& surface, int max_rounds, const R
                               ConformingFigures& figures) {
   for (int round = 0;; ++round) {
     LABELMESH_RETURN_IF_ERROR(context.check_stop());
-    auto crossing = crossing_points(surface);
-    if (!crossing.ok()) return crossing.status();
-    if (crossing->empty()) return absl::OkStatus();
+    LABELMESH_ASSIGN_OR_RETURN(auto crossing, crossing_points(surface));
+    if (crossing.empty()) return absl::OkStatus();
     if (round == max_rounds) {
       std::vector<uint32_t> all(surface.points.size());
       for (uint32_t p = 0; p < all.size(); ++p) all[p] = p;
@@ -43,8 +42,8 @@ absl::Status remove_crossings(InterfaceSurface& surface, int max_rounds, const R
       return absl::OkStatus();
     }
     ++figures.crossing_repairs;
-    figures.restored_points += crossing->size();
-    restore_staircase(surface, *crossing);
+    figures.restored_points += crossing.size();
+    restore_staircase(surface, crossing);
   }
 }
 
@@ -63,16 +62,16 @@ absl::StatusOr<InterfaceSurface> grid_interfaces(const volume::LabelVolume& volu
   std::optional<volume::LabelVolume> coarse, thinner;
   const volume::LabelVolume* grid = &volume;
   if (figures.coarsening.factors != std::array<double, 3>{1, 1, 1}) {
-    auto coarsened = coarsen_labels(volume, labels, figures.coarsening.factors, context);
-    if (!coarsened.ok()) return coarsened.status();
-    coarse = std::move(*coarsened);
+    LABELMESH_ASSIGN_OR_RETURN(auto coarsened,
+                               coarsen_labels(volume, labels, figures.coarsening.factors, context));
+    coarse = std::move(coarsened);
     grid = &*coarse;
   }
   figures.thick_slices = find_thick_slices(grid->geometry, params.thick_slices);
   if (figures.thick_slices.axis >= 0) {
-    auto cut = interpolate_thick_slices(*grid, labels, figures.thick_slices, context);
-    if (!cut.ok()) return cut.status();
-    thinner = std::move(*cut);
+    LABELMESH_ASSIGN_OR_RETURN(
+        auto cut, interpolate_thick_slices(*grid, labels, figures.thick_slices, context));
+    thinner = std::move(cut);
     grid = &*thinner;
     coarse.reset();
   }

@@ -143,8 +143,7 @@ absl::StatusOr<volume_mesh::TetMesh> labelled_mesh(const InterfaceSurface& surfa
     return absl::ResourceExhaustedError(cat("tetgen: ", out.numberofpoints, " points for ", kWhat,
                                             "; at most ", kMaxKeyedPoints - 1, " are supported"));
   }
-  auto labels = region_labels(surface, out, regions);
-  if (!labels.ok()) return labels.status();
+  LABELMESH_ASSIGN_OR_RETURN(auto labels, region_labels(surface, out, regions));
 
   const size_t tet_count = static_cast<size_t>(out.numberoftetrahedra);
   const size_t out_points = static_cast<size_t>(out.numberofpoints);
@@ -153,7 +152,7 @@ absl::StatusOr<volume_mesh::TetMesh> labelled_mesh(const InterfaceSurface& surfa
   constexpr uint32_t kUnused = UINT32_MAX;
   std::vector<uint32_t> new_index(out_points, kUnused);
   for (size_t t = 0; t < tet_count; ++t) {
-    if ((*labels)[t] == kOutside) continue;
+    if (labels[t] == kOutside) continue;
     const int* v = out_tet(out, t);
     for (int k = 0; k < 4; ++k) {
       if (v[k] < 0 || static_cast<size_t>(v[k]) >= out_points)
@@ -168,10 +167,10 @@ absl::StatusOr<volume_mesh::TetMesh> labelled_mesh(const InterfaceSurface& surfa
     mesh.points.push_back(tetgen_point(out, static_cast<int>(p)));
   }
   for (size_t t = 0; t < tet_count; ++t) {
-    if ((*labels)[t] == kOutside) continue;
+    if (labels[t] == kOutside) continue;
     const int* v = out_tet(out, t);
     mesh.tetrahedra.push_back({new_index[v[0]], new_index[v[1]], new_index[v[2]], new_index[v[3]]});
-    mesh.labels.push_back((*labels)[t]);
+    mesh.labels.push_back(labels[t]);
     if (!(volume_mesh::signed_volume(mesh, mesh.tetrahedra.size() - 1) > 0)) {
       return absl::InternalError(cat("tetgen: tetrahedron ", t, " of ", kWhat,
                                      " is flat or inverted; all must have positive volume"));

@@ -5,6 +5,7 @@
 #include <map>
 
 #include "core/surface/surface_statistics.h"
+#include "core/util/status_macros.h"
 #include "core/util/text.h"
 
 namespace labelmesh::mixed_mesh {
@@ -51,16 +52,16 @@ absl::StatusOr<MixedMesh> mesh_with_hex_layer(const SurfaceOracle& oracle,
   HexCoreParams core_params = params.core;
   core_params.pyramids = false;
   core_params.max_open_faces = 3;
-  auto core = build_hex_core(oracle, surface, label, core_params, context);
-  if (!core.ok()) return core.status();
-  figures.grid_cells += core->grid_cells;
-  figures.depth_queries += core->depth_queries;
-  figures.core_cells_removed += core->cells_removed;
-  if (core->mesh.size() == 0) {
+  LABELMESH_ASSIGN_OR_RETURN(auto core,
+                             build_hex_core(oracle, surface, label, core_params, context));
+  figures.grid_cells += core.grid_cells;
+  figures.depth_queries += core.depth_queries;
+  figures.core_cells_removed += core.cells_removed;
+  if (core.mesh.size() == 0) {
     return absl::FailedPreconditionError(
         cat("too thin for a single ", params.core.cell_mm, " mm cube"));
   }
-  MixedMesh cells = std::move(core->mesh);
+  MixedMesh cells = std::move(core.mesh);
   if (!params.hexahedra_only) {
     OctreeParams octree = params.octree;
     octree.cell_mm = params.core.cell_mm;

@@ -249,9 +249,9 @@ class LabelGuard {
     StageTimer timer(outcome_.stages, "voxel_fidelity");
     context_.report("voxel_fidelity", 0);
     candidate.statistics = surface::compute_surface_statistics(candidate.mesh);
-    auto voxels = surface::measure_voxel_fidelity(candidate.mesh, layer_, label_, context_);
-    if (!voxels.ok()) return voxels.status();
-    voxels->hausdorff_voxels =
+    LABELMESH_ASSIGN_OR_RETURN(
+        auto voxels, surface::measure_voxel_fidelity(candidate.mesh, layer_, label_, context_));
+    voxels.hausdorff_voxels =
         corresponding != nullptr ? surface::corresponding_hausdorff_voxels(
                                        candidate.mesh, *corresponding, layer_.geometry)
                                  : surface::sampled_hausdorff_voxels(
@@ -259,10 +259,10 @@ class LabelGuard {
     LABELMESH_RETURN_IF_ERROR(context_.check_stop());
     SurfaceAttempt attempt;
     attempt.method = method;
-    attempt.volume_change = voxels->volume_change;
+    attempt.volume_change = voxels.volume_change;
     attempt.min_angle_deg = candidate.statistics.min_angle_deg;
     attempt.max_angle_deg = candidate.statistics.max_angle_deg;
-    attempt.voxels = *voxels;
+    attempt.voxels = voxels;
     // A surface must also be closed and manifold to be delivered.
     if (!candidate.statistics.closed || !candidate.statistics.manifold)
       attempt.error = "the surface is not a closed 2-manifold";

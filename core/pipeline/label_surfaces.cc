@@ -41,15 +41,15 @@ absl::StatusOr<Pieces> kept_component_surfaces(const volume::LabelVolume& volume
   // segmentation noise too: Poisson closes them, and the distance check would
   // measure them (a 1-voxel hole 10 mm deep in the liver file's label 127).
   component_options.fill_cavities_below = options.min_component_voxels;
-  auto components = volume::find_label_components(volume, label, component_options, context);
-  if (!components.ok()) return components.status();
+  LABELMESH_ASSIGN_OR_RETURN(
+      auto components, volume::find_label_components(volume, label, component_options, context));
   const uint64_t min_voxels = options.min_component_voxels;
   Pieces pieces;
-  pieces.counts.pruned_voxels = components->pruned_voxels;
-  pieces.counts.filled_cavities = components->filled_cavities;
-  pieces.counts.filled_voxels = components->filled_voxels;
+  pieces.counts.pruned_voxels = components.pruned_voxels;
+  pieces.counts.filled_cavities = components.filled_cavities;
+  pieces.counts.filled_voxels = components.filled_voxels;
   std::vector<int32_t> kept;
-  for (const auto& component : components->components) {
+  for (const auto& component : components.components) {
     if (component.voxels >= min_voxels) {
       kept.push_back(component.id);
     } else {
@@ -59,10 +59,10 @@ absl::StatusOr<Pieces> kept_component_surfaces(const volume::LabelVolume& volume
   }
   pieces.counts.kept = static_cast<uint32_t>(kept.size());
   if (kept.empty()) return pieces;
-  auto meshes = surface::extract_component_surfaces(*components, kept, volume.geometry, context);
+  auto meshes = surface::extract_component_surfaces(components, kept, volume.geometry, context);
   if (!meshes.ok()) return meshes.status();
   pieces.meshes = std::move(*meshes);
-  pieces.components = std::move(*components);
+  pieces.components = std::move(components);
   pieces.ids = std::move(kept);
   return pieces;
 }
@@ -117,11 +117,11 @@ absl::Status repair_pieces(double voxel, const RunContext& context,
   PieceProgress progress(context, "repair", pieces);
   for (auto& piece : pieces) {
     surface::RepairCounts counts;
-    auto fixed = surface::repair_surface(piece, repair_params, context, counts);
-    if (!fixed.ok()) return fixed.status();
+    LABELMESH_ASSIGN_OR_RETURN(auto fixed,
+                               surface::repair_surface(piece, repair_params, context, counts));
     add_repair_counts(*repaired.repair, counts);
     progress.done(piece);
-    piece = std::move(*fixed);
+    piece = std::move(fixed);
     repaired.mesh.append(piece);
   }
   return absl::OkStatus();

@@ -180,9 +180,9 @@ absl::Status add_every_label_surface(const std::vector<volume::LabelVolume>& lay
   // The shared nets are built once, before any label.
   std::optional<LabelNets> nets;
   if (params.surface == SurfaceMethod::kNet) {
-    auto built = build_label_nets(layers, layer_of, labels, params, context, stages);
-    if (!built.ok()) return built.status();
-    nets = std::move(*built);
+    LABELMESH_ASSIGN_OR_RETURN(auto built,
+                               build_label_nets(layers, layer_of, labels, params, context, stages));
+    nets = std::move(built);
   }
   const auto tolerances = label_tolerances(layers.front().geometry, input, labels, params.guard);
   const size_t count = labels.size();
@@ -297,9 +297,9 @@ absl::StatusOr<std::vector<surface::LabelSurface>> extract_layer_surfaces(
       at.push_back(i);
     }
     if (here.empty()) continue;
-    auto extracted = surface::extract_surfaces(layers[layer], statistics, here, context);
-    if (!extracted.ok()) return extracted.status();
-    for (size_t k = 0; k < at.size(); ++k) all[at[k]] = std::move((*extracted)[k]);
+    LABELMESH_ASSIGN_OR_RETURN(auto extracted,
+                               surface::extract_surfaces(layers[layer], statistics, here, context));
+    for (size_t k = 0; k < at.size(); ++k) all[at[k]] = std::move(extracted[k]);
   }
   return all;
 }
@@ -322,11 +322,10 @@ absl::Status add_mixed_mesh(const MeshParams& params, const volume::ImageGeometr
   // facing split triangles: the layer's boundaries are always kept.
   mixed.tetgen.keep_boundary = true;
   StageTimer timer(result.stages, "mixed_mesh");
-  auto meshes = mesh_labels_mixed(boundaries, mixed, context);
-  if (!meshes.ok()) return meshes.status();
-  for (const auto& left_out : meshes->labels_left_out)
+  LABELMESH_ASSIGN_OR_RETURN(auto meshes, mesh_labels_mixed(boundaries, mixed, context));
+  for (const auto& left_out : meshes.labels_left_out)
     result.warnings.push_back({left_out.label, cat("no volume mesh: ", left_out.reason)});
-  result.mixed = std::move(*meshes);
+  result.mixed = std::move(meshes);
   return absl::OkStatus();
 }
 
@@ -361,9 +360,8 @@ absl::StatusOr<VolumeSummary> summarise_volume(const std::string& path,
                                                const volume::ReadLimits& limits,
                                                const RunContext& context) {
   try {
-    auto volume = volume::read_label_volume(path, limits, context);
-    if (!volume.ok()) return volume.status();
-    return summary_of(volume_layers(*volume));
+    LABELMESH_ASSIGN_OR_RETURN(auto volume, volume::read_label_volume(path, limits, context));
+    return summary_of(volume_layers(volume));
   } catch (...) {
     return current_exception_status(path);
   }
@@ -414,9 +412,8 @@ absl::StatusOr<MeshResult> run_stages(const std::string& path, const MeshParams&
   }
   if (!volume.ok()) return volume.status();
   if (params.dicom_surfaces) {
-    auto source = dicom::read_dicom_source(path);
-    if (!source.ok()) return source.status();
-    dicom = std::move(*source);
+    LABELMESH_ASSIGN_OR_RETURN(auto source, dicom::read_dicom_source(path));
+    dicom = std::move(source);
   }
   auto meshed = run_on_volume(path, std::move(volume), params, context, std::move(result));
   if (meshed.ok()) {
@@ -452,9 +449,9 @@ absl::StatusOr<MeshResult> run_on_volume(const std::string& path,
     result.input = summary_of(layers);
     volume::apply_label_table(params.label_names, result.input.descriptions);
   }
-  auto labels = choose_labels(path, result.input.statistics, params.labels);
-  if (!labels.ok()) return labels.status();
-  auto layer_of = layer_of_labels(layers, *labels);
+  LABELMESH_ASSIGN_OR_RETURN(auto labels,
+                             choose_labels(path, result.input.statistics, params.labels));
+  auto layer_of = layer_of_labels(layers, labels);
   // The label volume as read, for the scene formats that write it.
   const auto keep_label_image = [&] {
     if (std::any_of(params.scene_formats.begin(), params.scene_formats.end(),
@@ -469,7 +466,7 @@ absl::StatusOr<MeshResult> run_on_volume(const std::string& path,
               " layers); one conforming mesh gives each point one label, so mesh overlapping "
               "segments with --volume tet"));
     }
-    LABELMESH_RETURN_IF_ERROR(add_conforming_mesh(*volume, *labels, params, context, result));
+    LABELMESH_RETURN_IF_ERROR(add_conforming_mesh(*volume, labels, params, context, result));
     LABELMESH_RETURN_IF_ERROR(refuse_warnings_if_strict(path, result, params));
     keep_label_image();
     return result;
@@ -479,7 +476,7 @@ absl::StatusOr<MeshResult> run_on_volume(const std::string& path,
   {
     StageTimer timer(result.stages, "marching_cubes");
     context.report("marching_cubes", 0);
-    surfaces = extract_layer_surfaces(layers, layer_of, result.input.statistics, *labels, context);
+    surfaces = extract_layer_surfaces(layers, layer_of, result.input.statistics, labels, context);
   }
   if (!surfaces.ok()) return surfaces.status();
   // The Marching Cubes figures. When quality surfaces follow, the Marching
@@ -514,7 +511,7 @@ absl::StatusOr<MeshResult> run_on_volume(const std::string& path,
     measure_marching_cubes();
   } else {
     side_by_side(measure_marching_cubes, [&] {
-      quality_status = add_every_label_surface(layers, layer_of, result.input, *labels, params,
+      quality_status = add_every_label_surface(layers, layer_of, result.input, labels, params,
                                                context, quality_surfaces, result.stages);
     });
   }
@@ -537,7 +534,7 @@ absl::StatusOr<MeshResult> run_on_volume(const std::string& path,
   if (tetrahedra || params.volume == VolumeMethod::kMixed || params.volume == VolumeMethod::kHex) {
     // Labels are meshed one by one: where they touch, their meshes overlap.
     for (size_t layer = 0; layer < layers.size(); ++layer) {
-      auto touching = volume::touching_labels(layers[layer], *labels);
+      auto touching = volume::touching_labels(layers[layer], labels);
       result.touching_labels.insert(result.touching_labels.end(), touching.begin(), touching.end());
     }
   }

@@ -104,9 +104,8 @@ absl::StatusOr<Mesh> mesh_from_soup(const TriangleMesh& input, RepairCounts& cou
 absl::StatusOr<TriangleMesh> repair(const TriangleMesh& input, const RepairParams& params,
                                     const RunContext& context, RepairCounts& counts) {
   counts = RepairCounts{};
-  auto built = mesh_from_soup(input, counts);
-  if (!built.ok()) return built.status();
-  Mesh& mesh = *built;
+  LABELMESH_ASSIGN_OR_RETURN(auto built, mesh_from_soup(input, counts));
+  Mesh& mesh = built;
   counts.non_manifold_vertices_split +=
       static_cast<uint32_t>(PMP::duplicate_non_manifold_vertices(mesh));
   LABELMESH_RETURN_IF_ERROR(context.check_stop());

@@ -325,15 +325,14 @@ absl::StatusOr<VoxelFidelity> measure_voxel_fidelity(const TriangleMesh& mesh,
     fidelity.volume_change = signed_volume(mesh) / fidelity.voxel_volume_mm3 - 1;
   fidelity.axis_aligned_share = axis_aligned_share(mesh, geometry);
 
-  auto box = label_box(volume, label);
-  if (!box.ok()) return box.status();
+  LABELMESH_ASSIGN_OR_RETURN(auto box, label_box(volume, label));
   LABELMESH_RETURN_IF_ERROR(context.check_stop());
   const std::vector<Vec3> at = index_points(mesh, geometry);
-  const Crossings crossings = column_crossings(at, mesh.triangles, *box);
+  const Crossings crossings = column_crossings(at, mesh.triangles, box);
   LABELMESH_RETURN_IF_ERROR(context.check_stop());
 
   std::vector<Vec3> wrong;
-  const auto& b = *box;
+  const auto& b = box;
   const auto& dims = geometry.dims;
   for (int64_t j = b.lo[1]; j < b.lo[1] + b.size[1]; ++j) {
     for (int64_t i = b.lo[0]; i < b.lo[0] + b.size[0]; ++i) {

@@ -137,9 +137,8 @@ absl::StatusOr<DicomSegGrid> dicom_seg_grid(std::string_view path,
         !s.ok())
       return s;
   }
-  auto axes = plane_axes(path, *header.orientation);
-  if (!axes.ok()) return axes.status();
-  const auto& [row_dir, column_dir] = *axes;
+  LABELMESH_ASSIGN_OR_RETURN(auto axes, plane_axes(path, *header.orientation));
+  const auto& [row_dir, column_dir] = axes;
   const Vec3 normal = cross(row_dir, column_dir);
   const double column_spacing = (*header.pixel_spacing)[1];  // between columns, along a row
   const double row_spacing = (*header.pixel_spacing)[0];
@@ -214,18 +213,17 @@ namespace labelmesh::volume::internal {
 
 absl::StatusOr<VolumeHeader> check_dicom_seg_volume_header(const std::string& path,
                                                            const ReadLimits& limits) {
-  auto header = parse_dicom_seg_header(path);
-  if (!header.ok()) return header.status();
-  auto grid = dicom_seg_grid(path, *header, limits);
+  LABELMESH_ASSIGN_OR_RETURN(auto header, parse_dicom_seg_header(path));
+  auto grid = dicom_seg_grid(path, header, limits);
   if (!grid.ok()) return grid.status();
   // BINARY frames are one bit a pixel, packed without padding between frames.
-  const uint64_t pixels = uint64_t(header->rows) * header->columns * header->frames;
-  const uint64_t needed = header->bits_allocated == 1 ? (pixels + 7) / 8 : pixels;
-  if (header->pixel_data_bytes < needed) {
+  const uint64_t pixels = uint64_t(header.rows) * header.columns * header.frames;
+  const uint64_t needed = header.bits_allocated == 1 ? (pixels + 7) / 8 : pixels;
+  if (header.pixel_data_bytes < needed) {
     return field_error(
         path, "(7FE0,0010) Pixel Data",
-        absl::StrCat("holds ", header->pixel_data_bytes, " bytes; ", header->frames, " frames of ",
-                     header->rows, " x ", header->columns, " need ", needed));
+        absl::StrCat("holds ", header.pixel_data_bytes, " bytes; ", header.frames, " frames of ",
+                     header.rows, " x ", header.columns, " need ", needed));
   }
   VolumeHeader volume;
   volume.format = ImageFormat::kDicomSeg;
@@ -233,7 +231,7 @@ absl::StatusOr<VolumeHeader> check_dicom_seg_volume_header(const std::string& pa
   volume.scalar_type = ScalarType::kUInt16;
   volume.geometry = grid->geometry;
   volume.data_path = path;
-  volume.file_offset = header->pixel_data_offset;
+  volume.file_offset = header.pixel_data_offset;
   return volume;
 }
 

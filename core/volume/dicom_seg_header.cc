@@ -354,48 +354,46 @@ absl::StatusOr<Element> Walker::element_at(uint64_t pos, int depth) {
 absl::StatusOr<uint64_t> Walker::walk_elements(uint64_t pos, uint64_t end, bool until_item_end,
                                                int depth, Scope scope, FrameGroups* groups) {
   while (until_item_end || pos < end) {
-    auto e = element_at(pos, depth);
-    if (!e.ok()) return e.status();
-    const KnownTag* known = known_tag(e->tag);
-    if (e->value_offset > end) {
-      return field_error(path_, tag_name(e->tag),
+    LABELMESH_ASSIGN_OR_RETURN(auto e, element_at(pos, depth));
+    const KnownTag* known = known_tag(e.tag);
+    if (e.value_offset > end) {
+      return field_error(path_, tag_name(e.tag),
                          cat("runs past the end of its item at byte ", end));
     }
-    if (e->tag == kItemEnd && until_item_end) return e->value_offset;
-    if (e->tag >> 16 == 0xFFFE) {
-      return field_error(path_, tag_name(e->tag), cat("is out of place at byte ", pos));
+    if (e.tag == kItemEnd && until_item_end) return e.value_offset;
+    if (e.tag >> 16 == 0xFFFE) {
+      return field_error(path_, tag_name(e.tag), cat("is out of place at byte ", pos));
     }
-    if (syntax_.explicit_vr && known && !known->vr.empty() && e->vr != known->vr) {
-      return field_error(path_, tag_name(e->tag),
-                         cat("has VR ", e->vr, "; PS3.6 gives ", known->vr));
+    if (syntax_.explicit_vr && known && !known->vr.empty() && e.vr != known->vr) {
+      return field_error(path_, tag_name(e.tag), cat("has VR ", e.vr, "; PS3.6 gives ", known->vr));
     }
-    if (depth == 0 && e->tag == kPixelData) {
-      LABELMESH_RETURN_IF_ERROR(pixel_data(*e));
+    if (depth == 0 && e.tag == kPixelData) {
+      LABELMESH_RETURN_IF_ERROR(pixel_data(e));
       return end;
     }
     // Implicit VR: our sequences are known, and an undefined length outside
     // Pixel Data can only be a sequence (PS3.5 7.5.1).
-    const bool sequence = syntax_.explicit_vr
-                              ? e->vr == "SQ"
-                              : (known && known->vr == "SQ") ||
-                                    (e->length == kUndefinedLength && e->tag != kPixelData);
+    const bool sequence =
+        syntax_.explicit_vr
+            ? e.vr == "SQ"
+            : (known && known->vr == "SQ") || (e.length == kUndefinedLength && e.tag != kPixelData);
     if (sequence) {
-      if (e->tag == kPlanePositionSlideSequence) out_.has_plane_position_slide = true;
-      auto next = walk_sequence(*e, end, depth + 1, scope, groups);
+      if (e.tag == kPlanePositionSlideSequence) out_.has_plane_position_slide = true;
+      auto next = walk_sequence(e, end, depth + 1, scope, groups);
       if (!next.ok()) return next.status();
       pos = *next;
       continue;
     }
-    if (e->length == kUndefinedLength) {
-      return field_error(path_, tag_name(e->tag), "has an undefined length but is not a sequence");
+    if (e.length == kUndefinedLength) {
+      return field_error(path_, tag_name(e.tag), "has an undefined length but is not a sequence");
     }
-    if (e->value_offset + e->length > std::min({end, max_header_, file_size_})) {
-      LABELMESH_RETURN_IF_ERROR(span(tag_name(e->tag), "a value", e->value_offset, e->length));
-      return field_error(path_, tag_name(e->tag),
+    if (e.value_offset + e.length > std::min({end, max_header_, file_size_})) {
+      LABELMESH_RETURN_IF_ERROR(span(tag_name(e.tag), "a value", e.value_offset, e.length));
+      return field_error(path_, tag_name(e.tag),
                          cat("runs past the end of its item at byte ", end));
     }
-    LABELMESH_RETURN_IF_ERROR(use_value(*e, scope, groups));
-    pos = e->value_offset + e->length;
+    LABELMESH_RETURN_IF_ERROR(use_value(e, scope, groups));
+    pos = e.value_offset + e.length;
   }
   return pos;
 }
@@ -503,9 +501,8 @@ absl::Status Walker::use_value(const Element& e, Scope scope, FrameGroups* group
                         "; a segmentation has 1, 8 or 16");
       }
       if (e.tag == kNumberOfFrames) {
-        auto value = text(e);
-        if (!value.ok()) return value.status();
-        std::string_view digits = *value;
+        LABELMESH_ASSIGN_OR_RETURN(auto value, text(e));
+        std::string_view digits = value;
         if (!digits.empty() && digits.front() == '+') digits.remove_prefix(1);
         uint32_t frames = 0;
         const char* stop = digits.data() + digits.size();
@@ -610,9 +607,8 @@ bool is_plain_uid(std::string_view uid) {
 
 absl::StatusOr<DicomSegHeader> parse_dicom_seg_header(const std::string& path,
                                                       uint64_t max_header_bytes) {
-  auto size = file_size(path);
-  if (!size.ok()) return size.status();
-  return Walker(path, *size, max_header_bytes).run();
+  LABELMESH_ASSIGN_OR_RETURN(auto size, file_size(path));
+  return Walker(path, size, max_header_bytes).run();
 }
 
 }  // namespace labelmesh::volume::internal

@@ -108,19 +108,17 @@ absl::StatusOr<std::string> read_prefix(std::string_view path, uint64_t max_byte
       PayloadStream::open(std::string(path), 0, gzip ? DataEncoding::kGzip : DataEncoding::kRaw);
   if (!stream.ok()) return stream.status();
   std::string bytes(max_bytes, '\0');
-  auto got = (*stream)->read(bytes.data(), max_bytes);
-  if (!got.ok()) return got.status();
-  bytes.resize(*got);
+  LABELMESH_ASSIGN_OR_RETURN(auto got, (*stream)->read(bytes.data(), max_bytes));
+  bytes.resize(got);
   return bytes;
 }
 
 absl::Status check_raw_payload(std::string_view path, uint64_t offset, uint64_t needed) {
-  auto size = file_size(path);
-  if (!size.ok()) return size.status();
-  if (*size < offset || *size - offset < needed) {
+  LABELMESH_ASSIGN_OR_RETURN(auto size, file_size(path));
+  if (size < offset || size - offset < needed) {
     return field_error(path, "voxel data",
                        cat("is truncated: the header needs ", needed, " bytes at offset ", offset,
-                           ", the file has ", *size, " bytes"));
+                           ", the file has ", size, " bytes"));
   }
   return absl::OkStatus();
 }
@@ -144,12 +142,11 @@ absl::Status check_encoded_payload(std::string_view path, uint64_t file_offset,
   }
   auto stream = PayloadStream::open(std::string(path), file_offset, encoding, compressed_bytes);
   if (!stream.ok()) return stream.status();
-  auto got = (*stream)->skip(needed);
-  if (!got.ok()) return got.status();
-  if (*got < needed) {
+  LABELMESH_ASSIGN_OR_RETURN(auto got, (*stream)->skip(needed));
+  if (got < needed) {
     return field_error(path, "voxel data",
                        cat("is truncated: the header needs ", needed,
-                           " decoded bytes, the compressed stream holds ", *got));
+                           " decoded bytes, the compressed stream holds ", got));
   }
   return absl::OkStatus();
 }

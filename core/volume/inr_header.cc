@@ -25,9 +25,8 @@ absl::StatusOr<double> number_field(const std::string& path, const TextHeader& h
     if (fallback) return *fallback;
     return field_error(path, key, "is missing");
   }
-  auto parsed = parse_numbers(path, key, *value, 1);
-  if (!parsed.ok()) return parsed.status();
-  return (*parsed)[0];
+  LABELMESH_ASSIGN_OR_RETURN(auto parsed, parse_numbers(path, key, *value, 1));
+  return parsed[0];
 }
 
 }  // namespace
@@ -57,17 +56,15 @@ absl::StatusOr<VolumeHeader> check_inr_header(const std::string& path, bool gzip
   std::array<int64_t, 3> dims{};
   const char* dim_keys[3] = {"XDIM", "YDIM", "ZDIM"};
   for (int axis = 0; axis < 3; ++axis) {
-    auto value = number_field(path, h, dim_keys[axis], std::nullopt);
-    if (!value.ok()) return value.status();
-    if (*value != std::floor(*value) || *value < 1 || *value > 1e12) {
+    LABELMESH_ASSIGN_OR_RETURN(auto value, number_field(path, h, dim_keys[axis], std::nullopt));
+    if (value != std::floor(value) || value < 1 || value > 1e12) {
       return field_error(path, dim_keys[axis], "must be a whole number >= 1");
     }
-    dims[axis] = static_cast<int64_t>(*value);
+    dims[axis] = static_cast<int64_t>(value);
   }
   LABELMESH_RETURN_IF_ERROR(check_dims(path, "XDIM/YDIM/ZDIM", dims, limits));
-  auto vdim = number_field(path, h, "VDIM", 1.0);
-  if (!vdim.ok()) return vdim.status();
-  if (*vdim != 1) return field_error(path, "VDIM", "must be 1 for a label volume");
+  LABELMESH_ASSIGN_OR_RETURN(auto vdim, number_field(path, h, "VDIM", 1.0));
+  if (vdim != 1) return field_error(path, "VDIM", "must be 1 for a label volume");
 
   auto type = h.find("TYPE");
   auto pixsize = h.find("PIXSIZE");

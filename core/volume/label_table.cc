@@ -94,9 +94,8 @@ absl::StatusOr<LabelDescriptions> read_text_table(const std::string& path,
       name = std::string(fields[1]);
       rgb = {fields[2], fields[3], fields[4]};
     }
-    auto colour = colour_of(path, where, rgb);
-    if (!colour.ok()) return colour.status();
-    LABELMESH_RETURN_IF_ERROR(add_entry(path, where, label, std::move(name), *colour, table));
+    LABELMESH_ASSIGN_OR_RETURN(auto colour, colour_of(path, where, rgb));
+    LABELMESH_RETURN_IF_ERROR(add_entry(path, where, label, std::move(name), colour, table));
   }
   return table;
 }
@@ -174,9 +173,8 @@ absl::StatusOr<LabelDescriptions> read_json_table(const std::string& path,
 }  // namespace
 
 absl::StatusOr<LabelDescriptions> read_label_table(const std::string& path) {
-  auto size = internal::file_size(path);
-  if (!size.ok()) return size.status();
-  if (*size > kMostTableBytes)
+  LABELMESH_ASSIGN_OR_RETURN(auto size, internal::file_size(path));
+  if (size > kMostTableBytes)
     return field_error(path, "file", absl::StrCat("over ", kMostTableBytes, " bytes"));
   std::ifstream in(path, std::ios::binary);
   std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());

@@ -77,9 +77,8 @@ absl::StatusOr<VolumeHeader> check_metaimage_header(const std::string& path,
   if (!ndims || *ndims != "3") return field_error(path, "NDims", "must be 3");
   auto dim_text = h.find("DimSize");
   if (!dim_text) return field_error(path, "DimSize", "is missing");
-  auto dim_values = parse_numbers(path, "DimSize", *dim_text, 3);
-  if (!dim_values.ok()) return dim_values.status();
-  auto whole = whole_sizes(path, "DimSize", *dim_values);
+  LABELMESH_ASSIGN_OR_RETURN(auto dim_values, parse_numbers(path, "DimSize", *dim_text, 3));
+  auto whole = whole_sizes(path, "DimSize", dim_values);
   if (!whole.ok()) return whole.status();
   const std::array<int64_t, 3> dims = *whole;
   LABELMESH_RETURN_IF_ERROR(check_dims(path, "DimSize", dims, limits));

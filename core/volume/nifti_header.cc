@@ -229,8 +229,7 @@ absl::StatusOr<VolumeHeader> check_nifti_header(const std::string& path, bool gz
     }
   }
   LABELMESH_RETURN_IF_ERROR(check_dims(path, "dim", dims, limits));
-  auto type = nifti_scalar_type(path, n.datatype, n.bitpix);
-  if (!type.ok()) return type.status();
+  LABELMESH_ASSIGN_OR_RETURN(auto type, nifti_scalar_type(path, n.datatype, n.bitpix));
 
   const std::array<double, 3> pixdim{n.pixdim[1], n.pixdim[2], n.pixdim[3]};
   if (n.sform_code <= 0) {
@@ -255,7 +254,7 @@ absl::StatusOr<VolumeHeader> check_nifti_header(const std::string& path, bool gz
 
   VolumeHeader header;
   header.format = ImageFormat::kNifti;
-  header.scalar_type = *type;
+  header.scalar_type = type;
   header.big_endian = swap != (std::endian::native == std::endian::big);
   header.data_path = path;
   header.encoding = gzip ? DataEncoding::kGzip : DataEncoding::kRaw;

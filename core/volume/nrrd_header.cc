@@ -109,9 +109,8 @@ absl::StatusOr<NrrdAxes> nrrd_sizes(const std::string& path, const TextHeader& h
     axes.layers = static_cast<int64_t>(layers);
     sizes->erase(sizes->begin());
   }
-  auto whole = whole_sizes(path, "sizes", *sizes);
-  if (!whole.ok()) return whole.status();
-  axes.dims = *whole;
+  LABELMESH_ASSIGN_OR_RETURN(auto whole, whole_sizes(path, "sizes", *sizes));
+  axes.dims = whole;
   LABELMESH_RETURN_IF_ERROR(check_dims(path, "sizes", axes.dims, limits));
   const auto voxels = static_cast<uint64_t>(axes.dims[0] * axes.dims[1] * axes.dims[2]);
   if (voxels > limits.max_voxels / static_cast<uint64_t>(axes.layers)) {
@@ -159,13 +158,12 @@ std::optional<std::string_view> grid_part(std::string_view text, bool layered) {
 }  // namespace
 
 absl::StatusOr<VolumeHeader> check_nrrd_header(const std::string& path, const ReadLimits& limits) {
-  auto bytes = read_prefix(path, limits.max_header_bytes, false);
-  if (!bytes.ok()) return bytes.status();
-  if (!std::string_view(*bytes).starts_with("NRRD000")) {
+  LABELMESH_ASSIGN_OR_RETURN(auto bytes, read_prefix(path, limits.max_header_bytes, false));
+  if (!std::string_view(bytes).starts_with("NRRD000")) {
     return field_error(path, "magic", "the file does not start with NRRD000X");
   }
   auto text = parse_text_header(
-      path, *bytes, {.separator = ": ", .comment = "#", .last_key = "", .key_value_marker = ":="},
+      path, bytes, {.separator = ": ", .comment = "#", .last_key = "", .key_value_marker = ":="},
       limits.max_header_bytes);
   if (!text.ok()) return text.status();
   const TextHeader& h = *text;
@@ -278,7 +276,7 @@ absl::StatusOr<VolumeHeader> check_nrrd_header(const std::string& path, const Re
     header.data_path = sibling_path(path, *data_file);
     header.file_offset = 0;
   } else {
-    if (h.size >= bytes->size() && bytes->size() < limits.max_header_bytes) {
+    if (h.size >= bytes.size() && bytes.size() < limits.max_header_bytes) {
       return field_error(path, "data file", "is missing and no voxels follow the header");
     }
     header.data_path = path;

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <memory>
 
+#include "core/util/status_macros.h"
 #include "core/util/text.h"
 #include "core/volume/header_checks.h"
 
@@ -23,9 +24,8 @@ absl::StatusOr<std::unique_ptr<PayloadStream>> PayloadStream::open(const std::st
                                                                    uint64_t file_offset,
                                                                    DataEncoding encoding,
                                                                    uint64_t compressed_bytes) {
-  auto size = file_size(path);
-  if (!size.ok()) return size.status();
-  if (file_offset > *size) {
+  LABELMESH_ASSIGN_OR_RETURN(auto size, file_size(path));
+  if (file_offset > size) {
     return field_error(path, "voxel data",
                        cat("offset ", file_offset, " is past the end of the file"));
   }
@@ -33,7 +33,7 @@ absl::StatusOr<std::unique_ptr<PayloadStream>> PayloadStream::open(const std::st
   stream->path_ = path;
   stream->encoding_ = encoding;
   stream->encoded_left_ =
-      compressed_bytes == 0 ? *size - file_offset : std::min(compressed_bytes, *size - file_offset);
+      compressed_bytes == 0 ? size - file_offset : std::min(compressed_bytes, size - file_offset);
   stream->file_.open(path, std::ios::binary);
   if (!stream->file_) return absl::NotFoundError(cat(path, ": cannot open the file"));
   stream->file_.seekg(static_cast<std::streamoff>(file_offset));

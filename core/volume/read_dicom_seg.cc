@@ -115,9 +115,8 @@ absl::StatusOr<LabelVolume> read_dicom_seg(const std::string& path, const ReadLi
                        absl::StrCat(header->segments - segmentation->getNumberOfSegments(),
                                     " segment items are malformed"));
   }
-  auto pixels = pixel_bytes(path, *file.getDataset());
-  if (!pixels.ok()) return pixels.status();
-  const auto [bytes, byte_count] = *pixels;
+  LABELMESH_ASSIGN_OR_RETURN(auto pixels, pixel_bytes(path, *file.getDataset()));
+  const auto [bytes, byte_count] = pixels;
   context.report("read", 0.5);
 
   const uint64_t rows = header->rows, columns = header->columns;

@@ -187,46 +187,45 @@ absl::StatusOr<LabelVolume> read_label_volume(const std::string& path, const Rea
                                               const RunContext& context) {
   LABELMESH_RETURN_IF_ERROR(context.check_stop());
   if (format_of_file(path) == ImageFormat::kDicomSeg) return read_dicom_seg(path, limits, context);
-  auto header = check_volume_header(path, limits);
-  if (!header.ok()) return header.status();
+  LABELMESH_ASSIGN_OR_RETURN(auto header, check_volume_header(path, limits));
   context.report("read", 0.1);
 
-  const bool own_reader = header->format == ImageFormat::kInr ||
-                          header->format == ImageFormat::kNrrd ||
-                          header->format == ImageFormat::kMetaImage;
-  auto decoded = own_reader ? read_block(path, *header) : read_with_vtk(path, *header);
+  const bool own_reader = header.format == ImageFormat::kInr ||
+                          header.format == ImageFormat::kNrrd ||
+                          header.format == ImageFormat::kMetaImage;
+  auto decoded = own_reader ? read_block(path, header) : read_with_vtk(path, header);
   if (!decoded.ok()) return decoded.status();
   if (decoded->array->GetNumberOfComponents() != 1 ||
-      decoded->array->GetNumberOfTuples() != header->geometry.voxel_count() * header->layers) {
+      decoded->array->GetNumberOfTuples() != header.geometry.voxel_count() * header.layers) {
     return field_error(path, "voxel data", "does not hold one value per voxel");
   }
   LABELMESH_RETURN_IF_ERROR(context.check_stop());
-  auto labels = to_label_array(path, *header, decoded->array);
+  auto labels = to_label_array(path, header, decoded->array);
   if (!labels.ok()) return labels.status();
 
   LabelVolume volume;
-  if (!header->segments.empty()) {
-    auto slicer = merge_slicer_layers(path, *header, *labels, limits, context);
+  if (!header.segments.empty()) {
+    auto slicer = merge_slicer_layers(path, header, *labels, limits, context);
     if (!slicer.ok()) return slicer.status();
     *labels = slicer->voxels;
     volume.descriptions = std::move(slicer->descriptions);
     for (const auto& layer : slicer->more_layers) {
       auto image = vtkSmartPointer<vtkImageData>::New();
-      image->SetDimensions(static_cast<int>(header->geometry.dims[0]),
-                           static_cast<int>(header->geometry.dims[1]),
-                           static_cast<int>(header->geometry.dims[2]));
+      image->SetDimensions(static_cast<int>(header.geometry.dims[0]),
+                           static_cast<int>(header.geometry.dims[1]),
+                           static_cast<int>(header.geometry.dims[2]));
       image->GetPointData()->SetScalars(layer);
       volume.more_layers.push_back(std::move(image));
     }
   }
-  volume.format = header->format;
-  volume.file_voxel_type = std::string(scalar_type_name(header->scalar_type));
-  volume.geometry = header->geometry;
+  volume.format = header.format;
+  volume.file_voxel_type = std::string(scalar_type_name(header.scalar_type));
+  volume.geometry = header.geometry;
   if (decoded->reversed_k) volume.geometry.reverse_axis(2);
   volume.voxels = vtkSmartPointer<vtkImageData>::New();
-  volume.voxels->SetDimensions(static_cast<int>(header->geometry.dims[0]),
-                               static_cast<int>(header->geometry.dims[1]),
-                               static_cast<int>(header->geometry.dims[2]));
+  volume.voxels->SetDimensions(static_cast<int>(header.geometry.dims[0]),
+                               static_cast<int>(header.geometry.dims[1]),
+                               static_cast<int>(header.geometry.dims[2]));
   volume.voxels->GetPointData()->SetScalars(*labels);
   context.report("read", 1.0);
   return volume;

@@ -118,11 +118,10 @@ absl::StatusOr<std::string> segment_name(std::string_view path, int index,
 absl::StatusOr<std::array<uint8_t, 3>> segment_colour(std::string_view path, int index,
                                                       const std::string& text) {
   const std::string field = key_name(index, "Color");
-  auto values = internal::parse_numbers(path, field, text, 3);
-  if (!values.ok()) return values.status();
+  LABELMESH_ASSIGN_OR_RETURN(auto values, internal::parse_numbers(path, field, text, 3));
   std::array<uint8_t, 3> colour{};
   for (int c = 0; c < 3; ++c) {
-    const double v = (*values)[c];
+    const double v = values[c];
     if (!(v >= 0 && v <= 1)) {
       return field_error(path, field, "components must be numbers from 0 to 1");
     }
@@ -184,9 +183,8 @@ absl::StatusOr<SlicerSegment> parse_segment(std::string_view path, int index,
                                             const SegmentKeys& keys, int64_t layers,
                                             bool layer_per_segment) {
   SlicerSegment segment;
-  auto name = segment_name(path, index, keys);
-  if (!name.ok()) return name.status();
-  segment.description.name = std::move(*name);
+  LABELMESH_ASSIGN_OR_RETURN(auto name, segment_name(path, index, keys));
+  segment.description.name = std::move(name);
   if (keys.colour != nullptr) {
     auto colour = segment_colour(path, index, *keys.colour);
     if (!colour.ok()) return colour.status();
@@ -229,12 +227,11 @@ absl::Status check_distinct_values(std::string_view path,
 absl::StatusOr<std::vector<SlicerSegment>> parse_slicer_segments(
     std::string_view path, const std::map<std::string, std::string, std::less<>>& key_values,
     int64_t layers) {
-  auto grouped = group_keys(path, key_values);
-  if (!grouped.ok()) return grouped.status();
-  const bool layer_per_segment = layers > 1 && layers == static_cast<int64_t>(grouped->size());
+  LABELMESH_ASSIGN_OR_RETURN(auto grouped, group_keys(path, key_values));
+  const bool layer_per_segment = layers > 1 && layers == static_cast<int64_t>(grouped.size());
   std::vector<SlicerSegment> segments;
-  segments.reserve(grouped->size());
-  for (const auto& [index, keys] : *grouped) {
+  segments.reserve(grouped.size());
+  for (const auto& [index, keys] : grouped) {
     auto segment = parse_segment(path, index, keys, layers, layer_per_segment);
     if (!segment.ok()) return segment.status();
     segments.push_back(std::move(*segment));

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <fstream>
 
+#include "core/util/status_macros.h"
 #include "core/util/text.h"
 #include "core/volume/header_checks.h"
 #include "core/volume/header_formats.h"
@@ -129,12 +130,11 @@ absl::Status check_whole_payload(const VolumeHeader& header) {
                                               header.compressed_bytes);
   if (!stream.ok()) return stream.status();
   const uint64_t needed = header.decoded_offset + header.data_bytes();
-  auto got = (*stream)->skip(needed);
-  if (!got.ok()) return got.status();
-  if (*got < needed) {
+  LABELMESH_ASSIGN_OR_RETURN(auto got, (*stream)->skip(needed));
+  if (got < needed) {
     return internal::field_error(header.data_path, "voxel data",
                                  cat("is truncated: the header needs ", needed,
-                                     " decoded bytes, the compressed stream holds ", *got));
+                                     " decoded bytes, the compressed stream holds ", got));
   }
   // Whatever follows the voxels is decoded too, so that the stream's own
   // check at its end is read; but a bomb of zeros after them is bounded.

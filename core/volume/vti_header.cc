@@ -56,9 +56,8 @@ absl::StatusOr<ScalarType> vti_scalar_type(const std::string& path, std::string_
 }  // namespace
 
 absl::StatusOr<VolumeHeader> check_vti_header(const std::string& path, const ReadLimits& limits) {
-  auto bytes = read_prefix(path, limits.max_header_bytes, false);
-  if (!bytes.ok()) return bytes.status();
-  const std::string_view xml = *bytes;
+  LABELMESH_ASSIGN_OR_RETURN(auto bytes, read_prefix(path, limits.max_header_bytes, false));
+  const std::string_view xml = bytes;
   auto file = find_element(xml, "<VTKFile");
   if (!file || find_attribute(*file, "type") != "ImageData") {
     return field_error(path, "VTKFile", "is not a VTK XML ImageData file");

@@ -207,11 +207,10 @@ absl::StatusOr<TetMesh> run(const surface::TriangleMesh& mesh, int32_t label,
                             const RunContext& context, TetgenFigures& figures) {
   LABELMESH_RETURN_IF_ERROR(check_tetgen_params(params));
   const std::string what = cat("the surface of label ", label);
-  auto boundary = used_boundary(mesh, label);
-  if (!boundary.ok()) return boundary.status();
-  figures.input_points = boundary->points.size();
-  figures.input_triangles = boundary->triangles.size();
-  if (six_enclosed_volume(*boundary) <= 0) {
+  LABELMESH_ASSIGN_OR_RETURN(auto boundary, used_boundary(mesh, label));
+  figures.input_points = boundary.points.size();
+  figures.input_triangles = boundary.triangles.size();
+  if (six_enclosed_volume(boundary) <= 0) {
     return absl::FailedPreconditionError(
         cat("the surface of label ", label,
             " encloses no volume: it is wound inwards or flat (normals must point out)"));
@@ -220,7 +219,7 @@ absl::StatusOr<TetMesh> run(const surface::TriangleMesh& mesh, int32_t label,
   context.report(kStage, 0);
 
   tetgenio in;
-  fill_triangle_plc(boundary->points, boundary->triangles, in);
+  fill_triangle_plc(boundary.points, boundary.triangles, in);
 
   // -d reports intersecting facets instead of failing, which TetGen 1.5.0 cannot do safely.
   {
@@ -235,14 +234,14 @@ absl::StatusOr<TetMesh> run(const surface::TriangleMesh& mesh, int32_t label,
   LABELMESH_RETURN_IF_ERROR(context.check_stop());
   context.report(kStage, 0.2);
 
-  if (known_holes != nullptr || component_count(*boundary) > 1) {
+  if (known_holes != nullptr || component_count(boundary) > 1) {
     absl::StatusOr<std::vector<Vec3>> holes;
     if (known_holes != nullptr) {
       holes = *known_holes;
     } else {
       tetgenio cdt;
       LABELMESH_RETURN_IF_ERROR(run_tetgen("pzQ", in, cdt, what));
-      holes = cavity_points(*boundary, cdt, label);
+      holes = cavity_points(boundary, cdt, label);
     }
     if (!holes.ok()) return holes.status();
     if (!holes->empty()) {

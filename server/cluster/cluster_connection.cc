@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 #include "server/cluster/cluster_connection.h"
 
+#include "core/util/status_macros.h"
+
 namespace labelmesh::cluster {
 
 absl::StatusOr<std::unique_ptr<ClusterConnection>> ClusterConnection::open(
@@ -10,9 +12,8 @@ absl::StatusOr<std::unique_ptr<ClusterConnection>> ClusterConnection::open(
       NatsClient::connect(settings.nats_url, settings.connection_name, settings.connect_timeout);
   if (!client.ok()) return client.status();
   connection->client = std::move(*client);
-  auto queue = JobQueue::open(*connection->client, settings.queue);
-  if (!queue.ok()) return queue.status();
-  connection->queue = std::move(*queue);
+  LABELMESH_ASSIGN_OR_RETURN(auto queue, JobQueue::open(*connection->client, settings.queue));
+  connection->queue = std::move(queue);
   auto states = JobStates::open(*connection->client, settings.states_bucket);
   if (!states.ok()) return states.status();
   connection->states = std::move(*states);

@@ -102,9 +102,8 @@ absl::StatusOr<v1::JobRecord> ClusterJobStore::record(const std::string& job_id)
 }
 
 absl::StatusOr<v1::Job> ClusterJobStore::get(const std::string& job_id) const {
-  auto found = record(job_id);
-  if (!found.ok()) return found.status();
-  v1::Job job = found->job();
+  LABELMESH_ASSIGN_OR_RETURN(auto found, record(job_id));
+  v1::Job job = found.job();
   if (job.state() == v1::JOB_STATE_RUNNING) {
     // The record holds no stage: the newest event tells it.
     auto last = cluster_.events->last(job_id);
@@ -122,16 +121,14 @@ absl::StatusOr<v1::Job> ClusterJobStore::get(const std::string& job_id) const {
 }
 
 absl::StatusOr<std::string> ClusterJobStore::owner(const std::string& job_id) const {
-  auto found = record(job_id);
-  if (!found.ok()) return found.status();
-  return found->job().owner();
+  LABELMESH_ASSIGN_OR_RETURN(auto found, record(job_id));
+  return found.job().owner();
 }
 
 absl::StatusOr<JobStore::JobPage> ClusterJobStore::list(const JobQuery& query) const {
-  auto ids = cluster_.jobs->job_ids();
-  if (!ids.ok()) return ids.status();
+  LABELMESH_ASSIGN_OR_RETURN(auto ids, cluster_.jobs->job_ids());
   std::vector<v1::Job> jobs;
-  for (const auto& id : *ids) {
+  for (const auto& id : ids) {
     auto found = record(id);
     if (found.status().code() == absl::StatusCode::kNotFound) continue;  // deleted meanwhile
     if (!found.ok()) return found.status();
@@ -155,33 +152,30 @@ absl::Status ClusterJobStore::erase(const std::string& job_id) const {
 }
 
 absl::StatusOr<v1::JobState> ClusterJobStore::remove(const std::string& job_id) {
-  auto found = record(job_id);
-  if (!found.ok()) return found.status();
+  LABELMESH_ASSIGN_OR_RETURN(auto found, record(job_id));
   auto removed = cluster_.jobs->remove(job_id);
   if (!removed.ok()) return removed.status();
   // A running job's worker removes its files once it stops.
   if (*removed) files_.remove_job(job_id);
   spdlog::info("job {} deleted by a client", job_id);
-  return found->job().state();
+  return found.job().state();
 }
 
 absl::StatusOr<v1::Job> ClusterJobStore::cancel(const std::string& job_id) {
   auto found = record(job_id);
   if (!found.ok()) return found.status();
-  auto cancelled = cluster_.jobs->cancel(job_id);
-  if (!cancelled.ok()) return cancelled.status();
-  return with_timestamps(cancelled->job());
+  LABELMESH_ASSIGN_OR_RETURN(auto cancelled, cluster_.jobs->cancel(job_id));
+  return with_timestamps(cancelled.job());
 }
 
 absl::StatusOr<std::vector<v1::Artifact>> ClusterJobStore::artifacts(
     const std::string& job_id) const {
-  auto found = record(job_id);
-  if (!found.ok()) return found.status();
-  if (found->job().state() != v1::JOB_STATE_SUCCEEDED) {
+  LABELMESH_ASSIGN_OR_RETURN(auto found, record(job_id));
+  if (found.job().state() != v1::JOB_STATE_SUCCEEDED) {
     return absl::FailedPreconditionError(absl::StrCat("job ", job_id, " has no results: it is ",
-                                                      v1::JobState_Name(found->job().state())));
+                                                      v1::JobState_Name(found.job().state())));
   }
-  return std::vector<v1::Artifact>(found->artifacts().begin(), found->artifacts().end());
+  return std::vector<v1::Artifact>(found.artifacts().begin(), found.artifacts().end());
 }
 
 std::string ClusterJobStore::artifact_path(const v1::Job& job, const std::string& name) const {
@@ -190,10 +184,9 @@ std::string ClusterJobStore::artifact_path(const v1::Job& job, const std::string
 
 absl::Status ClusterJobStore::replay_ended(const v1::JobRecord& record, uint64_t from,
                                            EventListener* listener) {
-  auto follower = cluster_.events->follow(record.job().job_id(), from);
-  if (!follower.ok()) return follower.status();
+  LABELMESH_ASSIGN_OR_RETURN(auto follower, cluster_.events->follow(record.job().job_id(), from));
   for (;;) {
-    auto next = (*follower)->next(kReplayWait);
+    auto next = (follower)->next(kReplayWait);
     if (!next.ok()) return next.status();
     if (!next->has_value()) break;
     const v1::JobEvent event = watched_event(**next);
@@ -217,9 +210,8 @@ absl::Status ClusterJobStore::listen(const std::string& job_id, uint64_t from,
     absl::MutexLock lock(&mutex_);
     if (closed_) return absl::UnavailableError("the server is shutting down");
   }
-  auto found = record(job_id);
-  if (!found.ok()) return found.status();
-  if (has_ended(found->job().state())) return replay_ended(*found, from, listener);
+  LABELMESH_ASSIGN_OR_RETURN(auto found, record(job_id));
+  if (has_ended(found.job().state())) return replay_ended(found, from, listener);
   auto heard_last = std::make_shared<std::atomic<bool>>(false);
   auto subscription =
       cluster_.events->subscribe(job_id, from, [listener, heard_last](cluster::LoggedEvent logged) {

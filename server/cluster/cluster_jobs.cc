@@ -45,12 +45,11 @@ template <typename Change>
 absl::StatusOr<v1::JobRecord> ClusterJobs::change_record(const std::string& job_id,
                                                          Change&& change) {
   for (;;) {
-    auto stored = states_.get(job_id);
-    if (!stored.ok()) return stored.status();
-    auto record = parse(*stored, job_id);
+    LABELMESH_ASSIGN_OR_RETURN(auto stored, states_.get(job_id));
+    auto record = parse(stored, job_id);
     if (!record.ok()) return record.status();
     LABELMESH_RETURN_IF_ERROR(change(*record));
-    auto written = states_.update(job_id, record->SerializeAsString(), stored->revision);
+    auto written = states_.update(job_id, record->SerializeAsString(), stored.revision);
     if (written.ok()) return record;
     if (written.status().code() != absl::StatusCode::kAborted) return written.status();
     // Another writer came in between: read again and decide again.
@@ -87,9 +86,8 @@ absl::StatusOr<v1::JobRecord> ClusterJobs::submit(v1::JobRecord record) {
 }
 
 absl::StatusOr<v1::JobRecord> ClusterJobs::get(const std::string& job_id) {
-  auto stored = states_.get(job_id);
-  if (!stored.ok()) return stored.status();
-  return parse(*stored, job_id);
+  LABELMESH_ASSIGN_OR_RETURN(auto stored, states_.get(job_id));
+  return parse(stored, job_id);
 }
 
 absl::StatusOr<Claim> ClusterJobs::claim(const std::string& job_id, const Delivered& from) {

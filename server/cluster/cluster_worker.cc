@@ -8,10 +8,9 @@
 namespace labelmesh::cluster {
 
 absl::StatusOr<bool> ClusterWorker::run_one() {
-  auto taken = queue_.take(config_.poll);
-  if (!taken.ok()) return taken.status();
-  if (!taken->has_value()) return false;
-  JobDelivery& delivery = **taken;
+  LABELMESH_ASSIGN_OR_RETURN(auto taken, queue_.take(config_.poll));
+  if (!taken.has_value()) return false;
+  JobDelivery& delivery = *taken;
   const bool final_delivery = delivery.delivered() >= static_cast<uint64_t>(queue_.max_deliver());
   auto claim =
       jobs_.claim(delivery.job_id(), {delivery.made(), delivery.sequence(), final_delivery});

@@ -4,6 +4,7 @@
 #include <filesystem>
 
 #include "absl/strings/str_cat.h"
+#include "core/util/status_macros.h"
 #include "server/durable_file.h"
 #include "server/job_limits.h"
 #include "server/spool.h"
@@ -51,9 +52,8 @@ absl::StatusOr<std::unique_ptr<ClusterWorkerRole>> ClusterWorkerRole::start(
     const cluster::SharedArtifacts& files, Metrics& metrics) {
   std::unique_ptr<ClusterWorkerRole> role(new ClusterWorkerRole(config, files, metrics));
   for (int i = 0; i < config.workers; ++i) {
-    auto connection = cluster::ClusterConnection::open(settings);
-    if (!connection.ok()) return connection.status();
-    role->connections_.push_back(std::move(*connection));
+    LABELMESH_ASSIGN_OR_RETURN(auto connection, cluster::ClusterConnection::open(settings));
+    role->connections_.push_back(std::move(connection));
   }
   for (auto& connection : role->connections_) {
     role->slots_.emplace_back([r = role.get(), c = connection.get()] { r->run_slot(*c); });

@@ -2,6 +2,7 @@
 #include "server/cluster/job_states.h"
 
 #include "absl/strings/str_cat.h"
+#include "core/util/status_macros.h"
 
 namespace labelmesh::cluster {
 
@@ -49,11 +50,10 @@ absl::StatusOr<uint64_t> JobStates::update(const std::string& key, const std::st
   const natsStatus status = kvStore_Update(&written, store_, key.c_str(), value.data(),
                                            static_cast<int>(value.size()), revision);
   if (status == NATS_OK) return written;
-  auto current = get(key);
-  if (!current.ok()) return current.status();
-  if (current->revision != revision) {
+  LABELMESH_ASSIGN_OR_RETURN(auto current, get(key));
+  if (current.revision != revision) {
     return absl::AbortedError(absl::StrCat("job state ", key, " changed: revision ",
-                                           current->revision, ", not ", revision));
+                                           current.revision, ", not ", revision));
   }
   return nats_error(status, absl::StrCat("updating job state ", key));
 }

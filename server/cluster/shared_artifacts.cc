@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "absl/strings/str_cat.h"
+#include "core/util/status_macros.h"
 #include "server/durable_file.h"
 
 namespace labelmesh::cluster {
@@ -88,9 +89,8 @@ absl::Status SharedArtifacts::put(std::string_view relative, std::string_view by
 }
 
 absl::StatusOr<std::string> SharedArtifacts::get(std::string_view relative) const {
-  auto path = resolve(relative);
-  if (!path.ok()) return path.status();
-  std::ifstream in(*path, std::ios::binary);
+  LABELMESH_ASSIGN_OR_RETURN(auto path, resolve(relative));
+  std::ifstream in(path, std::ios::binary);
   if (!in)
     return absl::NotFoundError(absl::StrCat("artifact ", std::string(relative), " not found"));
   std::stringstream bytes;
@@ -100,12 +100,11 @@ absl::StatusOr<std::string> SharedArtifacts::get(std::string_view relative) cons
 
 absl::StatusOr<size_t> SharedArtifacts::remove_other_attempts(const std::string& job_id,
                                                               uint32_t kept) const {
-  auto job_dir = resolve(absl::StrCat("jobs/", job_id));
-  if (!job_dir.ok()) return job_dir.status();
+  LABELMESH_ASSIGN_OR_RETURN(auto job_dir, resolve(absl::StrCat("jobs/", job_id)));
   const std::string keep = absl::StrCat("out-", kept);
   size_t removed = 0;
   std::error_code error;
-  for (const auto& entry : fs::directory_iterator(*job_dir, error)) {
+  for (const auto& entry : fs::directory_iterator(job_dir, error)) {
     const std::string name = entry.path().filename().string();
     if (name.rfind("out-", 0) != 0 || name == keep) continue;
     fs::remove_all(entry.path(), error);
