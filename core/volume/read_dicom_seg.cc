@@ -116,7 +116,9 @@ absl::StatusOr<LabelVolume> read_dicom_seg(const std::string& path, const ReadLi
                                     " segment items are malformed"));
   }
   LABELMESH_ASSIGN_OR_RETURN(auto pixels, pixel_bytes(path, *file.getDataset()));
-  const auto [bytes, byte_count] = pixels;
+  // Named, not bound: a lambda below captures them.
+  const uint8_t* const bytes = pixels.first;
+  const size_t byte_count = pixels.second;
   context.report("read", 0.5);
 
   const uint64_t rows = header->rows, columns = header->columns;
