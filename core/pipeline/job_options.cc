@@ -298,24 +298,12 @@ absl::Status read_volume_options(const v1::MeshOptions& options, MeshParams& par
   if (options.has_tet_improve_quality())
     params.improve.target_quality = options.tet_improve_quality();
   if (params.volume == VolumeMethod::kNone) return absl::OkStatus();
-  // The ranges are TetGen's, as tetrahedralize() checks them; a job should be
-  // refused here, before any surface work is done.
-  if (!(tetgen.radius_edge_ratio >= 1 && tetgen.radius_edge_ratio <= 100))
-    return absl::InvalidArgumentError(
-        cat("tet_radius_edge: ", tetgen.radius_edge_ratio, " is outside [1, 100]"));
-  if (!(tetgen.min_dihedral_deg >= 0 && tetgen.min_dihedral_deg <= 30))
-    return absl::InvalidArgumentError(
-        cat("tet_min_dihedral_deg: ", tetgen.min_dihedral_deg, " is outside [0, 30]"));
-  if (!(tetgen.max_dihedral_deg >= 90 && tetgen.max_dihedral_deg <= 179))
-    return absl::InvalidArgumentError(
-        cat("tet_max_dihedral_deg: ", tetgen.max_dihedral_deg, " is outside [90, 179]"));
+  // TetGen's ranges, as every TetGen run checks them: a job is refused here,
+  // before any surface work is done.
+  LABELMESH_RETURN_IF_ERROR(volume_mesh::check_tetgen_params(tetgen));
   if (!(params.improve.target_quality >= 0 && params.improve.target_quality < 1))
     return absl::InvalidArgumentError(
         cat("tet_improve_quality: ", params.improve.target_quality, " is outside [0, 1)"));
-  if (!(tetgen.max_volume_mm3 == 0 ||
-        (tetgen.max_volume_mm3 >= 1e-6 && tetgen.max_volume_mm3 <= 1e12)))
-    return absl::InvalidArgumentError(
-        cat("tet_max_volume_mm3: ", tetgen.max_volume_mm3, " is neither 0 nor in [1e-6, 1e12]"));
   return absl::OkStatus();
 }
 

@@ -63,31 +63,6 @@ absl::Status run_tetgen(const std::string& switches, tetgenio& in, tetgenio& out
   return absl::OkStatus();
 }
 
-absl::Status check_tetgen_params(const TetgenParams& params) {
-  const double ratio = params.radius_edge_ratio;
-  if (!std::isfinite(ratio) || ratio < 1.0 || ratio > 100.0) {
-    return absl::InvalidArgumentError(
-        cat("tet-radius-edge: is ", ratio,
-            "; it must be in [1, 100] (TetGen may not terminate below 1)"));
-  }
-  const double angle = params.min_dihedral_deg;
-  if (!std::isfinite(angle) || angle < 0.0 || angle > 30.0) {
-    return absl::InvalidArgumentError(
-        cat("tet-min-dihedral: is ", angle, " degrees; it must be in [0, 30] (0: no bound)"));
-  }
-  const double max_angle = params.max_dihedral_deg;
-  if (!std::isfinite(max_angle) || max_angle < 90.0 || max_angle > 179.0) {
-    return absl::InvalidArgumentError(
-        cat("tet-max-dihedral: is ", max_angle, " degrees; it must be in [90, 179]"));
-  }
-  const double volume = params.max_volume_mm3;
-  if (!std::isfinite(volume) || (volume != 0.0 && (volume < 1e-6 || volume > 1e12))) {
-    return absl::InvalidArgumentError(
-        cat("tet-max-volume: is ", volume, " mm³; it must be 0 (no bound) or in [1e-6, 1e12]"));
-  }
-  return absl::OkStatus();
-}
-
 void fill_triangle_plc(const std::vector<std::array<double, 3>>& points,
                        const std::vector<std::array<uint32_t, 3>>& triangles, tetgenio& in) {
   in.firstnumber = 0;

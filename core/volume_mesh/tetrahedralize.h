@@ -49,7 +49,9 @@ struct TetgenFigures {
   double seconds = 0;          // wall time of the whole call
 };
 
-// INVALID_ARGUMENT naming the option when a parameter is out of range.
+// INVALID_ARGUMENT naming the job option (tet_radius_edge, ...) when a
+// parameter is out of TetGen's range. In the job checks library
+// (tetgen_params.cc): the job options use it too.
 absl::Status check_tetgen_params(const TetgenParams& params);
 
 // Meshes the region inside `boundary` with tetrahedra labelled `label`.
@@ -69,7 +71,7 @@ absl::Status check_tetgen_params(const TetgenParams& params);
 //
 // Errors:
 // - INVALID_ARGUMENT: a parameter out of range (the message names the option, e.g.
-//   "tet-radius-edge: ..."); a boundary with fewer than 4 points or 4 triangles, a triangle
+//   "tet_radius_edge: ..."); a boundary with fewer than 4 points or 4 triangles, a triangle
 //   naming a missing point, or a triangle with a repeated corner.
 // - FAILED_PRECONDITION: the surface intersects itself (found by TetGen's -d check), is wound
 //   inwards, or TetGen rejects it (a feature below its tolerance, nearly coincident facets).

@@ -272,13 +272,13 @@ TEST(Tetrahedralize, OutOfRangeParametersNameTheOption) {
   std::vector<Case> cases;
   const double nan = std::numeric_limits<double>::quiet_NaN();
   for (double ratio : {0.9, 0.0, -1.0, 101.0, nan}) {
-    cases.push_back({TetgenParams{.radius_edge_ratio = ratio}, "tet-radius-edge"});
+    cases.push_back({TetgenParams{.radius_edge_ratio = ratio}, "tet_radius_edge"});
   }
   for (double angle : {-1.0, 31.0, 70.0, nan}) {
-    cases.push_back({TetgenParams{.min_dihedral_deg = angle}, "tet-min-dihedral"});
+    cases.push_back({TetgenParams{.min_dihedral_deg = angle}, "tet_min_dihedral_deg"});
   }
   for (double volume : {-1.0, 1e-9, 1e13, std::numeric_limits<double>::infinity(), nan}) {
-    cases.push_back({TetgenParams{.max_volume_mm3 = volume}, "tet-max-volume"});
+    cases.push_back({TetgenParams{.max_volume_mm3 = volume}, "tet_max_volume_mm3"});
   }
   for (const auto& c : cases) {
     TetgenFigures figures;
