@@ -16,7 +16,7 @@
 #include "core/volume/label_description.h"
 #include "core/volume/volume_header.h"
 #include "core/volume_mesh/improve_tet_mesh.h"
-#include "core/volume_mesh/tetrahedralize.h"
+#include "core/volume_mesh/tetgen_params.h"
 #include "core/volume_mesh/volume_format.h"
 
 namespace labelmesh {

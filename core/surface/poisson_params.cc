@@ -1,7 +1,6 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-// The Poisson options' checks that need no CGAL, so that job options can be
-// validated where CGAL is not linked.
-#include "core/surface/poisson_surface.h"
+#include "core/surface/poisson_params.h"
+
 #include "core/util/text.h"
 
 namespace labelmesh::surface {

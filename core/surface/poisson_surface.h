@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
+#include "core/surface/poisson_params.h"
 #include "core/surface/triangle_mesh.h"
 #include "core/util/run_context.h"
 #include "core/util/vec3.h"
@@ -34,15 +35,6 @@ enum class PointReduction {
   // sphere's vertices come out rougher (docs/pipeline.md, "Point reduction").
   kHierarchy,
 };
-
-// Clusters larger than this thin the points more than any use we measured.
-inline constexpr uint32_t kMaxClusterSize = 64;
-// A point budget below this thins even a small organ's surface.
-inline constexpr uint64_t kMinPointBudget = 1000;
-
-// A point count that 0 turns off (max_points, split_points): otherwise at
-// least kMinPointBudget. INVALID_ARGUMENT names `field`.
-absl::Status check_point_count(std::string_view field, uint64_t value);
 
 struct PoissonParams {
   // Surface mesher criteria (CGAL Surface_mesh_default_criteria_3).

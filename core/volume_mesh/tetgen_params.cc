@@ -1,11 +1,9 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-// TetGen's parameter ranges, checked once for the job options and for every
-// TetGen run. Part of the job checks, so that a job is refused before any
-// surface work and the server needs no TetGen to refuse it.
+#include "core/volume_mesh/tetgen_params.h"
+
 #include <cmath>
 
 #include "core/util/text.h"
-#include "core/volume_mesh/tetrahedralize.h"
 
 namespace labelmesh::volume_mesh {
 
