@@ -208,10 +208,7 @@ absl::Status MeshingService::fetch(grpc::ServerContext& context, const v1::Fetch
   do {
     in.read(buffer.data(), static_cast<std::streamsize>(buffer.size()));
     chunk.set_data(buffer.data(), static_cast<size_t>(in.gcount()));
-    if (!writer.Write(chunk)) {
-      LABELMESH_RETURN_IF_ERROR(ticket->cancellation());
-      return absl::CancelledError("reader left");
-    }
+    if (!writer.Write(chunk)) return ticket->cancellation_or(absl::CancelledError("reader left"));
     sent += chunk.data().size();
     ticket->touch(sent);
     chunk.clear_artifact();

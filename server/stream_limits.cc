@@ -106,6 +106,11 @@ absl::Status StreamWatchdog::Ticket::cancellation() const {
   return it == watchdog_.entries_.end() ? absl::OkStatus() : it->second.cancellation;
 }
 
+absl::Status StreamWatchdog::Ticket::cancellation_or(absl::Status otherwise) const {
+  absl::Status cancelled = cancellation();
+  return cancelled.ok() ? otherwise : cancelled;
+}
+
 std::unique_ptr<StreamWatchdog::Ticket> StreamWatchdog::watch(grpc::ServerContextBase* context,
                                                               absl::Duration idle,
                                                               absl::Duration total,

@@ -106,6 +106,9 @@ class StreamWatchdog {
     // DEADLINE_EXCEEDED saying why, marked stalled or too_slow, when the
     // watchdog cancelled the stream; OK otherwise.
     absl::Status cancellation() const;
+    // The cancellation when there is one, else `otherwise`: how a stream
+    // that stopped ends.
+    absl::Status cancellation_or(absl::Status otherwise) const;
 
    private:
     friend class StreamWatchdog;

@@ -68,12 +68,6 @@ RequestsInFlight::Claim::~Claim() {
   requests_.claims_.erase(key_);
 }
 
-absl::Status SubmitUpload::stalled_or(const StreamWatchdog::Ticket& ticket,
-                                      absl::Status otherwise) const {
-  absl::Status cancelled = ticket.cancellation();
-  return cancelled.ok() ? otherwise : cancelled;
-}
-
 absl::Status SubmitUpload::check_spool_space(uint64_t upload_bytes) const {
   const ServerConfig& config = services_.config;
   auto free = services_.store.free_bytes();
@@ -150,7 +144,7 @@ absl::Status SubmitUpload::run(v1::SubmitReply& reply) {
   if (!upload_slot.ok()) return upload_slot.status();
   v1::SubmitRequest first;
   if (!reader_.Read(&first) || !first.has_spec())
-    return stalled_or(*ticket, bad_request("the first message must hold the job spec"));
+    return ticket->cancellation_or(bad_request("the first message must hold the job spec"));
   ticket->touch();
   v1::JobSpec spec = first.spec();
   auto checked = check_spec(spec, config);
@@ -241,7 +235,8 @@ absl::Status SubmitUpload::run(v1::SubmitReply& reply) {
   record.set_input_extension(extension);
   // A client that left (or the watchdog dropped) hears nothing: no job.
   if (context_.IsCancelled()) {
-    return stalled_or(*ticket, refused(Refusal::kStalled, absl::CancelledError("the client left")));
+    return ticket->cancellation_or(
+        refused(Refusal::kStalled, absl::CancelledError("the client left")));
   }
   // The store's refusals come marked queue_full or disk_full.
   LABELMESH_ASSIGN_OR_RETURN(auto position, store.accept(std::move(record), upload.path()));

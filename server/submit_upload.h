@@ -83,9 +83,6 @@ class SubmitUpload {
   // The chunks into `path`, checked against the spec's size and SHA-256.
   absl::Status receive(const v1::JobSpec& spec, const std::string& path,
                        StreamWatchdog::Ticket& ticket);
-  // The stream's cancellation by the watchdog when it has one, else
-  // `otherwise`.
-  absl::Status stalled_or(const StreamWatchdog::Ticket& ticket, absl::Status otherwise) const;
 
   SubmitServices services_;
   grpc::ServerContext& context_;

@@ -77,8 +77,8 @@ void WatchReactor::OnCancel() {
 }
 
 grpc::Status WatchReactor::left_or_stalled() const {
-  absl::Status stalled = ticket_ ? ticket_->cancellation() : absl::OkStatus();
-  return to_grpc(stalled.ok() ? absl::CancelledError("watcher left") : stalled);
+  const absl::Status left = absl::CancelledError("watcher left");
+  return to_grpc(ticket_ ? ticket_->cancellation_or(left) : left);
 }
 
 void WatchReactor::finish(const grpc::Status& status) {
