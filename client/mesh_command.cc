@@ -11,7 +11,7 @@
 #include "client/pipeline_options.h"
 #include "client/report_table.h"
 #include "client/terminal_progress.h"
-#include "core/pipeline/job_options.h"
+#include "core/job/job_options.h"
 #include "core/pipeline/pipeline.h"
 #include "core/pipeline/report.h"
 #include "core/pipeline/write_results.h"

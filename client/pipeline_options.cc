@@ -5,7 +5,7 @@
 
 #include <cstdio>
 
-#include "core/pipeline/job_options.h"
+#include "core/job/job_options.h"
 #include "core/volume/label_table.h"
 
 namespace labelmesh::client {

@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
-#include "core/pipeline/mesh_params.h"
+#include "core/job/mesh_params.h"
 #include "labelmesh/v1/options.pb.h"
 
 namespace CLI {

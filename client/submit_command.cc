@@ -20,10 +20,10 @@
 #include "client/report_table.h"
 #include "client/server_connection.h"
 #include "core/digest/sha256.h"
-#include "core/pipeline/job_options.h"
+#include "core/header/volume_header.h"
+#include "core/job/job_options.h"
 #include "core/pipeline/report.h"
 #include "core/util/status_macros.h"
-#include "core/volume/volume_header.h"
 #include "labelmesh/v1/service.grpc.pb.h"
 
 namespace labelmesh::client {

@@ -7,8 +7,8 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_replace.h"
 #include "core/digest/sha256.h"
-#include "core/pipeline/job_options.h"
-#include "core/volume/volume_header.h"
+#include "core/header/volume_header.h"
+#include "core/job/job_options.h"
 #include "server/refusal.h"
 
 namespace labelmesh::server {

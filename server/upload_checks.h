@@ -6,8 +6,8 @@
 #include <string>
 
 #include "absl/status/statusor.h"
-#include "core/pipeline/mesh_params.h"
-#include "core/volume/image_geometry.h"
+#include "core/header/image_geometry.h"
+#include "core/job/mesh_params.h"
 #include "labelmesh/v1/service.pb.h"
 #include "server/server_config.h"
 

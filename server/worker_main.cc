@@ -22,14 +22,14 @@
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_replace.h"
-#include "core/pipeline/job_options.h"
+#include "core/job/job_options.h"
 #include "core/pipeline/pipeline.h"
 #include "core/pipeline/report.h"
 #include "core/pipeline/write_results.h"
 #include "core/util/status_macros.h"
 #include "core/volume/read_label_volume.h"
 #include "server/event_pipe.h"
-#include "server/worker_process.h"
+#include "server/worker_protocol.h"
 
 namespace labelmesh::server {
 namespace {

@@ -27,6 +27,7 @@
 #include "absl/strings/str_replace.h"
 #include "absl/strings/str_split.h"
 #include "server/event_pipe.h"
+#include "server/worker_protocol.h"
 #include "spdlog/spdlog.h"
 
 namespace labelmesh::server {

@@ -17,10 +17,6 @@
 
 namespace labelmesh::server {
 
-// The environment variable that tells a worker how many labels to mesh at
-// once: the server's cores divided among its workers.
-inline constexpr char kJobThreadsVariable[] = "LABELMESH_JOB_THREADS";
-
 struct WorkerLimits {
   // Labels meshed at once; 0: the worker's default (every core).
   unsigned threads = 0;
@@ -59,15 +55,6 @@ struct WorkerRun {
   // Polled every 100 ms.
   std::function<StopRequest()> stop_request;
 };
-
-// The first argument of a worker started for a job.
-inline constexpr char kWorkerMode[] = "--worker";
-// `labelmesh-worker --check-volume FILE MAX_VOXELS`: reads the whole volume
-// with the readers a job uses, writes why it cannot be read to descriptor 3,
-// exits 0 if it can.
-inline constexpr char kCheckVolumeMode[] = "--check-volume";
-// What `labelmesh-worker --version` prints, and what the server expects.
-inline constexpr char kWorkerVersionLine[] = "labelmesh-worker " LABELMESH_VERSION;
 
 WorkerOutcome run_worker_process(const WorkerRun& run);
 

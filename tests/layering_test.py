@@ -1,64 +1,145 @@
 #!/usr/bin/python3
 # SPDX-License-Identifier: AGPL-3.0-or-later
-"""Includes follow the layers docs/architecture.md draws: util and digest
-include nothing above them, the stage folders never include the pipeline,
-the server (but its worker) only the job checks, the client never the
-server, and neither links CGAL, VTK or TetGen headers directly. Prints each
-include that breaks a rule, with its file and line."""
+"""Every include follows the build's links, read from CMake's code model (the
+file API reply in the build directory): a file of target T includes only
+project headers of T or of a target T links, directly or through others.
+Also: each folder of core/ is one target, labelmesh_<folder>, with no files
+elsewhere; the server and the client reach CGAL, VTK and TetGen only through
+core. CMake's build order has no cycles (it drops a link that would close
+one), so a cycle shows as an include across a missing link. Prints each break with its file
+and line.
 
+Usage: layering_test.py BUILD_DIR"""
+
+import json
 import pathlib
 import re
+import subprocess
 import sys
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 INCLUDE = re.compile(r'^\s*#\s*include\s*([<"])([^>"]+)[>"]')
-
-STAGES = ["volume", "surface", "volume_mesh", "quality", "mixed_mesh", "conforming", "dicom"]
-# What the serving process may include of core: the job checks (options,
-# volume headers), the digest and the status macros. labelmesh-worker
-# (worker_main.cc) runs the whole pipeline.
-SERVER_CORE = re.compile(r"^core/(digest/|util/status_macros\.h|pipeline/job_options\.h|"
-                         r"pipeline/mesh_params\.h|"
-                         r"volume/(image_geometry|volume_header|header_checks)\.h)")
 HEAVY = re.compile(r"^(CGAL/|vtk|tetgen\.h)")
 
 
+def code_model(build):
+    """Target name -> (its project source paths, names of the targets it
+    depends on). Asks CMake to write the reply when it has not yet."""
+    api = build / ".cmake" / "api" / "v1"
+    query = api / "query" / "codemodel-v2"
+    replies = api / "reply"
+    if not query.exists():
+        query.parent.mkdir(parents=True, exist_ok=True)
+        query.touch()
+    if not list(replies.glob("codemodel-v2-*.json")):
+        subprocess.run(["cmake", str(build)], check=True, stdout=subprocess.DEVNULL)
+    model = json.loads(next(replies.glob("codemodel-v2-*.json")).read_text())
+    targets = {}
+    for entry in model["configurations"][0]["targets"]:
+        target = json.loads((replies / entry["jsonFile"]).read_text())
+        sources = {s["path"] for s in target.get("sources", []) if is_project_file(s["path"], build)}
+        depends = {d["id"].split("::")[0] for d in target.get("dependencies", [])}
+        targets[target["name"]] = (sources, depends)
+    return targets
+
+
+def is_project_file(path, build):
+    """A file of the source tree, not one the build generates."""
+    full = (ROOT / path).resolve()
+    return full.is_file() and full.is_relative_to(ROOT) and not full.is_relative_to(build)
+
+
+def reachable(targets, name):
+    seen, stack = set(), list(targets[name][1])
+    while stack:
+        other = stack.pop()
+        if other not in seen and other in targets:
+            seen.add(other)
+            stack.extend(targets[other][1])
+    return seen
+
+
+def owners(targets):
+    """Project file -> the targets it belongs to: a source's own targets; a
+    header, those of its .cc twin, else those with sources in its folder or
+    the nearest folder above, when that is one target (several: none)."""
+    by_source, by_folder = {}, {}
+    for name, (sources, _) in targets.items():
+        for source in sources:
+            by_source.setdefault(source, set()).add(name)
+            by_folder.setdefault(str(pathlib.PurePosixPath(source).parent), set()).add(name)
+
+    def owner(path):
+        if path in by_source:
+            return by_source[path]
+        twin = re.sub(r"\.h$", ".cc", path)
+        if twin in by_source:
+            return by_source[twin]
+        folder = pathlib.PurePosixPath(path).parent
+        while str(folder) != ".":
+            names = by_folder.get(str(folder))
+            if names:
+                return names if len(names) == 1 else set()
+            folder = folder.parent
+        return set()
+
+    return owner
+
+
 def includes(path):
-    for number, line in enumerate(path.read_text(errors="replace").splitlines(), 1):
+    text = (ROOT / path).read_text(errors="replace")
+    for number, line in enumerate(text.splitlines(), 1):
         match = INCLUDE.match(line)
         if match:
             yield number, match.group(1), match.group(2)
 
 
-def broken_rules(path):
-    relative = path.relative_to(ROOT).as_posix()
-    folder = relative.split("/")
-    for number, bracket, target in includes(path):
-        why = None
-        if bracket == '"' and target.startswith("core/"):
-            layer = target.split("/")[1]
-            if folder[:2] in (["core", "util"], ["core", "digest"]) and layer != folder[1]:
-                why = f"core/{folder[1]} includes nothing above it"
-            elif folder[0] == "core" and folder[1] in STAGES and layer == "pipeline":
-                why = "a stage never includes the pipeline above it"
-            elif (folder[0] == "server" and relative != "server/worker_main.cc"
-                  and not SERVER_CORE.match(target)):
-                why = "the server links only core's job checks and digest"
-        if bracket == '"' and folder[0] == "client" and target.startswith("server/"):
-            why = "the client never includes the server"
-        if folder[0] in ("server", "client") and HEAVY.match(target):
-            why = "the server and client reach CGAL, VTK and TetGen only through core"
-        if why:
-            yield f"{relative}:{number}: #include {target}: {why}"
+def folder_problems(targets):
+    for folder in sorted(p for p in (ROOT / "core").iterdir() if p.is_dir()):
+        name = f"labelmesh_{folder.name}"
+        if name not in targets:
+            yield f"core/{folder.name}: no target {name}"
+            continue
+        for source in sorted(targets[name][0]):
+            if not source.startswith(f"core/{folder.name}/"):
+                yield f"{source}: in {name}, outside core/{folder.name}/"
+        for source in sorted(folder.rglob("*.cc")):
+            relative = source.relative_to(ROOT).as_posix()
+            if relative not in targets[name][0]:
+                yield f"{relative}: not in {name}"
+
+
+def include_problems(targets):
+    owner = owners(targets)
+    files = sorted({p.relative_to(ROOT).as_posix() for folder in ("core", "server", "client", "tests")
+                    for p in (ROOT / folder).rglob("*") if p.suffix in (".h", ".cc")})
+    closure = {name: reachable(targets, name) for name in targets}
+    for path in files:
+        mine = owner(path)
+        top = path.split("/")[0]
+        for number, bracket, included in includes(path):
+            if top in ("server", "client") and HEAVY.match(included):
+                yield (f"{path}:{number}: #include {included}: the server and client reach "
+                       "CGAL, VTK and TetGen only through core")
+            if bracket != '"' or not (ROOT / included).is_file():
+                continue
+            theirs = owner(included)
+            for name in sorted(mine):
+                if theirs and not theirs & (closure[name] | {name}):
+                    yield (f"{path}:{number}: #include {included}: {name} links none of "
+                           f"{sorted(theirs)}")
 
 
 def main():
-    files = [p for folder in ("core", "server", "client") for p in (ROOT / folder).rglob("*")
-             if p.suffix in (".h", ".cc")]
-    problems = [problem for path in sorted(files) for problem in broken_rules(path)]
+    if len(sys.argv) != 2:
+        print(__doc__)
+        return 2
+    targets = code_model(pathlib.Path(sys.argv[1]).resolve())
+    problems = list(folder_problems(targets)) + list(include_problems(targets))
     for problem in problems:
         print(problem)
-    print(f"{len(files)} files read, {len(problems)} includes across the layers")
+    ours = sum(1 for sources, _ in targets.values() if sources)
+    print(f"{ours} targets read, {len(problems)} includes or files across the links")
     return 1 if problems else 0
 
 

@@ -15,7 +15,7 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
-#include "core/conforming/interface_budget.h"
+#include "core/job/interface_budget.h"
 #include "core/util/run_context.h"
 #include "core/volume/label_volume.h"
 

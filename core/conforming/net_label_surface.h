@@ -11,9 +11,9 @@
 #include <vector>
 
 #include "core/conforming/interface_surface.h"
+#include "core/header/image_geometry.h"
 #include "core/surface/crossing_triangles.h"
 #include "core/surface/triangle_mesh.h"
-#include "core/volume/image_geometry.h"
 
 namespace labelmesh::conforming {
 

@@ -7,9 +7,9 @@
 #include <string>
 
 #include "absl/status/status.h"
+#include "core/job/volume_format.h"
 #include "core/mixed_mesh/check_mixed_mesh.h"
 #include "core/mixed_mesh/mixed_mesh.h"
-#include "core/volume_mesh/volume_format.h"
 #include "core/volume_mesh/write_volume_mesh.h"
 
 namespace labelmesh::mixed_mesh {

@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "absl/status/status.h"
-#include "core/pipeline/mesh_params.h"
+#include "core/job/mesh_params.h"
 #include "core/pipeline/mesh_result.h"
 #include "core/util/run_context.h"
 #include "core/volume/label_volume.h"

@@ -13,7 +13,7 @@
 #include "absl/status/statusor.h"
 #include "core/conforming/interface_surface.h"
 #include "core/conforming/label_interfaces.h"
-#include "core/pipeline/mesh_params.h"
+#include "core/job/mesh_params.h"
 #include "core/pipeline/mesh_result.h"
 #include "core/surface/crossing_triangles.h"
 #include "core/util/run_context.h"

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "core/dicom/dicom_source.h"
+#include "core/header/label_description.h"
 #include "core/pipeline/label_mixed_meshes.h"
 #include "core/pipeline/label_tet_meshes.h"
 #include "core/pipeline/surface_fidelity.h"
@@ -20,7 +21,6 @@
 #include "core/surface/surface_statistics.h"
 #include "core/surface/triangle_mesh.h"
 #include "core/util/stage_timer.h"
-#include "core/volume/label_description.h"
 #include "core/volume/label_statistics.h"
 #include "core/volume/label_volume.h"
 #include "core/volume/touching_labels.h"

@@ -7,8 +7,8 @@
 #include <string>
 #include <string_view>
 
+#include "core/header/label_description.h"
 #include "core/util/name_slug.h"
-#include "core/volume/label_description.h"
 
 namespace labelmesh {
 

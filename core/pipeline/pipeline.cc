@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 #include "core/pipeline/pipeline.h"
 
-#include "core/pipeline/job_options.h"
+#include "core/job/job_options.h"
 
 #include <malloc.h>
 
@@ -14,6 +14,7 @@
 #include "absl/synchronization/mutex.h"
 #include "core/dicom/dicom_source.h"
 #include "core/digest/sha256.h"
+#include "core/header/volume_header.h"
 #include "core/pipeline/label_conforming_mesh.h"
 #include "core/pipeline/label_net_surfaces.h"
 #include "core/pipeline/label_queue.h"
@@ -29,7 +30,6 @@
 #include "core/volume/read_label_volume.h"
 #include "core/volume/repeated_planes.h"
 #include "core/volume/touching_labels.h"
-#include "core/volume/volume_header.h"
 
 namespace labelmesh {
 namespace {

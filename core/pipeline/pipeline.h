@@ -6,7 +6,7 @@
 #include <string>
 
 #include "absl/status/statusor.h"
-#include "core/pipeline/mesh_params.h"
+#include "core/job/mesh_params.h"
 #include "core/pipeline/mesh_result.h"
 #include "core/util/run_context.h"
 #include "core/volume/label_volume.h"

@@ -8,8 +8,8 @@
 
 #include "absl/time/clock.h"
 #include "absl/time/time.h"
+#include "core/job/job_options.h"
 #include "core/pipeline/build_info.h"
-#include "core/pipeline/job_options.h"
 #include "core/util/text.h"
 
 namespace labelmesh {

@@ -6,7 +6,7 @@
 #include <string>
 #include <string_view>
 
-#include "core/pipeline/mesh_params.h"
+#include "core/job/mesh_params.h"
 #include "core/pipeline/mesh_result.h"
 #include "labelmesh/v1/report.pb.h"
 

@@ -10,31 +10,12 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
-#include "core/surface/poisson_params.h"
+#include "core/job/poisson_params.h"
 #include "core/surface/triangle_mesh.h"
 #include "core/util/run_context.h"
 #include "core/util/vec3.h"
 
 namespace labelmesh::surface {
-
-// How the oriented points are thinned before the solve (the solve's cost grows
-// with the point count; Marching Cubes points are far denser than needed).
-enum class PointReduction {
-  kNone,
-  // One input point per cube of side `reduction_cell_mm` (CGAL grid
-  // simplification). Kept points lie on the input surface, so the reduction
-  // adds no position error; the input surface is within cell * sqrt(3) of
-  // some kept point.
-  kGrid,
-  // CGAL hierarchy simplification: the point set is split in halves across
-  // its main axis until each cluster holds at most `cluster_size` points, and
-  // each cluster keeps its point nearest the centroid. Kept points lie on the
-  // input surface, as with the grid, but the density follows the points
-  // rather than a fixed lattice. On the liver, clusters of 3 keep the
-  // one-voxel grid's Hausdorff distance with 44 % fewer points, but the
-  // sphere's vertices come out rougher (docs/pipeline.md, "Point reduction").
-  kHierarchy,
-};
 
 struct PoissonParams {
   // Surface mesher criteria (CGAL Surface_mesh_default_criteria_3).

@@ -6,19 +6,11 @@
 #pragma once
 
 #include "absl/status/statusor.h"
+#include "core/job/poisson_params.h"
 #include "core/surface/triangle_mesh.h"
 #include "core/util/run_context.h"
 
 namespace labelmesh::surface {
-
-struct SmoothingParams {
-  // Filter iterations (the degree of the Chebyshev approximation); 0 turns
-  // smoothing off. More iterations give a sharper cut-off, not more smoothing.
-  int iterations = 20;
-  // Pass band in (0, 2): lower removes longer wavelengths. 0.1 flattens the
-  // one-voxel staircase and keeps features a few voxels across.
-  double pass_band = 0.1;
-};
 
 // The same triangles with moved points. Connectivity, orientation and the
 // number of points never change. Errors: INVALID_ARGUMENT for bad parameters,

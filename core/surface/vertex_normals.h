@@ -5,19 +5,11 @@
 
 #include <vector>
 
+#include "core/job/poisson_params.h"
 #include "core/surface/triangle_mesh.h"
 #include "core/util/vec3.h"
 
 namespace labelmesh::surface {
-
-enum class NormalWeighting {
-  // Mean of the unit normals of incident triangles (the paper's choice, and
-  // the default): on Marching Cubes surfaces, whose triangles come in a few
-  // shapes and sizes, it follows the staircase's overall slope best.
-  kUniform,
-  // Sum of area-weighted normals: large triangles count more.
-  kArea,
-};
 
 // One unit normal per point of `mesh`, pointing the way its triangles face.
 // A point on no triangle, or whose normals cancel out, gets {0, 0, 0}.

@@ -10,7 +10,7 @@
 #include <vtkSmartPointer.h>
 
 #include "absl/status/status.h"
-#include "core/surface/surface_format.h"
+#include "core/job/surface_format.h"
 #include "core/surface/triangle_mesh.h"
 #include "core/util/coordinate_frame.h"
 

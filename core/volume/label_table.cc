@@ -14,9 +14,9 @@
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_split.h"
+#include "core/header/header_checks.h"
 #include "core/util/status_macros.h"
 #include "core/util/utf8.h"
-#include "core/volume/header_checks.h"
 
 namespace labelmesh::volume {
 namespace {

@@ -6,7 +6,7 @@
 #include <string>
 
 #include "absl/status/statusor.h"
-#include "core/volume/label_description.h"
+#include "core/header/label_description.h"
 
 namespace labelmesh::volume {
 

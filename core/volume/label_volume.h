@@ -8,8 +8,8 @@
 #include <vtkImageData.h>
 #include <vtkSmartPointer.h>
 
-#include "core/volume/image_geometry.h"
-#include "core/volume/label_description.h"
+#include "core/header/image_geometry.h"
+#include "core/header/label_description.h"
 
 namespace labelmesh::volume {
 

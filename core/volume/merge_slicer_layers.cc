@@ -12,9 +12,9 @@
 #include <vtkUnsignedShortArray.h>
 
 #include "absl/container/flat_hash_map.h"
+#include "core/header/header_checks.h"
 #include "core/util/status_macros.h"
 #include "core/util/text.h"
-#include "core/volume/header_checks.h"
 #include "core/volume/segment_layers.h"
 
 namespace labelmesh::volume {

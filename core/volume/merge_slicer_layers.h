@@ -10,9 +10,9 @@
 #include <vtkSmartPointer.h>
 
 #include "absl/status/statusor.h"
+#include "core/header/label_description.h"
+#include "core/header/volume_header.h"
 #include "core/util/run_context.h"
-#include "core/volume/label_description.h"
-#include "core/volume/volume_header.h"
 
 namespace labelmesh::volume {
 

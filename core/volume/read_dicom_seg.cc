@@ -20,10 +20,10 @@
 #include <vtkUnsignedShortArray.h>
 
 #include "absl/strings/str_cat.h"
+#include "core/header/dicom_seg_grid.h"
+#include "core/header/header_checks.h"
 #include "core/util/status_macros.h"
 #include "core/util/utf8.h"
-#include "core/volume/dicom_seg_grid.h"
-#include "core/volume/header_checks.h"
 #include "core/volume/segment_layers.h"
 
 namespace labelmesh::volume {

@@ -13,12 +13,12 @@
 #include <vtkPointData.h>
 #include <vtkXMLImageDataReader.h>
 
+#include "core/header/header_checks.h"
+#include "core/header/payload_stream.h"
 #include "core/util/status_macros.h"
 #include "core/util/text.h"
 #include "core/util/vtk_error_flag.h"
-#include "core/volume/header_checks.h"
 #include "core/volume/merge_slicer_layers.h"
-#include "core/volume/payload_stream.h"
 #include "core/volume/read_dicom_seg.h"
 
 namespace labelmesh::volume {

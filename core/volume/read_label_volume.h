@@ -5,9 +5,9 @@
 #include <string>
 
 #include "absl/status/statusor.h"
+#include "core/header/volume_header.h"
 #include "core/util/run_context.h"
 #include "core/volume/label_volume.h"
-#include "core/volume/volume_header.h"
 
 namespace labelmesh::volume {
 

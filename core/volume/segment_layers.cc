@@ -8,9 +8,9 @@
 #include <vtkIntArray.h>
 #include <vtkUnsignedShortArray.h>
 
+#include "core/header/header_checks.h"
 #include "core/util/status_macros.h"
 #include "core/util/text.h"
-#include "core/volume/header_checks.h"
 
 namespace labelmesh::volume {
 namespace {

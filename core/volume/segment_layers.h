@@ -16,8 +16,8 @@
 
 #include "absl/functional/function_ref.h"
 #include "absl/status/statusor.h"
+#include "core/header/volume_header.h"
 #include "core/util/run_context.h"
-#include "core/volume/volume_header.h"
 
 namespace labelmesh::volume {
 

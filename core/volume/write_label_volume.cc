@@ -17,10 +17,10 @@
 #include <vtkPointData.h>
 #include <vtkXMLImageDataWriter.h>
 
+#include "core/header/volume_header.h"
 #include "core/util/status_macros.h"
 #include "core/util/text.h"
 #include "core/util/vtk_error_flag.h"
-#include "core/volume/volume_header.h"
 
 namespace labelmesh::volume {
 namespace {

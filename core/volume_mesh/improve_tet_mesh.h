@@ -6,27 +6,11 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "core/job/tetgen_params.h"
 #include "core/util/run_context.h"
 #include "core/volume_mesh/tet_mesh.h"
 
 namespace labelmesh::volume_mesh {
-
-struct ImproveParams {
-  // Tetrahedra with Q below this are worked on; the rest only take part as
-  // neighbours. Above the Table 1 "questionable" bound of 0.2, so the pass
-  // also lifts elements that are just good enough.
-  double target_quality = 0.3;
-  // Full sweeps over the bad tetrahedra; a sweep that changes nothing ends
-  // the pass early.
-  int max_sweeps = 8;
-  // No operation makes a tetrahedron larger than this (mm³) and larger than
-  // those it replaces; 0 for no bound. The pipeline passes TetGen's -a bound.
-  double max_volume_mm3 = 0;
-  // How far (mm) peeling a sliver off the surface may move it; 0 turns
-  // peeling off. The pipeline passes the Poisson surface's distance bound
-  // for Poisson surfaces and 0 for the others.
-  double max_peel_depth_mm = 0;
-};
 
 struct ImproveFigures {
   double quality_min_before = 0;

@@ -12,10 +12,10 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
+#include "core/job/tetgen_params.h"
 #include "core/surface/triangle_mesh.h"
 #include "core/util/run_context.h"
 #include "core/volume_mesh/tet_mesh.h"
-#include "core/volume_mesh/tetgen_params.h"
 
 namespace labelmesh::volume_mesh {
 

@@ -10,9 +10,9 @@
 #include <vector>
 
 #include "absl/status/status.h"
+#include "core/job/volume_format.h"
 #include "core/util/coordinate_frame.h"
 #include "core/volume_mesh/tet_mesh.h"
-#include "core/volume_mesh/volume_format.h"
 
 namespace labelmesh::volume_mesh {
 

@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "core/pipeline/job_options.h"
+#include "core/job/job_options.h"
 
 namespace labelmesh::client {
 namespace {

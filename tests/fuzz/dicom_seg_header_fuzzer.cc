@@ -5,8 +5,8 @@
 #include <cstdint>
 #include <filesystem>
 
-#include "core/volume/dicom_seg_header.h"
-#include "core/volume/volume_header.h"
+#include "core/header/dicom_seg_header.h"
+#include "core/header/volume_header.h"
 #include "fuzz/fuzz_support.h"
 
 namespace {

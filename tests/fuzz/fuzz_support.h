@@ -16,7 +16,7 @@
 #include <string_view>
 #include <system_error>
 
-#include "core/volume/image_geometry.h"
+#include "core/header/image_geometry.h"
 
 namespace labelmesh::fuzzing {
 

@@ -10,8 +10,8 @@
 #include <cstdint>
 #include <string>
 
-#include "core/pipeline/job_options.h"
-#include "core/volume/image_geometry.h"
+#include "core/header/image_geometry.h"
+#include "core/job/job_options.h"
 #include "fuzz/fuzz_support.h"
 #include "google/protobuf/stubs/logging.h"
 #include "labelmesh/v1/service.pb.h"

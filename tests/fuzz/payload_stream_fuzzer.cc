@@ -16,9 +16,9 @@
 #include <string>
 #include <vector>
 
-#include "core/volume/header_checks.h"
-#include "core/volume/payload_stream.h"
-#include "core/volume/volume_header.h"
+#include "core/header/header_checks.h"
+#include "core/header/payload_stream.h"
+#include "core/header/volume_header.h"
 #include "fuzz/fuzz_support.h"
 
 namespace {

@@ -9,7 +9,7 @@
 #include <iterator>
 #include <string>
 
-#include "core/volume/volume_header.h"
+#include "core/header/volume_header.h"
 #include "fuzz/fuzz_support.h"
 #include "server/upload_checks.h"
 

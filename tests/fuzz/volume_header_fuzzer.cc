@@ -8,7 +8,7 @@
 #include <filesystem>
 #include <iterator>
 
-#include "core/volume/volume_header.h"
+#include "core/header/volume_header.h"
 #include "fuzz/fuzz_support.h"
 
 namespace {

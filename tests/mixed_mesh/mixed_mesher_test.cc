@@ -13,10 +13,10 @@
 #include <random>
 #include <set>
 
+#include "core/job/job_options.h"
 #include "core/mixed_mesh/check_mixed_mesh.h"
 #include "core/mixed_mesh/hex_layer.h"
 #include "core/mixed_mesh/mixed_faces.h"
-#include "core/pipeline/job_options.h"
 #include "core/pipeline/pipeline.h"
 #include "core/pipeline/report.h"
 #include "core/pipeline/write_results.h"

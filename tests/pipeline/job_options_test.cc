@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 // Job options: every range is checked in one place (params_from_options), and
 // what it accepts survives the trip back to the proto.
-#include "core/pipeline/job_options.h"
+#include "core/job/job_options.h"
 #include "support/status_matchers.h"
 
 #include <gtest/gtest.h>

@@ -13,7 +13,7 @@
 
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
-#include "core/pipeline/job_options.h"
+#include "core/job/job_options.h"
 #include "core/pipeline/pipeline.h"
 #include "core/pipeline/report.h"
 #include "core/volume/label_volume.h"
@@ -23,6 +23,7 @@
 #include "server/labelmesh_server.h"
 #include "server/metrics.h"
 #include "server/worker_process.h"
+#include "server/worker_protocol.h"
 #include "support/service_harness.h"
 #include "support/status_matchers.h"
 

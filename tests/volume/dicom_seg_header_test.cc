@@ -2,7 +2,7 @@
 // The DICOM SEG header walk: the real dcmqi and highdicom files read as DCMTK
 // reads them, and broken or hostile files are errors that name the element,
 // never crashes.
-#include "core/volume/dicom_seg_header.h"
+#include "core/header/dicom_seg_header.h"
 
 #include <gtest/gtest.h>
 

@@ -17,7 +17,7 @@
 #include <vtkPointData.h>
 
 #include "absl/strings/match.h"
-#include "core/volume/dicom_seg_grid.h"
+#include "core/header/dicom_seg_grid.h"
 #include "core/volume/read_label_volume.h"
 #include "core/volume/voxel_access.h"
 #include "support/status_matchers.h"

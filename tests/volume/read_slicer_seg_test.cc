@@ -13,9 +13,9 @@
 #include <vtkImageData.h>
 #include <vtkPointData.h>
 
+#include "core/header/slicer_segments.h"
 #include "core/volume/label_statistics.h"
 #include "core/volume/read_label_volume.h"
-#include "core/volume/slicer_segments.h"
 #include "support/gzip_file.h"
 #include "support/status_matchers.h"
 #include "support/test_files.h"

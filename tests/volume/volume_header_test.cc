@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 // The broken-file corpus: every header problem is an error that names the
 // file and the field, and nothing is allocated from a field before it is checked.
-#include "core/volume/volume_header.h"
+#include "core/header/volume_header.h"
 
 #include <gtest/gtest.h>
 #include <zlib.h>

@@ -6,18 +6,15 @@
 #include <cstdint>
 #include <vector>
 
-#include "core/conforming/interface_budget.h"
-#include "core/pipeline/scene_format.h"
-#include "core/surface/poisson_surface.h"
-#include "core/surface/smooth_surface.h"
-#include "core/surface/surface_format.h"
-#include "core/surface/vertex_normals.h"
+#include "core/header/label_description.h"
+#include "core/header/volume_header.h"
+#include "core/job/interface_budget.h"
+#include "core/job/poisson_params.h"
+#include "core/job/scene_format.h"
+#include "core/job/surface_format.h"
+#include "core/job/tetgen_params.h"
+#include "core/job/volume_format.h"
 #include "core/util/coordinate_frame.h"
-#include "core/volume/label_description.h"
-#include "core/volume/volume_header.h"
-#include "core/volume_mesh/improve_tet_mesh.h"
-#include "core/volume_mesh/tetgen_params.h"
-#include "core/volume_mesh/volume_format.h"
 
 namespace labelmesh {
 

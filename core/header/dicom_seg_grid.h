@@ -11,9 +11,9 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
-#include "core/volume/dicom_seg_header.h"
-#include "core/volume/image_geometry.h"
-#include "core/volume/volume_header.h"
+#include "core/header/dicom_seg_header.h"
+#include "core/header/image_geometry.h"
+#include "core/header/volume_header.h"
 
 namespace labelmesh::volume {
 

@@ -12,8 +12,8 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
-#include "core/volume/image_geometry.h"
-#include "core/volume/slicer_segments.h"
+#include "core/header/image_geometry.h"
+#include "core/header/slicer_segments.h"
 
 namespace labelmesh::volume {
 

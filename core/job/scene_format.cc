@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-#include "core/pipeline/scene_format.h"
+#include "core/job/scene_format.h"
 
 namespace labelmesh {
 

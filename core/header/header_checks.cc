@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-#include "core/volume/header_checks.h"
+#include "core/header/header_checks.h"
 
 #include <cerrno>
 #include <charconv>
@@ -10,9 +10,9 @@
 #include <limits>
 #include <memory>
 
+#include "core/header/payload_stream.h"
 #include "core/util/status_macros.h"
 #include "core/util/text.h"
-#include "core/volume/payload_stream.h"
 
 namespace labelmesh::volume::internal {
 namespace {}  // namespace

@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
-#include "core/volume/volume_header.h"
+#include "core/header/volume_header.h"
 
 struct z_stream_s;
 

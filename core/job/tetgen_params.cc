@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-#include "core/volume_mesh/tetgen_params.h"
+#include "core/job/tetgen_params.h"
 
 #include <cmath>
 

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-#include "core/pipeline/job_options.h"
+#include "core/job/job_options.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-#include "core/volume/slicer_segments.h"
+#include "core/header/slicer_segments.h"
 
 #include <charconv>
 #include <cmath>
@@ -7,10 +7,10 @@
 #include <set>
 #include <utility>
 
+#include "core/header/header_checks.h"
 #include "core/util/status_macros.h"
 #include "core/util/text.h"
 #include "core/util/utf8.h"
-#include "core/volume/header_checks.h"
 
 namespace labelmesh::volume {
 namespace {

@@ -7,10 +7,10 @@
 #include <cmath>
 #include <optional>
 
+#include "core/header/header_checks.h"
+#include "core/header/header_formats.h"
 #include "core/util/status_macros.h"
 #include "core/util/text.h"
-#include "core/volume/header_checks.h"
-#include "core/volume/header_formats.h"
 
 namespace labelmesh::volume::internal {
 namespace {

@@ -4,11 +4,11 @@
 // LPS, which is MetaImage's (ITK's) frame.
 #include <cmath>
 
+#include "core/header/header_checks.h"
+#include "core/header/header_formats.h"
+#include "core/header/text_header.h"
 #include "core/util/status_macros.h"
 #include "core/util/text.h"
-#include "core/volume/header_checks.h"
-#include "core/volume/header_formats.h"
-#include "core/volume/text_header.h"
 
 namespace labelmesh::volume::internal {
 namespace {

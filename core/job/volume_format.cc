@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-#include "core/volume_mesh/volume_format.h"
+#include "core/job/volume_format.h"
 
 namespace labelmesh::volume_mesh {
 

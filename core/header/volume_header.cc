@@ -1,14 +1,14 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-#include "core/volume/volume_header.h"
+#include "core/header/volume_header.h"
 
 #include <algorithm>
 #include <fstream>
 
+#include "core/header/header_checks.h"
+#include "core/header/header_formats.h"
+#include "core/header/payload_stream.h"
 #include "core/util/status_macros.h"
 #include "core/util/text.h"
-#include "core/volume/header_checks.h"
-#include "core/volume/header_formats.h"
-#include "core/volume/payload_stream.h"
 
 namespace labelmesh::volume {
 

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-#include "core/volume/payload_stream.h"
+#include "core/header/payload_stream.h"
 
 #include <zlib.h>
 
@@ -7,9 +7,9 @@
 #include <filesystem>
 #include <memory>
 
+#include "core/header/header_checks.h"
 #include "core/util/status_macros.h"
 #include "core/util/text.h"
-#include "core/volume/header_checks.h"
 
 namespace labelmesh::volume::internal {
 namespace {

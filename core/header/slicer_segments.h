@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
-#include "core/volume/label_description.h"
+#include "core/header/label_description.h"
 
 namespace labelmesh::volume {
 

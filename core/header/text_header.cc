@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-#include "core/volume/text_header.h"
+#include "core/header/text_header.h"
 
+#include "core/header/header_checks.h"
 #include "core/util/text.h"
-#include "core/volume/header_checks.h"
 
 namespace labelmesh::volume::internal {
 

@@ -4,8 +4,8 @@
 #pragma once
 
 #include "absl/status/statusor.h"
-#include "core/pipeline/mesh_params.h"
-#include "core/volume/image_geometry.h"
+#include "core/header/image_geometry.h"
+#include "core/job/mesh_params.h"
 #include "labelmesh/v1/options.pb.h"
 
 namespace labelmesh {

@@ -7,7 +7,7 @@
 // the VR known from the data dictionary). Sequences and items follow PS3.5
 // 7.5: defined lengths, or undefined ones (0xFFFFFFFF) closed by the item
 // (FFFE,E00D) and sequence (FFFE,E0DD) delimiters.
-#include "core/volume/dicom_seg_header.h"
+#include "core/header/dicom_seg_header.h"
 
 #include <algorithm>
 #include <charconv>
@@ -17,9 +17,9 @@
 #include <fstream>
 #include <limits>
 
+#include "core/header/header_checks.h"
 #include "core/util/status_macros.h"
 #include "core/util/text.h"
-#include "core/volume/header_checks.h"
 
 namespace labelmesh::volume::internal {
 namespace {

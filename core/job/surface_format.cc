@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-#include "core/surface/surface_format.h"
+#include "core/job/surface_format.h"
 
 namespace labelmesh::surface {
 

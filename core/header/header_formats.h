@@ -5,7 +5,7 @@
 #include <string>
 
 #include "absl/status/statusor.h"
-#include "core/volume/volume_header.h"
+#include "core/header/volume_header.h"
 
 namespace labelmesh::volume::internal {
 

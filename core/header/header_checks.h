@@ -11,7 +11,7 @@
 
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
-#include "core/volume/volume_header.h"
+#include "core/header/volume_header.h"
 
 namespace labelmesh::volume::internal {
 

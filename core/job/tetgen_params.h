@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-// What a TetGen run is asked for, and the ranges TetGen accepts: no TetGen
-// here, so that job options are checked where TetGen is not linked.
+// What a TetGen run and the improvement pass after it are asked for, and the
+// ranges TetGen accepts: no TetGen here, so that job options are checked
+// where TetGen is not linked.
 #pragma once
 
 #include "absl/status/status.h"
@@ -33,5 +34,23 @@ struct TetgenParams {
 // INVALID_ARGUMENT naming the job option (tet_radius_edge, ...) when a
 // parameter is out of TetGen's range.
 absl::Status check_tetgen_params(const TetgenParams& params);
+
+// The improvement pass after TetGen (improve_tet_mesh.h).
+struct ImproveParams {
+  // Tetrahedra with Q below this are worked on; the rest only take part as
+  // neighbours. Above the Table 1 "questionable" bound of 0.2, so the pass
+  // also lifts elements that are just good enough.
+  double target_quality = 0.3;
+  // Full sweeps over the bad tetrahedra; a sweep that changes nothing ends
+  // the pass early.
+  int max_sweeps = 8;
+  // No operation makes a tetrahedron larger than this (mm³) and larger than
+  // those it replaces; 0 for no bound. The pipeline passes TetGen's -a bound.
+  double max_volume_mm3 = 0;
+  // How far (mm) peeling a sliver off the surface may move it; 0 turns
+  // peeling off. The pipeline passes the Poisson surface's distance bound
+  // for Poisson surfaces and 0 for the others.
+  double max_peel_depth_mm = 0;
+};
 
 }  // namespace labelmesh::volume_mesh

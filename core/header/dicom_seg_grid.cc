@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-#include "core/volume/dicom_seg_grid.h"
+#include "core/header/dicom_seg_grid.h"
 
 #include <algorithm>
 #include <array>
@@ -7,8 +7,8 @@
 #include <optional>
 
 #include "absl/strings/str_cat.h"
+#include "core/header/header_checks.h"
 #include "core/util/status_macros.h"
-#include "core/volume/header_checks.h"
 
 namespace labelmesh::volume {
 namespace {

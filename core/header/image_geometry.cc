@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-#include "core/volume/image_geometry.h"
+#include "core/header/image_geometry.h"
 
 #include <cmath>
 

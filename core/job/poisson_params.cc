@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-#include "core/surface/poisson_params.h"
+#include "core/job/poisson_params.h"
 
 #include "core/util/text.h"
 
