@@ -5,7 +5,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/digest/sha256.h"
-#include "core/pipeline/job_options.h"
+#include "core/job/job_options.h"
 #include "core/util/status_macros.h"
 #include "server/durable_file.h"
 #include "server/refusal.h"
@@ -227,7 +227,10 @@ absl::Status SubmitUpload::run(v1::SubmitReply& reply) {
   job.set_job_id(job_id);
   job.set_created_at(unix_now());
   job.set_owner(identity_.name);
-  *job.mutable_options() = spec.options();
+  // The options are kept once, in the job: GetJob shows them, the worker
+  // reads them.
+  *job.mutable_options() = std::move(*spec.mutable_options());
+  spec.clear_options();
   // Only the extension of the client's file name is kept: names can hold
   // patient identifiers.
   spec.set_file_name(absl::StrCat("upload", extension));

@@ -145,7 +145,7 @@ absl::Status run_job(const std::string& job_dir, const std::string& out_dir, int
       return absl::InternalError("the worker cannot read its job record");
     }
   }
-  LABELMESH_ASSIGN_OR_RETURN(auto params, params_from_options(record.spec().options()));
+  LABELMESH_ASSIGN_OR_RETURN(auto params, params_from_options(record.job().options()));
   // The server's share of the cores for each worker (kJobThreadsVariable).
   if (const char* threads = std::getenv(kJobThreadsVariable)) {
     params.threads = static_cast<unsigned>(std::clamp(std::atoi(threads), 1, 256));

@@ -22,6 +22,7 @@
 #include "server/event_pipe.h"
 #include "server/labelmesh_server.h"
 #include "server/metrics.h"
+#include "server/spool.h"
 #include "server/worker_process.h"
 #include "server/worker_protocol.h"
 #include "support/service_harness.h"
@@ -699,6 +700,15 @@ TEST_F(MeshingServiceTest, QueuedJobRunsAfterARestart) {
     job_id = reply.job_id();
     service.shutdown();
   }
+  // The record holds the options once, with every default filled in: the
+  // job's, which GetJob shows and the worker reads.
+  auto spool = server::Spool::open(spool_.string());
+  ASSERT_THAT(spool, testing::IsOk());
+  const auto records = spool->load_all();
+  ASSERT_EQ(records.size(), 1u);
+  EXPECT_FALSE(records[0].spec().has_options());
+  EXPECT_EQ(records[0].job().options().surface(), repaired_options().surface());
+  EXPECT_EQ(records[0].job().options().min_angle_deg(), 30);
   config_.workers = 1;
   ServiceHarness restarted(config_);
   const auto events = restarted.watch(job_id);
