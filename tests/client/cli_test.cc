@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "labelmesh/v1/report.pb.h"
+#include "support/status_matchers.h"
 #include "support/test_files.h"
 
 namespace labelmesh {
@@ -150,7 +151,8 @@ TEST(Cli, JsonReportOnStdout) {
                              " --surface poisson --poisson-min-thickness 0 --json 2>/dev/null");
   ASSERT_EQ(run.exit_code, 0);
   v1::Report report;
-  ASSERT_TRUE(google::protobuf::util::JsonStringToMessage(run.output, &report).ok()) << run.output;
+  ASSERT_THAT(google::protobuf::util::JsonStringToMessage(run.output, &report), testing::IsOk())
+      << run.output;
   // With Poisson, the report lists the Marching Cubes, repaired and
   // Poisson stages (Table 2's columns); only the last is the output.
   ASSERT_EQ(report.surfaces_size(), 3);
@@ -185,7 +187,8 @@ TEST(Cli, TetrahedralMeshFilesForSolvers) {
   const CliRun run = run_cli(mesh + " --volume tet --formats stl,vtu,msh,inp,mesh 2>/dev/null");
   ASSERT_EQ(run.exit_code, 0) << run.output;
   v1::Report report;
-  ASSERT_TRUE(google::protobuf::util::JsonStringToMessage(run.output, &report).ok()) << run.output;
+  ASSERT_THAT(google::protobuf::util::JsonStringToMessage(run.output, &report), testing::IsOk())
+      << run.output;
   ASSERT_TRUE(report.has_volume());
   EXPECT_EQ(report.volume().mesher(), "tetgen");
   EXPECT_GT(report.volume().tetrahedra(), 500u);
@@ -244,7 +247,8 @@ TEST(Cli, InfoJsonOnRealData) {
   const CliRun run = run_cli("info --json " + testing::shared_data("liver.inr.gz"));
   ASSERT_EQ(run.exit_code, 0) << run.output;
   v1::InputSummary summary;
-  ASSERT_TRUE(google::protobuf::util::JsonStringToMessage(run.output, &summary).ok()) << run.output;
+  ASSERT_THAT(google::protobuf::util::JsonStringToMessage(run.output, &summary), testing::IsOk())
+      << run.output;
   EXPECT_EQ(summary.dims(0), 438u);
   ASSERT_EQ(summary.labels_size(), 4);
   EXPECT_EQ(summary.labels(3).label(), 255);

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "core/job/job_options.h"
+#include "support/status_matchers.h"
 
 namespace labelmesh::client {
 namespace {
@@ -37,7 +38,7 @@ MeshParams params_of(std::vector<std::string> arguments) {
 
 TEST(PipelineFlags, NoFlagsGiveThePipelinesDefaults) {
   const auto options = options_of({});
-  ASSERT_TRUE(options.ok());
+  ASSERT_THAT(options, testing::IsOk());
   // The surface is left to the job options: net, or poisson under a volume.
   EXPECT_EQ(options->surface(), v1::SURFACE_METHOD_UNSPECIFIED);
   const MeshParams params = params_of({});

@@ -23,7 +23,7 @@ using testing::new_job;
 std::vector<v1::JobEvent::EventCase> logged(EventLog& events, const std::string& job_id) {
   std::vector<v1::JobEvent::EventCase> kinds;
   auto follower = events.follow(job_id, 0);
-  EXPECT_TRUE(follower.ok());
+  EXPECT_THAT(follower, testing::IsOk());
   while (true) {
     auto next = (*follower)->next(absl::Milliseconds(300));
     if (!next.ok() || !next->has_value()) break;
@@ -37,7 +37,7 @@ std::vector<v1::JobEvent::EventCase> logged(EventLog& events, const std::string&
 TEST(ClusterJobs, ARetriedSubmitGivesTheSameJobQueuedOnce) {
   testing::NatsServer server(testing::scratch_dir("submit"));
   Node frontend(server), other_frontend(server);
-  ASSERT_TRUE(frontend.jobs->submit(new_job("j1")).ok());
+  ASSERT_THAT(frontend.jobs->submit(new_job("j1")), testing::IsOk());
   auto again = other_frontend.jobs->submit(new_job("j1"));
   ASSERT_THAT(again, testing::IsOk());
   EXPECT_EQ(again->job().state(), v1::JOB_STATE_QUEUED);
@@ -47,7 +47,7 @@ TEST(ClusterJobs, ARetriedSubmitGivesTheSameJobQueuedOnce) {
 TEST(ClusterJobs, ALateResultFromAWorkerThatLostItsJobIsRefused) {
   testing::NatsServer server(testing::scratch_dir("fencing"));
   Node frontend(server);
-  ASSERT_TRUE(frontend.jobs->submit(new_job("j1")).ok());
+  ASSERT_THAT(frontend.jobs->submit(new_job("j1")), testing::IsOk());
 
   // Worker A takes the job and falls silent; the queue hands it to B.
   Node a(server), b(server);
@@ -60,13 +60,13 @@ TEST(ClusterJobs, ALateResultFromAWorkerThatLostItsJobIsRefused) {
   ASSERT_TRUE(second.ok() && second->has_value());
   EXPECT_EQ((*second)->delivered(), 2u);
   auto b_claim = b.jobs->claim("j1");
-  ASSERT_TRUE(b_claim.ok());
+  ASSERT_THAT(b_claim, testing::IsOk());
   EXPECT_EQ(b_claim->attempt, 2u);
 
   v1::JobRecord result;
   result.add_artifacts()->set_name("volume.vtu");
-  EXPECT_TRUE(b.jobs->finish(*b_claim, v1::JOB_STATE_SUCCEEDED, result).ok());
-  EXPECT_TRUE((*second)->ack().ok());
+  EXPECT_THAT(b.jobs->finish(*b_claim, v1::JOB_STATE_SUCCEEDED, result), testing::IsOk());
+  EXPECT_THAT((*second)->ack(), testing::IsOk());
   // A comes back late: its result is refused and the job stays B's.
   const auto late = a.jobs->finish(*a_claim, v1::JOB_STATE_FAILED, {});
   EXPECT_THAT(late, testing::StatusIs(absl::StatusCode::kAborted)) << late.status();
@@ -85,16 +85,16 @@ TEST(ClusterJobs, ALateResultFromAWorkerThatLostItsJobIsRefused) {
 TEST(ClusterJobs, CancelEndsAQueuedJobAndAsksARunningOneToStop) {
   testing::NatsServer server(testing::scratch_dir("cancel"));
   Node frontend(server), worker(server);
-  ASSERT_TRUE(frontend.jobs->submit(new_job("queued")).ok());
-  ASSERT_TRUE(frontend.jobs->submit(new_job("running")).ok());
+  ASSERT_THAT(frontend.jobs->submit(new_job("queued")), testing::IsOk());
+  ASSERT_THAT(frontend.jobs->submit(new_job("running")), testing::IsOk());
   auto claim = worker.jobs->claim("running");
-  ASSERT_TRUE(claim.ok());
+  ASSERT_THAT(claim, testing::IsOk());
 
   EXPECT_EQ(frontend.jobs->cancel("queued").value().job().state(), v1::JOB_STATE_CANCELLED);
   EXPECT_EQ(worker.jobs->claim("queued").status().code(), absl::StatusCode::kFailedPrecondition);
 
   const auto asked = frontend.jobs->cancel("running");
-  ASSERT_TRUE(asked.ok());
+  ASSERT_THAT(asked, testing::IsOk());
   EXPECT_EQ(asked->job().state(), v1::JOB_STATE_RUNNING);
   EXPECT_TRUE(worker.jobs->get("running").value().cancel_requested());
   EXPECT_EQ(worker.jobs->finish(*claim, v1::JOB_STATE_CANCELLED, {}).value().job().state(),

@@ -8,6 +8,7 @@
 #include <thread>
 
 #include "cluster/cluster_node.h"
+#include "support/status_matchers.h"
 #include "support/test_files.h"
 
 namespace labelmesh::cluster {
@@ -25,7 +26,7 @@ constexpr ClusterWorkerConfig kQuick{absl::Seconds(1), absl::Milliseconds(250)};
 TEST(ClusterWorker, ARunLongerThanTheAckWaitStaysWithItsWorker) {
   testing::NatsServer server(testing::scratch_dir("long-run"));
   Node frontend(server), worker_node(server), idle_node(server);
-  ASSERT_TRUE(frontend.jobs->submit(new_job("long")).ok());
+  ASSERT_THAT(frontend.jobs->submit(new_job("long")), testing::IsOk());
   std::atomic<int> runs = 0;
   // While the job runs, another worker polls the same queue and must get
   // nothing.
@@ -63,7 +64,7 @@ TEST(ClusterWorker, ARunLongerThanTheAckWaitStaysWithItsWorker) {
 TEST(ClusterWorker, ACancelReachesTheRunOnItsMachine) {
   testing::NatsServer server(testing::scratch_dir("cancel-run"));
   Node frontend(server), worker_node(server);
-  ASSERT_TRUE(frontend.jobs->submit(new_job("doomed")).ok());
+  ASSERT_THAT(frontend.jobs->submit(new_job("doomed")), testing::IsOk());
   ClusterWorker worker(
       *worker_node.queue, *worker_node.jobs,
       [&](const v1::JobRecord&, const Claim&, const std::atomic<bool>& cancelled) {
@@ -75,7 +76,7 @@ TEST(ClusterWorker, ACancelReachesTheRunOnItsMachine) {
       kQuick);
   std::thread client([&] {
     std::this_thread::sleep_for(std::chrono::milliseconds(500));
-    EXPECT_TRUE(frontend.jobs->cancel("doomed").ok());
+    EXPECT_THAT(frontend.jobs->cancel("doomed"), testing::IsOk());
   });
   const auto start = std::chrono::steady_clock::now();
   EXPECT_EQ(worker.run_one().value(), true);
@@ -87,7 +88,7 @@ TEST(ClusterWorker, ACancelReachesTheRunOnItsMachine) {
 TEST(ClusterWorker, AFailedRunEndsTheJobFailedAndARetriedSubmitDoesNotRunItAgain) {
   testing::NatsServer server(testing::scratch_dir("failed-run"));
   Node frontend(server), worker_node(server);
-  ASSERT_TRUE(frontend.jobs->submit(new_job("bad")).ok());
+  ASSERT_THAT(frontend.jobs->submit(new_job("bad")), testing::IsOk());
   int runs = 0;
   ClusterWorker worker(
       *worker_node.queue, *worker_node.jobs,
@@ -105,7 +106,7 @@ TEST(ClusterWorker, AFailedRunEndsTheJobFailedAndARetriedSubmitDoesNotRunItAgain
   // The same id submitted again is the same ended job, and the queue's
   // duplicate window keeps it from being queued again.
   const auto again = frontend.jobs->submit(new_job("bad"));
-  ASSERT_TRUE(again.ok());
+  ASSERT_THAT(again, testing::IsOk());
   EXPECT_EQ(again->job().state(), v1::JOB_STATE_FAILED);
   EXPECT_EQ(worker.run_one().value(), false);
   EXPECT_EQ(runs, 1);
@@ -115,7 +116,7 @@ TEST(ClusterWorker, AFailedRunEndsTheJobFailedAndARetriedSubmitDoesNotRunItAgain
 TEST(ClusterWorker, AJobGivenBackAtShutdownIsNotCountedAsAFailedDelivery) {
   testing::NatsServer server(testing::scratch_dir("give-back"));
   Node frontend(server), worker_node(server);
-  ASSERT_TRUE(frontend.jobs->submit(new_job("interrupted")).ok());
+  ASSERT_THAT(frontend.jobs->submit(new_job("interrupted")), testing::IsOk());
   // The queue stops a job after max_deliver (3) deliveries: four stops in a
   // row must not lose it.
   auto stop = [](const v1::JobRecord&, const Claim&, const std::atomic<bool>&) {

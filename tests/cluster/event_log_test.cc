@@ -48,7 +48,7 @@ TEST(EventLog, AnotherFrontendFollowsAJobFromAnyPoint) {
   std::vector<uint64_t> sequences;
   for (const char* data : {"queued", "started", "progress 50"}) {
     sequences.push_back(worker->append("job-a", data).value());
-    ASSERT_TRUE(worker->append("job-b", std::string("b ") + data).ok());
+    ASSERT_THAT(worker->append("job-b", std::string("b ") + data), testing::IsOk());
   }
   EXPECT_LT(sequences[0], sequences[1]);
   EXPECT_LT(sequences[1], sequences[2]);
@@ -64,8 +64,8 @@ TEST(EventLog, AnotherFrontendFollowsAJobFromAnyPoint) {
 
   // A client that saw "started" resumes after it, and then sees live events.
   auto resumed = frontend->follow("job-a", sequences[1] + 1);
-  ASSERT_TRUE(resumed.ok());
-  ASSERT_TRUE(worker->append("job-a", "finished").ok());
+  ASSERT_THAT(resumed, testing::IsOk());
+  ASSERT_THAT(worker->append("job-a", "finished"), testing::IsOk());
   EXPECT_EQ(drain(**resumed, absl::Milliseconds(500)),
             (std::vector<std::string>{"progress 50", "finished"}));
 }
@@ -75,8 +75,8 @@ TEST(EventLog, EventsOutliveANatsRestartAndGoWithTheirJob) {
   {
     auto client = connect(server);
     auto log = open_log(*client);
-    ASSERT_TRUE(log->append("job-a", "queued").ok());
-    ASSERT_TRUE(log->append("job-a", "started").ok());
+    ASSERT_THAT(log->append("job-a", "queued"), testing::IsOk());
+    ASSERT_THAT(log->append("job-a", "started"), testing::IsOk());
   }
   server.restart();
   ASSERT_TRUE(server.running());
@@ -84,12 +84,12 @@ TEST(EventLog, EventsOutliveANatsRestartAndGoWithTheirJob) {
   auto log = open_log(*client);
   ASSERT_NE(log, nullptr);
   auto follower = log->follow("job-a", 0);
-  ASSERT_TRUE(follower.ok());
+  ASSERT_THAT(follower, testing::IsOk());
   EXPECT_EQ(drain(**follower, absl::Milliseconds(500)),
             (std::vector<std::string>{"queued", "started"}));
-  ASSERT_TRUE(log->remove("job-a").ok());
+  ASSERT_THAT(log->remove("job-a"), testing::IsOk());
   auto after = log->follow("job-a", 0);
-  ASSERT_TRUE(after.ok());
+  ASSERT_THAT(after, testing::IsOk());
   EXPECT_TRUE(drain(**after, absl::Milliseconds(300)).empty());
 }
 

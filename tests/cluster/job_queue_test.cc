@@ -57,13 +57,14 @@ TEST(JobQueue, ADuplicateSubmitIsQueuedOnceAndEachJobGoesToOneWorker) {
   ASSERT_NE(other, nullptr);
   auto first = queue->take(absl::Seconds(2));
   auto second = other->take(absl::Seconds(2));
-  ASSERT_TRUE(first.ok() && second.ok());
+  ASSERT_THAT(first, testing::IsOk());
+  ASSERT_THAT(second, testing::IsOk());
   ASSERT_TRUE(first->has_value() && second->has_value());
   EXPECT_EQ((std::set<std::string>{(*first)->job_id(), (*second)->job_id()}),
             (std::set<std::string>{"job-a", "job-b"}));
   EXPECT_EQ((*first)->delivered(), 1u);
-  EXPECT_TRUE((*first)->ack().ok());
-  EXPECT_TRUE((*second)->ack().ok());
+  EXPECT_THAT((*first)->ack(), testing::IsOk());
+  EXPECT_THAT((*second)->ack(), testing::IsOk());
   EXPECT_FALSE(queue->take(absl::Milliseconds(300)).value().has_value());
   EXPECT_EQ(queue->stored().value(), 0u);  // acknowledged jobs leave the stream
 }
@@ -75,7 +76,7 @@ TEST(JobQueue, AJobWhoseWorkerDiedGoesToTheNextWorker) {
   const auto config = quick(absl::Seconds(1));
   auto queue = open_queue(*client, config);
   ASSERT_NE(queue, nullptr);
-  ASSERT_TRUE(queue->enqueue("job-a").ok());
+  ASSERT_THAT(queue->enqueue("job-a"), testing::IsOk());
   {
     // A worker takes the job and dies without a word: its connection ends.
     auto doomed_client = cluster.client();
@@ -88,7 +89,7 @@ TEST(JobQueue, AJobWhoseWorkerDiedGoesToTheNextWorker) {
   ASSERT_TRUE(again.ok() && again->has_value());
   EXPECT_EQ((*again)->job_id(), "job-a");
   EXPECT_EQ((*again)->delivered(), 2u);
-  EXPECT_TRUE((*again)->ack().ok());
+  EXPECT_THAT((*again)->ack(), testing::IsOk());
 }
 
 TEST(JobQueue, AWorkerThatSaysItIsWorkingKeepsItsJob) {
@@ -97,7 +98,7 @@ TEST(JobQueue, AWorkerThatSaysItIsWorkingKeepsItsJob) {
   ASSERT_NE(client, nullptr);
   const auto config = quick(absl::Seconds(2));
   auto queue = open_queue(*client, config);
-  ASSERT_TRUE(queue->enqueue("job-a").ok());
+  ASSERT_THAT(queue->enqueue("job-a"), testing::IsOk());
   auto taken = queue->take(absl::Seconds(2));
   ASSERT_TRUE(taken.ok() && taken->has_value());
   auto other_client = cluster.client();
@@ -105,12 +106,12 @@ TEST(JobQueue, AWorkerThatSaysItIsWorkingKeepsItsJob) {
   // Two ack waits, the job reported in progress every quarter wait: nobody
   // else gets it.
   for (int i = 0; i < 8; ++i) {
-    EXPECT_TRUE((*taken)->in_progress().ok());
+    EXPECT_THAT((*taken)->in_progress(), testing::IsOk());
     auto stolen = other->take(absl::Milliseconds(500));
-    ASSERT_TRUE(stolen.ok());
+    ASSERT_THAT(stolen, testing::IsOk());
     EXPECT_FALSE(stolen->has_value()) << "handed out again after " << i << " quarter waits";
   }
-  EXPECT_TRUE((*taken)->ack().ok());
+  EXPECT_THAT((*taken)->ack(), testing::IsOk());
 }
 
 TEST(JobQueue, APoisonJobStopsAfterMaxDeliveries) {
@@ -118,12 +119,12 @@ TEST(JobQueue, APoisonJobStopsAfterMaxDeliveries) {
   auto client = cluster.client();
   ASSERT_NE(client, nullptr);
   auto queue = open_queue(*client, quick(absl::Seconds(30), 2));
-  ASSERT_TRUE(queue->enqueue("poison").ok());
+  ASSERT_THAT(queue->enqueue("poison"), testing::IsOk());
   for (uint64_t attempt = 1; attempt <= 2; ++attempt) {
     auto taken = queue->take(absl::Seconds(2));
     ASSERT_TRUE(taken.ok() && taken->has_value());
     EXPECT_EQ((*taken)->delivered(), attempt);
-    EXPECT_TRUE((*taken)->nak().ok());
+    EXPECT_THAT((*taken)->nak(), testing::IsOk());
   }
   EXPECT_FALSE(queue->take(absl::Milliseconds(500)).value().has_value());
 }
@@ -146,7 +147,7 @@ TEST(JobQueue, QueuedJobsOutliveANatsRestart) {
     auto job = queue->take(absl::Seconds(2));
     ASSERT_TRUE(job.ok() && job->has_value());
     taken.insert((*job)->job_id());
-    EXPECT_TRUE((*job)->ack().ok());
+    EXPECT_THAT((*job)->ack(), testing::IsOk());
   }
   EXPECT_EQ(taken, (std::set<std::string>{"job-a", "job-b", "job-c"}));
 }
@@ -172,7 +173,7 @@ TEST(JobStates, AStaleWriterIsRefused) {
   EXPECT_THAT(stale, testing::StatusIs(absl::StatusCode::kAborted)) << stale.status();
   EXPECT_EQ(table.get("job-a").value().value, "running on worker 2");
 
-  EXPECT_TRUE(table.remove("job-a").ok());
+  EXPECT_THAT(table.remove("job-a"), testing::IsOk());
   EXPECT_EQ(table.get("job-a").status().code(), absl::StatusCode::kNotFound);
   EXPECT_EQ(table.get("never").status().code(), absl::StatusCode::kNotFound);
 }
@@ -192,7 +193,7 @@ TEST(NatsClient, AnUnansweredCallIsUnavailable) {
   EXPECT_THAT(status, testing::StatusIs(absl::StatusCode::kUnavailable));
   EXPECT_NE(std::string(status.message()).find("publish job-x"), std::string::npos) << status;
   EXPECT_EQ(nats_error(NATS_NOT_FOUND, "get").code(), absl::StatusCode::kNotFound);
-  EXPECT_TRUE(nats_error(NATS_OK, "get").ok());
+  EXPECT_THAT(nats_error(NATS_OK, "get"), testing::IsOk());
 }
 
 }  // namespace

@@ -20,7 +20,7 @@ TEST(SharedArtifacts, FilesAppearWholeUnderTheirName) {
   EXPECT_TRUE(fs::is_directory(root / "uploads"));
   EXPECT_TRUE(fs::is_directory(root / "jobs"));
   const std::string bytes(1 << 20, 'x');
-  ASSERT_TRUE(store->put("jobs/j1/out-1/volume.vtu", bytes).ok());
+  ASSERT_THAT(store->put("jobs/j1/out-1/volume.vtu", bytes), testing::IsOk());
   EXPECT_EQ(store->get("jobs/j1/out-1/volume.vtu").value(), bytes);
   // Nothing but the file itself is left in its directory.
   size_t entries = 0;
@@ -34,7 +34,7 @@ TEST(SharedArtifacts, FilesAppearWholeUnderTheirName) {
 
 TEST(SharedArtifacts, PathsOutsideTheStoreAreRefused) {
   auto store = SharedArtifacts::open(testing::scratch_dir("artifacts-paths").string());
-  ASSERT_TRUE(store.ok());
+  ASSERT_THAT(store, testing::IsOk());
   for (const char* path : {"/etc/passwd", "../x", "jobs/../../x", ""}) {
     EXPECT_EQ(store->put(path, "x").code(), absl::StatusCode::kInvalidArgument) << path;
     EXPECT_EQ(store->get(path).status().code(), absl::StatusCode::kInvalidArgument) << path;
@@ -44,10 +44,11 @@ TEST(SharedArtifacts, PathsOutsideTheStoreAreRefused) {
 TEST(SharedArtifacts, OnlyTheFinalAttemptsFilesRemain) {
   const auto root = testing::scratch_dir("artifacts-attempts");
   auto store = SharedArtifacts::open(root.string());
-  ASSERT_TRUE(store.ok());
+  ASSERT_THAT(store, testing::IsOk());
   EXPECT_EQ(store->attempt_dir("j1", 2), (root / "jobs/j1/out-2").string());
   for (int attempt : {1, 2, 3}) {
-    ASSERT_TRUE(store->put("jobs/j1/out-" + std::to_string(attempt) + "/report.json", "{}").ok());
+    ASSERT_THAT(store->put("jobs/j1/out-" + std::to_string(attempt) + "/report.json", "{}"),
+                testing::IsOk());
   }
   EXPECT_EQ(store->remove_other_attempts("j1", 2).value(), 2u);
   EXPECT_FALSE(fs::exists(root / "jobs/j1/out-1"));

@@ -95,7 +95,7 @@ TEST(CoarsenLabels, TheMesherCoarsensWhenTheInterfacesWouldBeTooLarge) {
   auto coarse = mesh_conforming(phantom.volume, {}, params, RunContext{}, coarse_figures, improve);
   ASSERT_THAT(coarse, testing::IsOk());
   for (double factor : coarse_figures.coarsening.factors) EXPECT_NEAR(factor, std::sqrt(3.0), 0.01);
-  EXPECT_TRUE(check_conforming_mesh(*coarse).ok());
+  EXPECT_THAT(check_conforming_mesh(*coarse), testing::IsOk());
   EXPECT_LT(coarse->tetrahedra.size(), fine->tetrahedra.size() / 2);
   // Volumes are still measured against the input's voxels.
   for (const auto& label : coarse_figures.labels)

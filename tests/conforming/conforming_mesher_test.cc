@@ -183,7 +183,7 @@ TEST(ConformingMesher, AMirroredGridKeepsEveryLabelOnItsSide) {
   auto& d = phantom.volume.geometry.direction;
   for (int row = 0; row < 3; ++row) d[3 * row] = -d[3 * row];  // x runs the other way
   const auto [mesh, figures] = mesh_phantom(phantom.volume);
-  EXPECT_TRUE(check_conforming_mesh(mesh).ok());
+  EXPECT_THAT(check_conforming_mesh(mesh), testing::IsOk());
   for (const auto& label : figures.labels)
     EXPECT_LT(std::abs(label.volume_change()), 0.03) << "label " << label.label;
 }
@@ -191,7 +191,7 @@ TEST(ConformingMesher, AMirroredGridKeepsEveryLabelOnItsSide) {
 TEST(ConformingMesher, UnselectedLabelsAreOutside) {
   const auto phantom = volume::make_phantom(PhantomShape::kNestedSpheres);
   const auto [mesh, figures] = mesh_phantom(phantom.volume, {1, 3});
-  EXPECT_TRUE(check_conforming_mesh(mesh).ok());
+  EXPECT_THAT(check_conforming_mesh(mesh), testing::IsOk());
   EXPECT_EQ(std::set<int32_t>(mesh.labels.begin(), mesh.labels.end()), (std::set<int32_t>{1, 3}));
   // The shell of label 2 between them is a cavity left empty.
   EXPECT_GE(figures.regions.outside_regions, 1u);
@@ -210,7 +210,7 @@ TEST(ConformingMesher, RefusesAVolumeWithoutTheSelectedLabels) {
 TEST(ConformityCheck, FindsWhatBreaksAMesh) {
   const auto phantom = volume::make_phantom(PhantomShape::kTouchingBoxes);
   const auto [mesh, figures] = mesh_phantom(phantom.volume);
-  ASSERT_TRUE(check_conforming_mesh(mesh).ok());
+  ASSERT_THAT(check_conforming_mesh(mesh), testing::IsOk());
 
   auto inverted = mesh;
   std::swap(inverted.tetrahedra[0][0], inverted.tetrahedra[0][1]);

@@ -168,7 +168,7 @@ TEST(ThickSlices, GiveAConformingMeshOfFiniteElementQuality) {
   auto mesh = mesh_conforming(thick, {}, ConformingParams{}, RunContext{}, figures, improve);
   ASSERT_THAT(mesh, testing::IsOk());
   EXPECT_EQ(figures.thick_slices.axis, 2);
-  EXPECT_TRUE(check_conforming_mesh(*mesh).ok());
+  EXPECT_THAT(check_conforming_mesh(*mesh), testing::IsOk());
   const auto quality = volume_mesh::summarise_quality(*mesh);
   EXPECT_GE(quality.min, 0.2);
   EXPECT_GE(quality.min_dihedral_deg, 10.0);

@@ -156,10 +156,10 @@ TEST(MixedMeshFaces, TablesAreVtksAndWindOutwards) {
 
 TEST(MixedMeshCheck, RejectsMalformedMeshes) {
   const MixedMesh good = all_four_types();
-  EXPECT_TRUE(check_mixed_mesh(good).ok());
+  EXPECT_THAT(check_mixed_mesh(good), testing::IsOk());
   MixedMesh unused_slots = good;
   unused_slots.cells[3][7] = 999;  // a tetrahedron's fifth to eighth entries are not read
-  EXPECT_TRUE(check_mixed_mesh(unused_slots).ok());
+  EXPECT_THAT(check_mixed_mesh(unused_slots), testing::IsOk());
 
   MixedMesh bad = good;
   bad.labels.pop_back();
@@ -195,7 +195,7 @@ void expect_conformity(const Conformity& c, size_t interior, size_t boundary, si
 
 TEST(MixedMeshConformity, TwoHexahedraShareAFace) {
   const MixedMesh mesh = two_hexahedra();
-  ASSERT_TRUE(check_mixed_mesh(mesh).ok());
+  ASSERT_THAT(check_mixed_mesh(mesh), testing::IsOk());
   expect_conformity(check_conformity(mesh), 1, 10, 0, 0, 0);
   const MixedQuality q = measure_mixed_mesh(mesh);
   EXPECT_NEAR(q.volume_mm3, 2, kNear);
@@ -286,7 +286,7 @@ TEST(MixedMeshConformity, CrackOpensTheBoundary) {
   MixedMesh mesh = two_hexahedra();
   const uint32_t copy = add_point(mesh, mesh.points[5]);
   mesh.cells[1][4] = copy;  // the right cube's corner (1,0,1)
-  ASSERT_TRUE(check_mixed_mesh(mesh).ok());
+  ASSERT_THAT(check_mixed_mesh(mesh), testing::IsOk());
   const Conformity c = check_conformity(mesh);
   expect_conformity(c, 0, 12, 0, 1, 2);
   EXPECT_FALSE(c.ok());
@@ -647,7 +647,7 @@ TEST(MixedMeshWrite, RasFrameInEveryFormat) {
        {VolumeFormat::kVtu, VolumeFormat::kMsh, VolumeFormat::kMedit, VolumeFormat::kAbaqus}) {
     SCOPED_TRACE(std::string(volume_format_name(format)));
     const auto path = (dir / ("ras." + std::string(volume_format_name(format)))).string();
-    ASSERT_TRUE(write_mixed_mesh(mesh, quality, path, format, info).ok());
+    ASSERT_THAT(write_mixed_mesh(mesh, quality, path, format, info), testing::IsOk());
     const auto summary = meshio_summary(dir, path);
     expect_four_cells(summary, format == VolumeFormat::kAbaqus);
     EXPECT_EQ(summary.at("point8"), "-0.5 -0.5 1.5");  // (0.5, 0.5, 1.5) in LPS
@@ -681,7 +681,7 @@ TEST(MixedMeshWrite, BadInputsAreErrorsNamingTheFile) {
   EXPECT_EQ(std::string(wrong_size.message()).rfind(msh + ": 3 quality values", 0), 0u)
       << wrong_size;
   // No quality at all is fine.
-  EXPECT_TRUE(write_mixed_mesh(mesh, {}, msh, VolumeFormat::kMsh).ok());
+  EXPECT_THAT(write_mixed_mesh(mesh, {}, msh, VolumeFormat::kMsh), testing::IsOk());
 
   MixedMesh unlabelled = mesh;
   unlabelled.labels[2] = 0;
@@ -690,7 +690,8 @@ TEST(MixedMeshWrite, BadInputsAreErrorsNamingTheFile) {
     EXPECT_THAT(status, testing::StatusIs(absl::StatusCode::kInvalidArgument)) << status;
     EXPECT_NE(std::string(status.message()).find("label 0"), std::string::npos) << status;
   }
-  EXPECT_TRUE(write_mixed_mesh(unlabelled, {}, (dir / "x.vtu").string(), VolumeFormat::kVtu).ok());
+  EXPECT_THAT(write_mixed_mesh(unlabelled, {}, (dir / "x.vtu").string(), VolumeFormat::kVtu),
+              testing::IsOk());
 
   MixedMesh broken = mesh;
   broken.cells[0][3] = 99;

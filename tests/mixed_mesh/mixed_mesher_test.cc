@@ -49,7 +49,8 @@ surface::TriangleMesh phantom_surface(volume::PhantomShape shape, const std::str
   if (name == "liver") return delivered_surface(testing::shared_data("liver.inr.gz"), 255);
   const fs::path dir = testing::scratch_dir("mixed-" + name);
   const auto path = (dir / "phantom.nii.gz").string();
-  EXPECT_TRUE(volume::write_label_volume(volume::make_phantom(shape).volume, path).ok());
+  EXPECT_THAT(volume::write_label_volume(volume::make_phantom(shape).volume, path),
+              testing::IsOk());
   return delivered_surface(path, 1);
 }
 
@@ -80,7 +81,7 @@ TEST_P(MixedMesher, BothLayersAreValidAndFillTheSurface) {
   ASSERT_FALSE(surface.triangles.empty());
   const double enclosed = surface::compute_surface_statistics(surface).volume_mm3;
   const auto oracle = SurfaceOracle::build(surface);
-  ASSERT_TRUE(oracle.ok());
+  ASSERT_THAT(oracle, testing::IsOk());
 
   MixedParams tet_layer;
   tet_layer.core.cell_mm = expect.cell_mm;
@@ -99,7 +100,7 @@ TEST_P(MixedMesher, BothLayersAreValidAndFillTheSurface) {
     EXPECT_GT(*q.pyramid_aspect_ratio_min, 0.5);
     EXPECT_GT(q.tetra_summary.min, 0.02);
     EXPECT_GE(double(q.cell_summary.good), expect.good_share * double(mesh->size()));
-    EXPECT_TRUE(check_conformity(*mesh).ok());
+    EXPECT_THAT(check_conformity(*mesh), testing::IsOk());
     std::printf("%s at %.1f mm, tetrahedral layer: %zu hexahedra, %zu pyramids, %zu tetrahedra\n",
                 expect.name, expect.cell_mm, q.hexahedra, q.pyramids, q.tetrahedra);
   }
@@ -145,7 +146,7 @@ TEST_P(MixedMesher, BothLayersAreValidAndFillTheSurface) {
   EXPECT_GE(oq.jacobian_ratio_min, 0.3);
   EXPECT_EQ(oq.cell_summary.good, int64_t(coarse->size()));
   EXPECT_NEAR(oq.volume_mm3, enclosed, 0.01 * enclosed);
-  EXPECT_TRUE(check_conformity(*coarse).ok());
+  EXPECT_THAT(check_conformity(*coarse), testing::IsOk());
   EXPECT_EQ(octree_figures.octree.octants[1] > 0, expect.octants_fit);
   EXPECT_EQ(octree_figures.octree.transition_octants > 0, expect.octants_fit);
   EXPECT_LE(coarse->points.size(), mesh->points.size());
@@ -205,7 +206,7 @@ TEST(HexLayerPattern, PoorHexahedraSplitIntoSixValidPyramids) {
     MixedMesh pyramids;
     pyramids.points = mesh.points;
     for (const auto& p : pyramids_of(mesh.cells[0], 8)) pyramids.add(CellType::kPyramid, p, 1);
-    ASSERT_TRUE(check_mixed_mesh(pyramids).ok());
+    ASSERT_THAT(check_mixed_mesh(pyramids), testing::IsOk());
     const MixedQuality q = measure_mixed_mesh(pyramids);
     EXPECT_EQ(q.pyramids, 6u);
     EXPECT_EQ(q.invalid, 0u);
@@ -214,7 +215,7 @@ TEST(HexLayerPattern, PoorHexahedraSplitIntoSixValidPyramids) {
     EXPECT_NEAR(q.volume_mm3, hex_volume, 1e-12) << "trial " << trial;
     // The pyramids meet face to face; their outside is the hexahedron's.
     const Conformity c = check_conformity(pyramids);
-    EXPECT_TRUE(c.ok());
+    EXPECT_THAT(c, testing::IsOk());
     EXPECT_EQ(c.boundary_faces, 6u);
     EXPECT_EQ(c.interior_faces, 12u);
   }
@@ -271,7 +272,7 @@ TEST(MixedVolumeStage, NestedSpheresConformAndKeepTheirVolume) {
   auto result = run_pipeline(path, params, {});
   ASSERT_THAT(result, testing::IsOk());
   ASSERT_TRUE(result->mixed.has_value());
-  ASSERT_TRUE(write_results(*result, params, (dir / "out").string(), {}).ok());
+  ASSERT_THAT(write_results(*result, params, (dir / "out").string(), {}), testing::IsOk());
   const v1::Report report = make_report(*result, params);
   ASSERT_TRUE(report.has_volume());
   const auto& v = report.volume();
@@ -315,7 +316,7 @@ TEST(MixedVolumeStage, HexahedraOnlyLeavesOutWhatCannotBeValid) {
   ASSERT_THAT(params, testing::IsOk());
   auto result = run_pipeline(path, *params, {});
   ASSERT_THAT(result, testing::IsOk());
-  ASSERT_TRUE(write_results(*result, *params, (dir / "fine").string(), {}).ok());
+  ASSERT_THAT(write_results(*result, *params, (dir / "fine").string(), {}), testing::IsOk());
   v1::Report report = make_report(*result, *params);
   const auto& v = report.volume();
   EXPECT_EQ(v.mesher(), "hex_grid");
@@ -341,7 +342,7 @@ TEST(MixedVolumeStage, HexahedraOnlyLeavesOutWhatCannotBeValid) {
   params->hex_size_mm = 2;
   result = run_pipeline(path, *params, {});
   ASSERT_THAT(result, testing::IsOk());
-  ASSERT_TRUE(write_results(*result, *params, (dir / "coarse").string(), {}).ok());
+  ASSERT_THAT(write_results(*result, *params, (dir / "coarse").string(), {}), testing::IsOk());
   report = make_report(*result, *params);
   EXPECT_EQ(report.volume().labels_left_out_size(), 3);
   EXPECT_EQ(report.volume().hexahedra(), 0u);

@@ -97,7 +97,7 @@ TEST(OctreeTransitions, EveryPatternIsValidConformingAndFillsItsOctant) {
         }
     OctreeFigures figures;
     const MixedMesh mesh = mesh_octants(octants, {10, -5, 3}, 1.5, 4, figures);
-    ASSERT_TRUE(check_mixed_mesh(mesh).ok());
+    ASSERT_THAT(check_mixed_mesh(mesh), testing::IsOk());
     const MixedQuality q = measure_mixed_mesh(mesh);
     EXPECT_EQ(q.invalid, 0u) << "trial " << trial;
     const double cube = 1.5 * 1.5 * 1.5;
@@ -107,7 +107,7 @@ TEST(OctreeTransitions, EveryPatternIsValidConformingAndFillsItsOctant) {
     for (size_t c = 0; c < mesh.size(); ++c)
       if (octant_edge(mesh, c) > 2) octant_volume += cell_signed_volume(mesh, c);
     EXPECT_NEAR(octant_volume, 8 * cube * double(whole), 1e-9) << "trial " << trial;
-    EXPECT_TRUE(check_conformity(mesh).ok()) << "trial " << trial;
+    EXPECT_THAT(check_conformity(mesh), testing::IsOk()) << "trial " << trial;
     EXPECT_EQ(hanging_nodes(mesh), 0u) << "trial " << trial;
     expect_balanced(mesh);
     if (q.pyramid_aspect_ratio_min) EXPECT_GE(*q.pyramid_aspect_ratio_min, 0.45);
@@ -154,12 +154,12 @@ TEST(OctreeCore, ABlockCoarsensInsideAndKeepsItsBoundary) {
   OctreeFigures figures;
   auto coarse = coarsen_core(core, params, figures);
   ASSERT_THAT(coarse, testing::IsOk());
-  ASSERT_TRUE(check_mixed_mesh(*coarse).ok());
+  ASSERT_THAT(check_mixed_mesh(*coarse), testing::IsOk());
   const MixedQuality q = measure_mixed_mesh(*coarse);
   EXPECT_EQ(q.invalid, 0u);
   EXPECT_NEAR(q.volume_mm3, double(n * n * n) * h * h * h, 1e-6);
   const Conformity c = check_conformity(*coarse);
-  EXPECT_TRUE(c.ok());
+  EXPECT_THAT(c, testing::IsOk());
   EXPECT_EQ(hanging_nodes(*coarse), 0u);
   EXPECT_EQ(c.boundary_faces, size_t(6 * n * n));
   for (const CellFace& face : label_boundary_faces(*coarse)) {
@@ -184,7 +184,7 @@ TEST(OctreeCore, ABlockCoarsensInsideAndKeepsItsBoundary) {
             absl::StatusCode::kInvalidArgument);
   params.interior_mm = 0;
   auto same = coarsen_core(core, params, figures);
-  ASSERT_TRUE(same.ok());
+  ASSERT_THAT(same, testing::IsOk());
   EXPECT_EQ(same->size(), core.size());
 }
 

@@ -39,7 +39,7 @@ using volume::PhantomShape;
 
 std::string phantom_file(PhantomShape shape, const std::string& name) {
   const auto path = (testing::scratch_dir("guard-" + name) / name).string();
-  EXPECT_TRUE(volume::write_label_volume(make_phantom(shape).volume, path).ok());
+  EXPECT_THAT(volume::write_label_volume(make_phantom(shape).volume, path), testing::IsOk());
   return path;
 }
 
@@ -162,7 +162,8 @@ TEST(DeliveryGuard, LabelsInParallelGiveTheSameSurfacesAsOneAtATime) {
   four.threads = 4;
   auto serial = run_pipeline(path, one, RunContext{});
   auto parallel = run_pipeline(path, four, RunContext{});
-  ASSERT_TRUE(serial.ok() && parallel.ok());
+  ASSERT_THAT(serial, testing::IsOk());
+  ASSERT_THAT(parallel, testing::IsOk());
   ASSERT_EQ(serial->surfaces.size(), parallel->surfaces.size());
   for (size_t i = 0; i < serial->surfaces.size(); ++i) {
     const auto& a = serial->surfaces[i];
@@ -234,11 +235,11 @@ TEST(LevelSetSurface, MeshesASphereMaskWithThirtyDegreeAnglesCloseToItsVoxels) {
   const auto statistics = volume::compute_label_statistics(phantom.volume);
   auto components = volume::find_label_components(phantom.volume, *statistics.find(1),
                                                   volume::ComponentOptions{}, RunContext{});
-  ASSERT_TRUE(components.ok());
+  ASSERT_THAT(components, testing::IsOk());
   ASSERT_EQ(components->components.size(), 1u);
   auto marching_cubes =
       surface::extract_component_surfaces(*components, {1}, phantom.volume.geometry, RunContext{});
-  ASSERT_TRUE(marching_cubes.ok());
+  ASSERT_THAT(marching_cubes, testing::IsOk());
   const auto& staircase = marching_cubes->front();
   auto field = surface::component_field(*components, 1, phantom.volume.geometry, 0.4);
   ASSERT_THAT(field, testing::IsOk());
@@ -314,7 +315,7 @@ TEST(LevelSetSurface, RefusesBadGridsAndSizes) {
   params.max_edge_mm = 1;
   params.max_distance_mm = 0.1;
   const std::vector<std::array<double, 3>> seeds{{0.5, 1, 1}};
-  EXPECT_TRUE(surface::mesh_level_set(grid, params, seeds, RunContext{}).ok());
+  EXPECT_THAT(surface::mesh_level_set(grid, params, seeds, RunContext{}), testing::IsOk());
   auto expect_refused = [&](const surface::ScalarGrid& g, const surface::LevelSetParams& p,
                             const std::vector<std::array<double, 3>>& s) {
     EXPECT_EQ(surface::mesh_level_set(g, p, s, RunContext{}).status().code(),

@@ -204,10 +204,10 @@ TEST(JobOptions, SizingInMillimetresIsCheckedAgainstTheGrid) {
   volume::ImageGeometry geometry;
   geometry.spacing = {3, 3, 3};
   PoissonOptions poisson;
-  EXPECT_TRUE(check_sizing_for_grid(poisson, geometry).ok());
+  EXPECT_THAT(check_sizing_for_grid(poisson, geometry), testing::IsOk());
   poisson.max_edge_mm = 1.5;  // half a 3 mm voxel: the finest allowed
   poisson.max_distance_mm = 0.15;
-  EXPECT_TRUE(check_sizing_for_grid(poisson, geometry).ok());
+  EXPECT_THAT(check_sizing_for_grid(poisson, geometry), testing::IsOk());
   poisson.max_edge_mm = 1.4;
   auto status = check_sizing_for_grid(poisson, geometry);
   EXPECT_THAT(status, testing::StatusIs(absl::StatusCode::kInvalidArgument));
@@ -217,7 +217,7 @@ TEST(JobOptions, SizingInMillimetresIsCheckedAgainstTheGrid) {
   status = check_sizing_for_grid(poisson, geometry);
   EXPECT_TRUE(absl::StrContains(status.message(), "label 114")) << status.message();
   geometry.spacing = {0.1, 0.1, 0.1};  // the same sizing on a fine grid is fine
-  EXPECT_TRUE(check_sizing_for_grid(poisson, geometry).ok());
+  EXPECT_THAT(check_sizing_for_grid(poisson, geometry), testing::IsOk());
 }
 
 }  // namespace

@@ -60,7 +60,8 @@ void expect_valid_elements(const VolumeResult& volume) {
 
 TEST(VolumeMeshes, SphereFillsItsPoissonSurface) {
   const auto path = (testing::scratch_dir("tets-sphere") / "sphere.nii.gz").string();
-  ASSERT_TRUE(volume::write_label_volume(make_phantom(PhantomShape::kSphere).volume, path).ok());
+  ASSERT_THAT(volume::write_label_volume(make_phantom(PhantomShape::kSphere).volume, path),
+              testing::IsOk());
   const MeshResult result = mesh_with_tets(path);
   ASSERT_TRUE(result.volume.has_value());
   const VolumeResult& volume = *result.volume;

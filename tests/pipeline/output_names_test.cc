@@ -37,7 +37,7 @@ TEST(OutputNames, ADicomSegSegmentNamesItsSurfaceFiles) {
   auto result =
       run_pipeline(testing::shared_data("dicom-seg/dcmqi-24x38x3-seg.dcm"), params, RunContext{});
   ASSERT_THAT(result, testing::IsOk());
-  ASSERT_TRUE(write_results(*result, params, out.string(), RunContext{}).ok());
+  ASSERT_THAT(write_results(*result, params, out.string(), RunContext{}), testing::IsOk());
   EXPECT_TRUE(std::filesystem::exists(out / "surface-label1-liver.stl"));
   EXPECT_TRUE(std::filesystem::exists(out / "surface-label1-liver.vtp"));
   EXPECT_FALSE(std::filesystem::exists(out / "surface-label1.stl"));

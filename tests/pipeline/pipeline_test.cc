@@ -65,7 +65,7 @@ TEST(Pipeline, OneOutputSurfacePerLabelAndItsFilesWritten) {
   MeshParams params = repaired_params();
   params.formats = {surface::SurfaceFormat::kPly, surface::SurfaceFormat::kStl};
   const fs::path out = dir / "out";
-  ASSERT_TRUE(write_results(*result, params, out.string(), {}).ok());
+  ASSERT_THAT(write_results(*result, params, out.string(), {}), testing::IsOk());
   size_t files = 0;
   for (const auto& surface : result->surfaces) {
     EXPECT_EQ(surface.files.size(), surface.is_output ? 2u : 0u) << surface.stage;
@@ -103,7 +103,7 @@ TEST(Pipeline, ProgressNamesTheLabelAndItsPlace) {
     places[label.label] = {label.name, label.index, label.count};
     EXPECT_LT(label.done, label.count);
   };
-  ASSERT_TRUE(run_pipeline(input, params, context).ok());
+  ASSERT_THAT(run_pipeline(input, params, context), testing::IsOk());
   EXPECT_TRUE(whole_volume_stages.count("read"));
   EXPECT_TRUE(whole_volume_stages.count("marching_cubes"));
   EXPECT_FALSE(whole_volume_stages.count("repair"));
@@ -127,7 +127,7 @@ TEST(Pipeline, SceneFilesAndTheRasFrame) {
   ASSERT_THAT(result, testing::IsOk());
   ASSERT_NE(result->label_image, nullptr);
   const fs::path out = dir / "out";
-  ASSERT_TRUE(write_results(*result, params, out.string(), {}).ok());
+  ASSERT_THAT(write_results(*result, params, out.string(), {}), testing::IsOk());
   EXPECT_EQ(result->scene_files,
             (std::vector<std::string>{"surfaces.vtm", "surfaces/surfaces_0.vtp",
                                       "surfaces/surfaces_1.vtp", "surfaces/surfaces_2.vtp",
@@ -178,7 +178,7 @@ TEST(Pipeline, BadRequestsGetTheirOwnCodesNamingTheCause) {
   std::memset(empty.voxels->GetScalarPointer(), 0,
               size_t(empty.geometry.voxel_count()) * size_t(empty.voxels->GetScalarSize()));
   const std::string background = (dir / "background.nii.gz").string();
-  ASSERT_TRUE(volume::write_label_volume(empty, background).ok());
+  ASSERT_THAT(volume::write_label_volume(empty, background), testing::IsOk());
   result = run_pipeline(background, repaired_params(), {});
   ASSERT_FALSE(result.ok());
   EXPECT_THAT(result, testing::StatusIs(absl::StatusCode::kFailedPrecondition));

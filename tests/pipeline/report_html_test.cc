@@ -311,7 +311,7 @@ TEST(ReportHtml, WrittenBesideReportJson) {
   params.surface = SurfaceMethod::kRepaired;
   auto result = run_pipeline(write_sphere(dir), params, {});
   ASSERT_THAT(result, testing::IsOk());
-  ASSERT_TRUE(write_results(*result, params, (dir / "out").string(), {}).ok());
+  ASSERT_THAT(write_results(*result, params, (dir / "out").string(), {}), testing::IsOk());
   ASSERT_TRUE(fs::exists(dir / "out" / "report.json"));
   const std::string html = testing::read_bytes(dir / "out" / "report.html");
   size_t delivered = 0;
@@ -324,7 +324,7 @@ TEST(ReportHtml, WrittenBesideReportJson) {
   // The input named with its digest, and every delivered surface pictured.
   EXPECT_TRUE(absl::StrContains(html, "<td>sphere.nii.gz</td>"));
   const auto digest = digest::sha256_file((dir / "sphere.nii.gz").string());
-  ASSERT_TRUE(digest.ok());
+  ASSERT_THAT(digest, testing::IsOk());
   EXPECT_TRUE(absl::StrContains(html, cat("<code>", *digest, "</code>")));
   EXPECT_EQ(count(html, "data:image/png;base64,"), 1 + delivered);
 }

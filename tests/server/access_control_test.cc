@@ -101,7 +101,7 @@ class AccessControlTest : public ::testing::Test {
   std::vector<std::string> listed(ServiceHarness& service) {
     auto ctx = service.context();
     v1::ListJobsReply reply;
-    EXPECT_TRUE(service.stub().ListJobs(ctx.get(), {}, &reply).ok());
+    EXPECT_THAT(service.stub().ListJobs(ctx.get(), {}, &reply), testing::IsOk());
     std::vector<std::string> ids;
     for (const auto& job : reply.jobs()) ids.push_back(job.job_id());
     return ids;
@@ -120,10 +120,10 @@ TEST_F(AccessControlTest, EachClientSeesOnlyItsOwnJobsAndAdminsSeeAll) {
   ServiceHarness service(config_);
   service.token = kAliceToken;
   v1::SubmitReply alices;
-  ASSERT_TRUE(service.submit(sphere_, repaired_options(), &alices).ok());
+  ASSERT_THAT(service.submit(sphere_, repaired_options(), &alices), testing::IsOk());
   service.token = kBobToken;
   v1::SubmitReply bobs;
-  ASSERT_TRUE(service.submit(sphere_, repaired_options(), &bobs).ok());
+  ASSERT_THAT(service.submit(sphere_, repaired_options(), &bobs), testing::IsOk());
 
   // To Bob, Alice's job does not exist, whatever he calls.
   for (grpc::StatusCode code : codes_of_every_call(service, alices.job_id())) {
@@ -134,15 +134,15 @@ TEST_F(AccessControlTest, EachClientSeesOnlyItsOwnJobsAndAdminsSeeAll) {
   EXPECT_EQ(listed(service), std::vector<std::string>{alices.job_id()});
   grpc::Status status;
   EXPECT_EQ(service.get(alices.job_id(), &status).owner(), "alice");
-  EXPECT_TRUE(status.ok());
+  EXPECT_THAT(status, testing::IsOk());
 
   // Carol, an admin, sees both and can act on them.
   service.token = kCarolToken;
   EXPECT_EQ(listed(service).size(), 2u);
   EXPECT_EQ(service.get(bobs.job_id(), &status).owner(), "bob");
-  EXPECT_TRUE(status.ok());
+  EXPECT_THAT(status, testing::IsOk());
   v1::DeleteJobReply deleted;
-  ASSERT_TRUE(delete_job(service, bobs.job_id(), &deleted).ok());
+  ASSERT_THAT(delete_job(service, bobs.job_id(), &deleted), testing::IsOk());
   EXPECT_EQ(deleted.state(), v1::JOB_STATE_QUEUED);
   EXPECT_FALSE(fs::exists(spool_ / "jobs" / bobs.job_id()));
   EXPECT_EQ(listed(service), std::vector<std::string>{alices.job_id()});
@@ -152,13 +152,13 @@ TEST_F(AccessControlTest, DeleteRemovesInputAndResultsAtOnce) {
   ServiceHarness service(config_);
   service.token = kAliceToken;
   v1::SubmitReply reply;
-  ASSERT_TRUE(service.submit(sphere_, repaired_options(), &reply).ok());
+  ASSERT_THAT(service.submit(sphere_, repaired_options(), &reply), testing::IsOk());
   ASSERT_TRUE(service.watch(reply.job_id()).back().has_finished());
   const fs::path job_dir = spool_ / "jobs" / reply.job_id();
   ASSERT_GT(count_files(job_dir / "out-1"), 2u);
 
   v1::DeleteJobReply deleted;
-  ASSERT_TRUE(delete_job(service, reply.job_id(), &deleted).ok());
+  ASSERT_THAT(delete_job(service, reply.job_id(), &deleted), testing::IsOk());
   EXPECT_EQ(deleted.state(), v1::JOB_STATE_SUCCEEDED);
   EXPECT_FALSE(fs::exists(job_dir));
   grpc::Status status;
@@ -175,13 +175,13 @@ TEST_F(AccessControlTest, ARunningJobDeletedIsStoppedAndGone) {
   v1::MeshOptions options;
   options.add_labels(255);
   v1::SubmitReply reply;
-  ASSERT_TRUE(service.submit(shared_data("liver.inr.gz"), options, &reply).ok());
+  ASSERT_THAT(service.submit(shared_data("liver.inr.gz"), options, &reply), testing::IsOk());
   for (int i = 0; i < 100 && service.get(reply.job_id()).state() != v1::JOB_STATE_RUNNING; ++i) {
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
   }
   ASSERT_EQ(service.get(reply.job_id()).state(), v1::JOB_STATE_RUNNING);
   v1::DeleteJobReply deleted;
-  ASSERT_TRUE(delete_job(service, reply.job_id(), &deleted).ok());
+  ASSERT_THAT(delete_job(service, reply.job_id(), &deleted), testing::IsOk());
   EXPECT_EQ(deleted.state(), v1::JOB_STATE_RUNNING);
   // Gone for clients at once; its files once the worker has stopped.
   grpc::Status status;
@@ -202,7 +202,7 @@ TEST_F(AccessControlTest, TheInputIsDeletedWhenTheJobEndsUnlessKept) {
   ServiceHarness service(config_);
   service.token = kAliceToken;
   v1::SubmitReply dropped, kept;
-  ASSERT_TRUE(service.submit(sphere_, repaired_options(), &dropped).ok());
+  ASSERT_THAT(service.submit(sphere_, repaired_options(), &dropped), testing::IsOk());
   const std::string bytes = read_bytes(sphere_);
   v1::JobSpec spec;
   *spec.mutable_options() = repaired_options();
@@ -210,7 +210,7 @@ TEST_F(AccessControlTest, TheInputIsDeletedWhenTheJobEndsUnlessKept) {
   spec.set_size_bytes(bytes.size());
   spec.set_sha256(digest::sha256_hex(bytes));
   spec.set_keep_input(true);
-  ASSERT_TRUE(service.submit_raw(spec, bytes, &kept).ok());
+  ASSERT_THAT(service.submit_raw(spec, bytes, &kept), testing::IsOk());
   ASSERT_TRUE(service.watch(dropped.job_id()).back().has_finished());
   ASSERT_TRUE(service.watch(kept.job_id()).back().has_finished());
   EXPECT_FALSE(fs::exists(spool_ / "jobs" / dropped.job_id() / "input.nii.gz"));
@@ -333,9 +333,9 @@ TEST_F(AccessControlTest, ARetriedSubmitWithTheSameRequestIdGetsTheSameJob) {
   spec.set_sha256(digest::sha256_hex(bytes));
   spec.set_request_id("order-4711/attempt");
   v1::SubmitReply first, again;
-  ASSERT_TRUE(service.submit_raw(spec, bytes, &first).ok());
+  ASSERT_THAT(service.submit_raw(spec, bytes, &first), testing::IsOk());
   EXPECT_FALSE(first.existing());
-  ASSERT_TRUE(service.submit_raw(spec, bytes, &again).ok());
+  ASSERT_THAT(service.submit_raw(spec, bytes, &again), testing::IsOk());
   EXPECT_TRUE(again.existing());
   EXPECT_EQ(again.job_id(), first.job_id());
   EXPECT_EQ(listed(service).size(), 1u);
@@ -343,7 +343,7 @@ TEST_F(AccessControlTest, ARetriedSubmitWithTheSameRequestIdGetsTheSameJob) {
   // Another client's id is its own; the same id for other bytes is refused.
   service.token = kBobToken;
   v1::SubmitReply bobs;
-  ASSERT_TRUE(service.submit_raw(spec, bytes, &bobs).ok());
+  ASSERT_THAT(service.submit_raw(spec, bytes, &bobs), testing::IsOk());
   EXPECT_NE(bobs.job_id(), first.job_id());
   service.token = kAliceToken;
   spec.set_sha256(std::string(64, 'a'));
@@ -358,7 +358,7 @@ TEST_F(AccessControlTest, ListJobsPagesAndFiltersByState) {
   std::vector<std::string> submitted;
   for (int i = 0; i < 5; ++i) {
     v1::SubmitReply reply;
-    ASSERT_TRUE(service.submit(sphere_, repaired_options(), &reply).ok());
+    ASSERT_THAT(service.submit(sphere_, repaired_options(), &reply), testing::IsOk());
     submitted.insert(submitted.begin(), reply.job_id());  // newest first
   }
   {
@@ -366,7 +366,7 @@ TEST_F(AccessControlTest, ListJobsPagesAndFiltersByState) {
     v1::CancelRequest cancel;
     cancel.set_job_id(submitted[4]);
     v1::Job job;
-    ASSERT_TRUE(service.stub().Cancel(ctx.get(), cancel, &job).ok());
+    ASSERT_THAT(service.stub().Cancel(ctx.get(), cancel, &job), testing::IsOk());
   }
   std::vector<std::string> paged;
   v1::ListJobsRequest request;
@@ -375,7 +375,7 @@ TEST_F(AccessControlTest, ListJobsPagesAndFiltersByState) {
   do {
     auto ctx = service.context();
     v1::ListJobsReply reply;
-    ASSERT_TRUE(service.stub().ListJobs(ctx.get(), request, &reply).ok());
+    ASSERT_THAT(service.stub().ListJobs(ctx.get(), request, &reply), testing::IsOk());
     EXPECT_LE(reply.jobs_size(), 2);
     for (const auto& job : reply.jobs()) {
       paged.push_back(job.job_id());
@@ -391,7 +391,7 @@ TEST_F(AccessControlTest, ListJobsPagesAndFiltersByState) {
   cancelled.add_states(v1::JOB_STATE_CANCELLED);
   auto ctx = service.context();
   v1::ListJobsReply reply;
-  ASSERT_TRUE(service.stub().ListJobs(ctx.get(), cancelled, &reply).ok());
+  ASSERT_THAT(service.stub().ListJobs(ctx.get(), cancelled, &reply), testing::IsOk());
   ASSERT_EQ(reply.jobs_size(), 1);
   EXPECT_EQ(reply.jobs(0).job_id(), submitted[4]);
 
@@ -418,11 +418,11 @@ TEST_F(AccessControlTest, TheAuditLogHasALinePerJobAndNoHeaderText) {
 
   service.token = kAliceToken;
   v1::SubmitReply accepted, refused;
-  ASSERT_TRUE(service.submit(named, repaired_options(), &accepted).ok());
+  ASSERT_THAT(service.submit(named, repaired_options(), &accepted), testing::IsOk());
   ASSERT_TRUE(service.watch(accepted.job_id()).back().has_finished());
   EXPECT_EQ(service.submit(broken, repaired_options(), &refused).error_code(),
             grpc::StatusCode::INVALID_ARGUMENT);
-  ASSERT_TRUE(delete_job(service, accepted.job_id()).ok());
+  ASSERT_THAT(delete_job(service, accepted.job_id()), testing::IsOk());
   service.token = "wrong-token-0123456789";
   EXPECT_EQ(service.submit(named, repaired_options(), &refused).error_code(),
             grpc::StatusCode::UNAUTHENTICATED);
@@ -462,7 +462,7 @@ TEST_F(AccessControlTest, JobsFromBeforeIdentitiesBelongToTheAnonymousClient) {
     record.mutable_job()->set_state(v1::JOB_STATE_CANCELLED);
     record.mutable_job()->set_created_at(server::unix_now());
     record.mutable_job()->set_finished_at(server::unix_now());
-    ASSERT_TRUE(spool->save(record).ok());
+    ASSERT_THAT(spool->save(record), testing::IsOk());
   }
   {
     ServiceHarness authenticated(config_);
@@ -472,7 +472,7 @@ TEST_F(AccessControlTest, JobsFromBeforeIdentitiesBelongToTheAnonymousClient) {
     EXPECT_EQ(status.error_code(), grpc::StatusCode::NOT_FOUND);
     authenticated.token = kCarolToken;
     EXPECT_EQ(authenticated.get(id, &status).owner(), "anonymous");
-    EXPECT_TRUE(status.ok());
+    EXPECT_THAT(status, testing::IsOk());
   }
   config_.clients_file.clear();
   ServiceHarness anonymous(config_);

@@ -82,7 +82,7 @@ class ClusterRolesTest : public ::testing::Test {
     record.mutable_spec()->set_request_id(request_id);
     record.mutable_spec()->set_sha256("digest of " + bytes);
     record.set_input_extension(".nii.gz");
-    EXPECT_TRUE(store_->accept(record, upload).ok());
+    EXPECT_THAT(store_->accept(record, upload), testing::IsOk());
     return id;
   }
 
@@ -91,7 +91,7 @@ class ClusterRolesTest : public ::testing::Test {
     auto claim = connection_->jobs->claim(id).value();
     v1::JobRecord result;
     if (state == v1::JOB_STATE_SUCCEEDED) result.add_artifacts()->set_name("volume.vtu");
-    ASSERT_TRUE(connection_->jobs->finish(claim, state, result).ok());
+    ASSERT_THAT(connection_->jobs->finish(claim, state, result), testing::IsOk());
   }
 
   // A sphere phantom accepted as a frontend would, for a real worker to run.
@@ -105,7 +105,7 @@ class ClusterRolesTest : public ::testing::Test {
     record.mutable_job()->set_owner("ann");
     record.mutable_job()->set_created_at(server::unix_now());
     record.set_input_extension(".nii.gz");
-    EXPECT_TRUE(store_->accept(record, upload).ok());
+    EXPECT_THAT(store_->accept(record, upload), testing::IsOk());
     return id;
   }
 
@@ -147,7 +147,7 @@ TEST_F(ClusterRolesTest, ARetriedRequestIsOneJobOnAnyFrontend) {
   std::ofstream(upload) << "volume bytes";
   v1::JobRecord again;
   again.mutable_job()->set_job_id(id);
-  ASSERT_TRUE(other.accept(again, upload).ok());
+  ASSERT_THAT(other.accept(again, upload), testing::IsOk());
   EXPECT_FALSE(fs::exists(upload));
   EXPECT_EQ(other.get(id).value().owner(), "ann");
   EXPECT_EQ(connection_->queue->stored().value(), 1u);
@@ -159,16 +159,16 @@ TEST_F(ClusterRolesTest, AnEndedJobWhoseEndWasNotLoggedIsToldByItsRecord) {
   const std::string id = accept("ann", "");
   finish(id, v1::JOB_STATE_SUCCEEDED);
   RecordingListener logged;
-  ASSERT_TRUE(store_->listen(id, 0, &logged).ok());
+  ASSERT_THAT(store_->listen(id, 0, &logged), testing::IsOk());
   ASSERT_TRUE(logged.ended());
   std::vector<std::string> kinds;
   for (const auto& event : logged.events()) kinds.push_back(event.has_finished() ? "f" : "-");
   EXPECT_EQ(kinds, (std::vector<std::string>{"-", "-", "f"}));  // queued, started, finished
 
   // The worker died between the record and the event; or the events aged out.
-  ASSERT_TRUE(connection_->events->remove(id).ok());
+  ASSERT_THAT(connection_->events->remove(id), testing::IsOk());
   RecordingListener unlogged;
-  ASSERT_TRUE(store_->listen(id, 0, &unlogged).ok());
+  ASSERT_THAT(store_->listen(id, 0, &unlogged), testing::IsOk());
   ASSERT_TRUE(unlogged.ended());
   ASSERT_EQ(unlogged.events().size(), 1u);
   EXPECT_TRUE(unlogged.events()[0].has_finished());
@@ -177,11 +177,11 @@ TEST_F(ClusterRolesTest, AnEndedJobWhoseEndWasNotLoggedIsToldByItsRecord) {
 TEST_F(ClusterRolesTest, ALiveJobIsFollowedUntilItsEnd) {
   const std::string id = accept("ann", "");
   RecordingListener listener;
-  ASSERT_TRUE(store_->listen(id, 0, &listener).ok());
+  ASSERT_THAT(store_->listen(id, 0, &listener), testing::IsOk());
   auto claim = connection_->jobs->claim(id).value();
   v1::JobEvent stage;
   stage.mutable_stage_started()->set_stage("surface");
-  ASSERT_TRUE(connection_->jobs->publish(claim, stage).ok());
+  ASSERT_THAT(connection_->jobs->publish(claim, stage), testing::IsOk());
   // GetJob reads a running job's stage from its newest event.
   bool staged = false;
   for (int i = 0; i < 100 && !staged; ++i) {
@@ -189,7 +189,7 @@ TEST_F(ClusterRolesTest, ALiveJobIsFollowedUntilItsEnd) {
     if (!staged) std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
   EXPECT_TRUE(staged);
-  ASSERT_TRUE(connection_->jobs->finish(claim, v1::JOB_STATE_FAILED, {}).ok());
+  ASSERT_THAT(connection_->jobs->finish(claim, v1::JOB_STATE_FAILED, {}), testing::IsOk());
   for (int i = 0; i < 250 && !listener.ended(); ++i)
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   store_->unlisten(id, &listener);
@@ -241,7 +241,7 @@ TEST_F(ClusterRolesTest, ExpiryRemovesEndedJobsWithTheirFilesAndKeepsTheRest) {
 
 TEST_F(ClusterRolesTest, ARequestIdReusedAfterADeleteIsANewJobAndTheOldMessageIsDropped) {
   const std::string first = accept("ann", "r1");
-  ASSERT_TRUE(store_->remove(first).ok());
+  ASSERT_THAT(store_->remove(first), testing::IsOk());
   std::this_thread::sleep_for(std::chrono::milliseconds(2));  // another creation time
   const std::string second = accept("ann", "r1");
   ASSERT_EQ(second, first);  // the same id, made again
@@ -251,7 +251,7 @@ TEST_F(ClusterRolesTest, ARequestIdReusedAfterADeleteIsANewJobAndTheOldMessageIs
   ASSERT_TRUE(old_message.has_value());
   EXPECT_EQ(connection_->jobs->claim(first, {old_message->made()}).status().code(),
             absl::StatusCode::kFailedPrecondition);
-  ASSERT_TRUE(old_message->ack().ok());
+  ASSERT_THAT(old_message->ack(), testing::IsOk());
   auto new_message = connection_->queue->take(absl::Seconds(2)).value();
   ASSERT_TRUE(new_message.has_value());
   auto claim = connection_->jobs->claim(second, {new_message->made()});
@@ -262,7 +262,7 @@ TEST_F(ClusterRolesTest, ARequestIdReusedAfterADeleteIsANewJobAndTheOldMessageIs
 TEST_F(ClusterRolesTest, ShutdownEndsEveryFollowAndListenRefusesAfter) {
   const std::string id = accept("ann", "");
   RecordingListener listener;
-  ASSERT_TRUE(store_->listen(id, 0, &listener).ok());
+  ASSERT_THAT(store_->listen(id, 0, &listener), testing::IsOk());
   store_->close();
   EXPECT_TRUE(listener.ended());
   store_->unlisten(id, &listener);  // gone already: returns at once
@@ -273,8 +273,8 @@ TEST_F(ClusterRolesTest, ShutdownEndsEveryFollowAndListenRefusesAfter) {
 TEST_F(ClusterRolesTest, FollowsOfDeletedOrSilentlyEndedJobsAreEnded) {
   const std::string deleted = accept("ann", "");
   RecordingListener of_deleted;
-  ASSERT_TRUE(store_->listen(deleted, 0, &of_deleted).ok());
-  ASSERT_TRUE(store_->remove(deleted).ok());
+  ASSERT_THAT(store_->listen(deleted, 0, &of_deleted), testing::IsOk());
+  ASSERT_THAT(store_->remove(deleted), testing::IsOk());
   store_->check_follows();
   EXPECT_TRUE(of_deleted.ended());
 
@@ -282,7 +282,7 @@ TEST_F(ClusterRolesTest, FollowsOfDeletedOrSilentlyEndedJobsAreEnded) {
   // the two): the record stands in once the event is overdue.
   const std::string silent = accept("ann", "");
   RecordingListener of_silent;
-  ASSERT_TRUE(store_->listen(silent, 0, &of_silent).ok());
+  ASSERT_THAT(store_->listen(silent, 0, &of_silent), testing::IsOk());
   auto stored = connection_->states->get(silent).value();
   v1::JobRecord record;
   ASSERT_TRUE(record.ParseFromString(stored.value));
@@ -320,20 +320,20 @@ TEST_F(ClusterRolesTest, AJobWhoseLastDeliveryDiedIsFailedPastTheTimeout) {
 TEST_F(ClusterRolesTest, AnotherMessageNeverTakesARunningJobOver) {
   const std::string id = accept("ann", "");
   auto first = connection_->jobs->claim(id, {"", 10, false});
-  ASSERT_TRUE(first.ok());
+  ASSERT_THAT(first, testing::IsOk());
   // The same message again (its worker went silent) takes over...
   auto again = connection_->jobs->claim(id, {"", 10, false});
-  ASSERT_TRUE(again.ok());
+  ASSERT_THAT(again, testing::IsOk());
   EXPECT_EQ(again->attempt, 2u);
   // ...a second message of the job (a give-back whose ack was lost) does not.
   EXPECT_EQ(connection_->jobs->claim(id, {"", 11, false}).status().code(),
             absl::StatusCode::kFailedPrecondition);
   // A give-back makes the job QUEUED, and the new message takes it.
-  ASSERT_TRUE(connection_->jobs->requeue(*again).ok());
+  ASSERT_THAT(connection_->jobs->requeue(*again), testing::IsOk());
   EXPECT_EQ(store_->get(id).value().state(), v1::JOB_STATE_QUEUED);
   EXPECT_EQ(connection_->jobs->requeue(*again).code(), absl::StatusCode::kAborted);
   auto third = connection_->jobs->claim(id, {"", 12, false});
-  ASSERT_TRUE(third.ok());
+  ASSERT_THAT(third, testing::IsOk());
   EXPECT_EQ(third->attempt, 3u);
 }
 
@@ -477,7 +477,7 @@ TEST(ClusterRoleConfig, FrontendsAndWorkersNeedNatsAndTheSharedDirectory) {
   config.nats_url = "nats://127.0.0.1:4222";
   EXPECT_NE(server::validate_config(config).message().find("--artifact-dir"), std::string::npos);
   config.artifact_dir = "/shared";
-  EXPECT_TRUE(server::validate_config(config).ok());
+  EXPECT_THAT(server::validate_config(config), testing::IsOk());
   config.role = "worker";
   config.workers = 0;
   EXPECT_NE(server::validate_config(config).message().find("--workers"), std::string::npos);

@@ -16,6 +16,7 @@
 #include "grpc/health/v1/health.grpc.pb.h"
 #include "server/metrics.h"
 #include "support/service_harness.h"
+#include "support/status_matchers.h"
 #include "support/test_files.h"
 
 namespace labelmesh {
@@ -110,7 +111,7 @@ TEST_F(FullDiskTest, NoAcceptedJobIsLostWhenTheDiskFills) {
     ServiceHarness service(config);
     for (int i = 0; i < 3; ++i) {
       v1::SubmitReply reply;
-      ASSERT_TRUE(service.submit(input_, testing::repaired_options(), &reply).ok());
+      ASSERT_THAT(service.submit(input_, testing::repaired_options(), &reply), testing::IsOk());
       jobs.push_back(reply.job_id());
     }
     fill_the_disk();
@@ -160,7 +161,7 @@ TEST_F(FullDiskTest, QueuedJobsWaitForRoomInsteadOfFailing) {
   {
     ServiceHarness service(config);
     v1::SubmitReply reply;
-    ASSERT_TRUE(service.submit(input_, testing::repaired_options(), &reply).ok());
+    ASSERT_THAT(service.submit(input_, testing::repaired_options(), &reply), testing::IsOk());
     id = reply.job_id();
     service.shutdown();
   }

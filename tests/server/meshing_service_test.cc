@@ -63,7 +63,7 @@ class MeshingServiceTest : public ::testing::Test {
   v1::Job finished_job(ServiceHarness& service, const fs::path& input,
                        const v1::MeshOptions& options) {
     v1::SubmitReply reply;
-    EXPECT_TRUE(service.submit(input, options, &reply).ok());
+    EXPECT_THAT(service.submit(input, options, &reply), testing::IsOk());
     service.watch(reply.job_id());
     return service.get(reply.job_id());
   }
@@ -83,7 +83,7 @@ TEST_F(MeshingServiceTest, WholeJobFromUploadToFetchedArtifacts) {
   ServiceHarness service(config_);
   v1::SubmitReply reply;
   const fs::path input = write_phantom(dir_, volume::PhantomShape::kSphere);
-  ASSERT_TRUE(service.submit(input, v1::MeshOptions(), &reply).ok());
+  ASSERT_THAT(service.submit(input, v1::MeshOptions(), &reply), testing::IsOk());
   EXPECT_EQ(reply.job_id().size(), 32u);
   EXPECT_EQ(reply.queue_position(), 0u);
 
@@ -129,7 +129,7 @@ TEST_F(MeshingServiceTest, WholeJobFromUploadToFetchedArtifacts) {
   v1::ListArtifactsRequest list_request;
   list_request.set_job_id(reply.job_id());
   v1::ListArtifactsReply artifacts;
-  ASSERT_TRUE(service.stub().ListArtifacts(ctx.get(), list_request, &artifacts).ok());
+  ASSERT_THAT(service.stub().ListArtifacts(ctx.get(), list_request, &artifacts), testing::IsOk());
   std::vector<std::string> names;
   for (const auto& artifact : artifacts.artifacts()) names.push_back(artifact.name());
   EXPECT_EQ(names, (std::vector<std::string>{"report.html", "report.json", "surface-label1.stl",
@@ -150,7 +150,7 @@ TEST_F(MeshingServiceTest, WholeJobFromUploadToFetchedArtifacts) {
       EXPECT_LE(chunk.data().size(), 1u << 20);
       bytes += chunk.data();
     }
-    ASSERT_TRUE(reader->Finish().ok());
+    ASSERT_THAT(reader->Finish(), testing::IsOk());
     EXPECT_EQ(bytes.size(), artifact.size_bytes());
     EXPECT_EQ(digest::sha256_hex(bytes), artifact.sha256()) << artifact.name();
   }
@@ -172,7 +172,7 @@ TEST_F(MeshingServiceTest, TheServiceMakesTheSameMixedMeshAsTheLibrary) {
   const v1::VolumeMeshSummary& served = job.report().volume();
 
   auto params = params_from_options(options);
-  ASSERT_TRUE(params.ok());
+  ASSERT_THAT(params, testing::IsOk());
   auto local = run_pipeline(input.string(), *params, {});
   ASSERT_THAT(local, testing::IsOk());
   const v1::VolumeMeshSummary mine = make_report(*local, *params).volume();
@@ -240,7 +240,7 @@ TEST_F(MeshingServiceTest, ConformingJobsShareInterfacesAsInTheCli) {
 
   // The same job in this process gives the same mesh.
   auto params = params_from_options(options);
-  ASSERT_TRUE(params.ok());
+  ASSERT_THAT(params, testing::IsOk());
   auto local = run_pipeline(input.string(), *params, {});
   ASSERT_THAT(local, testing::IsOk());
   const v1::VolumeMeshSummary mine = make_report(*local, *params).volume();
@@ -256,9 +256,9 @@ TEST_F(MeshingServiceTest, FullQueueRefusesWithResourceExhausted) {
   ServiceHarness service(config_);
   const fs::path input = write_phantom(dir_, volume::PhantomShape::kSphere);
   v1::SubmitReply reply;
-  ASSERT_TRUE(service.submit(input, repaired_options(), &reply).ok());
+  ASSERT_THAT(service.submit(input, repaired_options(), &reply), testing::IsOk());
   EXPECT_EQ(reply.queue_position(), 0u);
-  ASSERT_TRUE(service.submit(input, repaired_options(), &reply).ok());
+  ASSERT_THAT(service.submit(input, repaired_options(), &reply), testing::IsOk());
   EXPECT_EQ(reply.queue_position(), 1u);
   const grpc::Status full = service.submit(input, repaired_options(), &reply);
   EXPECT_EQ(full.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED) << full.error_message();
@@ -292,12 +292,12 @@ TEST_F(MeshingServiceTest, UploadOverFiftyMegabytesArrivesWhole) {
     }
   }
   const fs::path input = dir_ / "big.nii";
-  ASSERT_TRUE(volume::write_label_volume(big, input.string()).ok());
+  ASSERT_THAT(volume::write_label_volume(big, input.string()), testing::IsOk());
   ASSERT_GT(fs::file_size(input), 64'000'000u);
 
   ServiceHarness service(config_);
   v1::SubmitReply reply;
-  ASSERT_TRUE(service.submit(input, repaired_options(), &reply).ok());
+  ASSERT_THAT(service.submit(input, repaired_options(), &reply), testing::IsOk());
   EXPECT_EQ(uploads_left(), 0u);
   const auto events = service.watch(reply.job_id());
   ASSERT_TRUE(events.back().has_finished()) << events.back().DebugString();
@@ -392,7 +392,7 @@ TEST_F(MeshingServiceTest, BrokenUploadsAreRefusedAndLeaveNothing) {
   EXPECT_EQ(uploads_left(), 0u);
   EXPECT_EQ(job_dirs(), 0u);
   // The refusals cost the server nothing: a good upload still goes through.
-  EXPECT_TRUE(service.submit_raw(good, bytes, &reply).ok());
+  EXPECT_THAT(service.submit_raw(good, bytes, &reply), testing::IsOk());
 }
 
 // Refused at Submit, not later in a worker: a volume a worker cannot hold,
@@ -457,8 +457,8 @@ TEST_F(MeshingServiceTest, UploadsThatCouldOnlyFailLaterAreRefusedAtSubmit) {
 
   EXPECT_EQ(job_dirs(), 0u);
   EXPECT_EQ(uploads_left(), 0u);
-  EXPECT_TRUE(roomy.submit(sphere, repaired_options(), &reply).ok());
-  EXPECT_TRUE(roomy.submit(vti, repaired_options(), &reply).ok());
+  EXPECT_THAT(roomy.submit(sphere, repaired_options(), &reply), testing::IsOk());
+  EXPECT_THAT(roomy.submit(vti, repaired_options(), &reply), testing::IsOk());
 }
 
 // DICOM SEG: read whole in a worker at Submit, so what cannot be meshed
@@ -544,7 +544,8 @@ TEST_F(MeshingServiceTest, CancelStopsARunningJobWithinASecond) {
   LABELMESH_SKIP_WITHOUT_SHARED_DATA();
   ServiceHarness service(config_);
   v1::SubmitReply reply;
-  ASSERT_TRUE(service.submit(shared_data("liver.inr.gz"), liver_options(), &reply).ok());
+  ASSERT_THAT(service.submit(shared_data("liver.inr.gz"), liver_options(), &reply),
+              testing::IsOk());
   // Follow the job until a stage after reading starts, then cancel.
   auto ctx = service.context();
   v1::WatchRequest watch;
@@ -561,11 +562,11 @@ TEST_F(MeshingServiceTest, CancelStopsARunningJobWithinASecond) {
       v1::CancelRequest cancel;
       cancel.set_job_id(reply.job_id());
       v1::Job job;
-      ASSERT_TRUE(service.stub().Cancel(cancel_ctx.get(), cancel, &job).ok());
+      ASSERT_THAT(service.stub().Cancel(cancel_ctx.get(), cancel, &job), testing::IsOk());
       cancelled_at = Clock::now();
     }
   }
-  ASSERT_TRUE(reader->Finish().ok());
+  ASSERT_THAT(reader->Finish(), testing::IsOk());
   ASSERT_NE(cancelled_at, Clock::time_point{}) << "no repair stage seen";
   EXPECT_TRUE(events.back().has_cancelled()) << events.back().DebugString();
   EXPECT_LT(std::chrono::duration<double>(Clock::now() - cancelled_at).count(), 1.0);
@@ -591,7 +592,8 @@ TEST_F(MeshingServiceTest, JobOverTheDeadlineFailsWithDeadlineExceeded) {
   config_.job_timeout = absl::Seconds(1);
   ServiceHarness service(config_);
   v1::SubmitReply reply;
-  ASSERT_TRUE(service.submit(shared_data("liver.inr.gz"), liver_options(), &reply).ok());
+  ASSERT_THAT(service.submit(shared_data("liver.inr.gz"), liver_options(), &reply),
+              testing::IsOk());
   const auto events = service.watch(reply.job_id());
   ASSERT_TRUE(events.back().has_failed()) << events.back().DebugString();
   EXPECT_EQ(events.back().failed().code(), int(grpc::StatusCode::DEADLINE_EXCEEDED))
@@ -609,7 +611,7 @@ TEST_F(MeshingServiceTest, StrictJobWithALabelNotDeliveredFails) {
   v1::MeshOptions options = repaired_options();
   options.set_strict(true);
   v1::SubmitReply reply;
-  ASSERT_TRUE(service.submit(input, options, &reply).ok());
+  ASSERT_THAT(service.submit(input, options, &reply), testing::IsOk());
   auto events = service.watch(reply.job_id());
   ASSERT_TRUE(events.back().has_failed()) << events.back().DebugString();
   EXPECT_EQ(events.back().failed().code(), int(grpc::StatusCode::FAILED_PRECONDITION));
@@ -617,7 +619,7 @@ TEST_F(MeshingServiceTest, StrictJobWithALabelNotDeliveredFails) {
       << events.back().failed().message();
 
   options.set_strict(false);
-  ASSERT_TRUE(service.submit(input, options, &reply).ok());
+  ASSERT_THAT(service.submit(input, options, &reply), testing::IsOk());
   events = service.watch(reply.job_id());
   ASSERT_TRUE(events.back().has_finished()) << events.back().DebugString();
   const auto& report = events.back().finished().report();
@@ -650,7 +652,7 @@ TEST_F(MeshingServiceTest, AResultSentBeforeTheDeadlineStands) {
   config_.job_timeout = absl::Seconds(1);
   ServiceHarness service(config_);
   v1::SubmitReply reply;
-  ASSERT_TRUE(submit_sphere(service, &reply).ok());
+  ASSERT_THAT(submit_sphere(service, &reply), testing::IsOk());
   const auto watched = service.watch(reply.job_id());
   ASSERT_TRUE(watched.back().has_finished()) << watched.back().DebugString();
   EXPECT_EQ(watched.back().finished().report().labelmesh_version(), "scripted");
@@ -676,7 +678,7 @@ TEST_F(MeshingServiceTest, TwoWatchersSeeTheSameEvents) {
   v1::CancelRequest cancel;
   cancel.set_job_id(reply.job_id());
   v1::Job job;
-  ASSERT_TRUE(service.stub().Cancel(ctx.get(), cancel, &job).ok());
+  ASSERT_THAT(service.stub().Cancel(ctx.get(), cancel, &job), testing::IsOk());
   EXPECT_EQ(job.state(), v1::JOB_STATE_CANCELLED);
   a.join();
   b.join();
@@ -696,7 +698,7 @@ TEST_F(MeshingServiceTest, QueuedJobRunsAfterARestart) {
     config_.workers = 0;
     ServiceHarness service(config_);
     v1::SubmitReply reply;
-    ASSERT_TRUE(submit_sphere(service, &reply).ok());
+    ASSERT_THAT(submit_sphere(service, &reply), testing::IsOk());
     job_id = reply.job_id();
     service.shutdown();
   }
@@ -731,7 +733,7 @@ TEST_F(MeshingServiceTest, ExpiredResultsAreDeletedAtStart) {
   {
     ServiceHarness service(config_);
     v1::SubmitReply reply;
-    ASSERT_TRUE(submit_sphere(service, &reply).ok());
+    ASSERT_THAT(submit_sphere(service, &reply), testing::IsOk());
     job_id = reply.job_id();
     EXPECT_TRUE(service.watch(job_id).back().has_finished());
     service.shutdown();
@@ -751,12 +753,12 @@ TEST_F(MeshingServiceTest, EndedJobsBeyondTheCapAreDeletedOldestFirst) {
   std::vector<std::string> jobs;
   for (int i = 0; i < 3; ++i) {
     v1::SubmitReply reply;
-    ASSERT_TRUE(submit_sphere(service, &reply).ok());
+    ASSERT_THAT(submit_sphere(service, &reply), testing::IsOk());
     auto context = service.context();
     v1::CancelRequest cancel;
     cancel.set_job_id(reply.job_id());
     v1::Job job;
-    ASSERT_TRUE(service.stub().Cancel(context.get(), cancel, &job).ok());
+    ASSERT_THAT(service.stub().Cancel(context.get(), cancel, &job), testing::IsOk());
     jobs.push_back(reply.job_id());
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
@@ -771,7 +773,7 @@ TEST_F(MeshingServiceTest, EndedJobsBeyondTheCapAreDeletedOldestFirst) {
   for (size_t i = 1; i < jobs.size(); ++i) {
     grpc::Status kept;
     EXPECT_EQ(service.get(jobs[i], &kept).state(), v1::JOB_STATE_CANCELLED);
-    EXPECT_TRUE(kept.ok()) << jobs[i];
+    EXPECT_THAT(kept, testing::IsOk()) << jobs[i];
   }
   EXPECT_EQ(job_dirs(), 2u);
 }
@@ -798,7 +800,7 @@ TEST_F(MeshingServiceTest, CallsWithoutTheTokenAreUnauthenticated) {
   EXPECT_EQ(job_dirs(), 0u);
   service.token = "s3cret-token-0123456789";
   auto ctx = service.context();
-  EXPECT_TRUE(service.stub().ListJobs(ctx.get(), {}, &jobs).ok());
+  EXPECT_THAT(service.stub().ListJobs(ctx.get(), {}, &jobs), testing::IsOk());
 }
 
 TEST_F(MeshingServiceTest, UnknownJobsAndArtifactsAreNotFound) {
@@ -809,7 +811,7 @@ TEST_F(MeshingServiceTest, UnknownJobsAndArtifactsAreNotFound) {
   service.get("../../etc", &status);
   EXPECT_EQ(status.error_code(), grpc::StatusCode::NOT_FOUND);
   v1::SubmitReply reply;
-  ASSERT_TRUE(submit_sphere(service, &reply).ok());
+  ASSERT_THAT(submit_sphere(service, &reply), testing::IsOk());
   ASSERT_TRUE(service.watch(reply.job_id()).back().has_finished());
   for (const std::string name : {"../job.pb", "job.pb", "/etc/passwd", "missing.stl"}) {
     auto ctx = service.context();
@@ -862,14 +864,14 @@ TEST_F(MeshingServiceTest, CrashedWorkerFailsOnlyItsJob) {
   ServiceHarness service(config_);
   v1::SubmitReply reply;
   const fs::path input = write_phantom(dir_, volume::PhantomShape::kSphere);
-  ASSERT_TRUE(service.submit(input, repaired_options(), &reply).ok());
+  ASSERT_THAT(service.submit(input, repaired_options(), &reply), testing::IsOk());
   const auto events = service.watch(reply.job_id());
   ASSERT_TRUE(events.back().has_failed());
   EXPECT_EQ(events.back().failed().code(), int(grpc::StatusCode::INTERNAL));
   EXPECT_TRUE(absl::StrContains(events.back().failed().message(), "SIGSEGV"))
       << events.back().failed().message();
   // The server is still there and takes the next job.
-  ASSERT_TRUE(service.submit(input, repaired_options(), &reply).ok());
+  ASSERT_THAT(service.submit(input, repaired_options(), &reply), testing::IsOk());
   EXPECT_TRUE(service.watch(reply.job_id()).back().has_failed());
 }
 

@@ -13,6 +13,7 @@
 #include "absl/strings/str_cat.h"
 #include "core/volume/phantom.h"
 #include "support/service_harness.h"
+#include "support/status_matchers.h"
 
 namespace labelmesh {
 namespace {
@@ -49,7 +50,7 @@ class OutputLimitTest : public ::testing::Test {
       v1::ListArtifactsRequest request;
       request.set_job_id(reply.job_id());
       v1::ListArtifactsReply listed;
-      EXPECT_TRUE(service.stub().ListArtifacts(context.get(), request, &listed).ok());
+      EXPECT_THAT(service.stub().ListArtifacts(context.get(), request, &listed), testing::IsOk());
       artifacts_.assign(listed.artifacts().begin(), listed.artifacts().end());
     }
     outputs_left_ = count_files(dir_ / spool_name / "jobs" / reply.job_id(), "out-");

@@ -14,6 +14,7 @@
 #include "server/error_details.h"
 #include "server/stream_limits.h"
 #include "server/upload_checks.h"
+#include "support/status_matchers.h"
 
 namespace labelmesh::server {
 namespace {
@@ -44,7 +45,7 @@ TEST(Refusal, UnmarkedStatusesGiveTheFallback) {
   EXPECT_EQ(refusal_of(absl::InternalError("x")), Refusal::kRefused);
   // OK holds no payload: marking it leaves it OK and unmarked.
   const absl::Status ok = refused(Refusal::kQueueFull, absl::OkStatus());
-  EXPECT_TRUE(ok.ok());
+  EXPECT_THAT(ok, testing::IsOk());
   EXPECT_EQ(refusal_of(ok), Refusal::kRefused);
   // A later mark replaces an earlier one.
   const absl::Status twice =
@@ -67,7 +68,7 @@ TEST(Refusal, TheLayersThatKnowWhyMarkTheirStatuses) {
 
   StreamCounts uploads({1, 5, 5}, "uploads", Refusal::kTooManyUploads);
   auto first = uploads.open("client", "host");
-  ASSERT_TRUE(first.ok());
+  ASSERT_THAT(first, testing::IsOk());
   auto second = uploads.open("client", "host");
   ASSERT_FALSE(second.ok());
   EXPECT_EQ(second.status().code(), absl::StatusCode::kResourceExhausted);

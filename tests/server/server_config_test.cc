@@ -39,13 +39,13 @@ TEST(ServerConfigRules, ANonLoopbackAddressNeedsClientAuthenticationOrAllowAnony
   EXPECT_THAT(status, testing::StatusIs(absl::StatusCode::kInvalidArgument));
   EXPECT_NE(status.message().find("--allow-anonymous"), std::string::npos) << status;
   config.allow_anonymous = true;
-  EXPECT_TRUE(server::validate_config(config).ok());
+  EXPECT_THAT(server::validate_config(config), testing::IsOk());
   config.allow_anonymous = false;
   config.clients_file = "clients";
-  EXPECT_TRUE(server::validate_config(config).ok());
+  EXPECT_THAT(server::validate_config(config), testing::IsOk());
   config.clients_file.clear();
   config.client_ca = "ca.pem";
-  EXPECT_TRUE(server::validate_config(config).ok());
+  EXPECT_THAT(server::validate_config(config), testing::IsOk());
 }
 
 TEST(ServerConfigRules, NonLoopbackMetricsNeedAllowAnonymous) {
@@ -57,17 +57,17 @@ TEST(ServerConfigRules, NonLoopbackMetricsNeedAllowAnonymous) {
   EXPECT_NE(server::validate_config(config).message().find("--metrics-listen"), std::string::npos);
   config.clients_file.clear();
   config.allow_anonymous = true;
-  EXPECT_TRUE(server::validate_config(config).ok());
+  EXPECT_THAT(server::validate_config(config), testing::IsOk());
   config.metrics_listen = "127.0.0.1:9464";
   config.allow_anonymous = false;
-  EXPECT_TRUE(server::validate_config(config).ok());
+  EXPECT_THAT(server::validate_config(config), testing::IsOk());
 }
 
 TEST(ServerConfigRules, AbandonedUploadsOutliveEveryPauseOfALivingUpload) {
   server::ServerConfig config;
   config.stream_idle_timeout = absl::Minutes(3);  // a living upload may pause 3 minutes
   // One machine sweeps nothing: any idle timeout is fine there.
-  EXPECT_TRUE(server::validate_config(config).ok());
+  EXPECT_THAT(server::validate_config(config), testing::IsOk());
   config.role = "frontend";
   config.nats_url = "nats://127.0.0.1:4222";
   config.artifact_dir = "/srv/labelmesh";
@@ -75,7 +75,7 @@ TEST(ServerConfigRules, AbandonedUploadsOutliveEveryPauseOfALivingUpload) {
   EXPECT_THAT(status, testing::StatusIs(absl::StatusCode::kInvalidArgument));
   EXPECT_NE(status.message().find("--abandoned-upload-age"), std::string::npos) << status;
   config.abandoned_upload_age = absl::Minutes(6);
-  EXPECT_TRUE(server::validate_config(config).ok());
+  EXPECT_THAT(server::validate_config(config), testing::IsOk());
   config.stream_idle_timeout = absl::Seconds(5);
   config.abandoned_upload_age = absl::Seconds(19);
   EXPECT_FALSE(server::validate_config(config).ok());
@@ -117,26 +117,26 @@ TEST(AuthBackoff, DoublesUpToTheLongestAndForgetsOnlyWithTime) {
   server::AuthBackoff backoff(2, absl::Seconds(1), absl::Seconds(3));
   const absl::Time t0 = absl::FromUnixSeconds(1'000'000);
   backoff.failed("ipv4:10.0.0.7", t0);
-  EXPECT_TRUE(backoff.check("ipv4:10.0.0.7", t0).ok());
+  EXPECT_THAT(backoff.check("ipv4:10.0.0.7", t0), testing::IsOk());
   backoff.failed("ipv4:10.0.0.7", t0);
   EXPECT_EQ(backoff.check("ipv4:10.0.0.7", t0).code(), absl::StatusCode::kResourceExhausted);
-  EXPECT_TRUE(backoff.check("ipv4:10.0.0.8", t0).ok());
-  EXPECT_TRUE(backoff.check("ipv4:10.0.0.7", t0 + absl::Seconds(1)).ok());
+  EXPECT_THAT(backoff.check("ipv4:10.0.0.8", t0), testing::IsOk());
+  EXPECT_THAT(backoff.check("ipv4:10.0.0.7", t0 + absl::Seconds(1)), testing::IsOk());
   backoff.failed("ipv4:10.0.0.7", t0);  // third: 2 s
   EXPECT_FALSE(backoff.check("ipv4:10.0.0.7", t0 + absl::Milliseconds(1900)).ok());
-  EXPECT_TRUE(backoff.check("ipv4:10.0.0.7", t0 + absl::Seconds(2)).ok());
+  EXPECT_THAT(backoff.check("ipv4:10.0.0.7", t0 + absl::Seconds(2)), testing::IsOk());
   for (int i = 0; i < 5; ++i) backoff.failed("ipv4:10.0.0.7", t0);  // capped at 3 s
   EXPECT_FALSE(backoff.check("ipv4:10.0.0.7", t0 + absl::Milliseconds(2900)).ok());
-  EXPECT_TRUE(backoff.check("ipv4:10.0.0.7", t0 + absl::Seconds(3)).ok());
+  EXPECT_THAT(backoff.check("ipv4:10.0.0.7", t0 + absl::Seconds(3)), testing::IsOk());
   // Failures are forgotten a while after the last one.
   const absl::Time later = t0 + server::AuthBackoff::kForgetAfter + absl::Seconds(1);
   backoff.failed("ipv4:10.0.0.7", later);
-  EXPECT_TRUE(backoff.check("ipv4:10.0.0.7", later).ok());
+  EXPECT_THAT(backoff.check("ipv4:10.0.0.7", later), testing::IsOk());
   // IPv6 hosts count by their /64: stepping through it does not help.
   backoff.failed("ipv6:[2001:db8:1:2::10]", t0);
   backoff.failed("ipv6:%5B2001:db8:1:2::11%5D", t0);
   EXPECT_FALSE(backoff.check("ipv6:[2001:db8:1:2::12]", t0).ok());
-  EXPECT_TRUE(backoff.check("ipv6:[2001:db8:1:3::12]", t0).ok());
+  EXPECT_THAT(backoff.check("ipv6:[2001:db8:1:3::12]", t0), testing::IsOk());
 }
 
 TEST(AuditLine, IsOneJsonObjectWithEveryCharacterEscaped) {

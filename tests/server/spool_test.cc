@@ -110,9 +110,9 @@ TEST(Spool, EachAttemptHasItsOwnOutputDirectory) {
   ASSERT_THAT(spool, testing::IsOk());
   const std::string id = server::new_job_id();
   ASSERT_TRUE(save_queued(*spool, id));
-  ASSERT_TRUE(spool->reset_output(id, 1).ok());
+  ASSERT_THAT(spool->reset_output(id, 1), testing::IsOk());
   testing::write_file(fs::path(spool->output_dir(id, 1)) / "surface-label1.stl", "first");
-  ASSERT_TRUE(spool->reset_output(id, 2).ok());
+  ASSERT_THAT(spool->reset_output(id, 2), testing::IsOk());
   EXPECT_FALSE(fs::exists(spool->output_dir(id, 1)));
   EXPECT_EQ(testing::entries_in(spool->output_dir(id, 2)), 0u);
   // What the stale worker writes now lands in out-1, not among the results.

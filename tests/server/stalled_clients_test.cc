@@ -11,6 +11,7 @@
 #include "core/digest/sha256.h"
 #include "server/metrics.h"
 #include "support/service_harness.h"
+#include "support/status_matchers.h"
 
 namespace labelmesh {
 namespace {
@@ -116,7 +117,7 @@ TEST_F(StalledClientsTest, AClientHoldsAtMostItsStreams) {
   config_.max_streams_per_client = 2;
   ServiceHarness service(config_);
   v1::SubmitReply reply;
-  ASSERT_TRUE(service.submit(input_, testing::repaired_options(), &reply).ok());
+  ASSERT_THAT(service.submit(input_, testing::repaired_options(), &reply), testing::IsOk());
   v1::WatchRequest request;
   request.set_job_id(reply.job_id());
   grpc::ClientContext first_context, second_context;
@@ -162,7 +163,7 @@ TEST_F(StalledClientsTest, AnIdentitysStreamsDoNotCountAgainstAnother) {
   ServiceHarness service(config_);
   v1::SubmitReply alices, bobs;
   service.token = kAliceToken;
-  ASSERT_TRUE(service.submit(input_, testing::repaired_options(), &alices).ok());
+  ASSERT_THAT(service.submit(input_, testing::repaired_options(), &alices), testing::IsOk());
   OpenWatch first(service, kAliceToken, alices.job_id());
   OpenWatch second(service, kAliceToken, alices.job_id());
   ASSERT_TRUE(first.open && second.open);
@@ -275,7 +276,7 @@ TEST_F(StalledClientsTest, WaitingWatchersHoldNoThreads) {
   config_.max_streams_per_host = 200;
   ServiceHarness service(config_);
   v1::SubmitReply reply;
-  ASSERT_TRUE(service.submit(input_, testing::repaired_options(), &reply).ok());
+  ASSERT_THAT(service.submit(input_, testing::repaired_options(), &reply), testing::IsOk());
   v1::WatchRequest request;
   request.set_job_id(reply.job_id());
   // Client and server share this process: count before the first watch.

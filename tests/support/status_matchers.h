@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 // gMock matchers for absl::Status and absl::StatusOr, which print the status
-// when they fail:
+// when they fail (IsOk also takes other results with ok(): grpc::Status,
+// protobuf's util Status, the mesh checks):
 //   EXPECT_THAT(read(path), testing::IsOk());
 //   EXPECT_THAT(read(path), testing::StatusIs(absl::StatusCode::kInvalidArgument));
 //   EXPECT_THAT(read(path), testing::StatusIs(absl::StatusCode::kInvalidArgument,
@@ -11,6 +12,7 @@
 
 #include <ostream>
 #include <string>
+#include <type_traits>
 
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
@@ -18,9 +20,24 @@
 
 namespace labelmesh::testing {
 
+// What a failed status says: absl's and protobuf's as they print, gRPC's
+// message; a result without one only says it is not ok.
+template <typename S>
+std::string status_text(const S& status) {
+  if constexpr (std::is_convertible_v<const S&, const absl::Status&>) {
+    return static_cast<const absl::Status&>(status).ToString();
+  } else if constexpr (requires { status.error_message(); }) {
+    return status.error_message();
+  } else if constexpr (requires { status.ToString(); }) {
+    return status.ToString();
+  } else {
+    return "not ok";
+  }
+}
+
 MATCHER(IsOk, negation ? "is not ok" : "is ok") {
-  const absl::Status& status = status_internal::status_of(arg);
-  if (!status.ok()) *result_listener << "whose status is " << status;
+  const auto& status = status_internal::status_of(arg);
+  if (!status.ok()) *result_listener << "whose status is " << status_text(status);
   return status.ok();
 }
 

@@ -134,7 +134,7 @@ TEST(VoxelFidelity, TheStaircaseIsExactAndAShrunkCopyIsNot) {
     for (int k = 0; k < 3; ++k)
       p[k] = phantom.centre[k] + (p[k] - phantom.centre[k]) * (19.5 / 20.5);
   auto wrong = surface::measure_voxel_fidelity(shrunk, v, statistics.labels.front(), {});
-  ASSERT_TRUE(wrong.ok());
+  ASSERT_THAT(wrong, testing::IsOk());
   EXPECT_LT(wrong->volume_change, -0.1);
   EXPECT_GT(wrong->misclassified_fraction(), 0.5);
   EXPECT_GT(wrong->farthest_misclassified_voxels, 0.3);

@@ -35,7 +35,7 @@ using volume::PhantomShape;
 std::string phantom_file(PhantomShape shape, const std::string& name) {
   const auto path = (testing::scratch_dir("poisson-" + name) / name).string();
   const auto phantom = make_phantom(shape);
-  EXPECT_TRUE(volume::write_label_volume(phantom.volume, path).ok());
+  EXPECT_THAT(volume::write_label_volume(phantom.volume, path), testing::IsOk());
   return path;
 }
 
@@ -228,7 +228,7 @@ TEST(PoissonSurface, EveryComponentComesOutClosedAndSmallOnesAreCounted) {
     return (i >= 52 && i <= 53 && j >= 2 && j <= 3 && k >= 2 && k <= 3) ? 1 : 0;
   });
   const auto path = (testing::scratch_dir("poisson-balls") / "balls.nrrd").string();
-  ASSERT_TRUE(volume::write_label_volume(v, path).ok());
+  ASSERT_THAT(volume::write_label_volume(v, path), testing::IsOk());
   const MeshResult result = mesh_file(path);
   const SurfaceResult* smooth = find_stage(result, 1, "poisson");
   ASSERT_NE(smooth, nullptr);
@@ -250,7 +250,7 @@ TEST(PoissonSurface, ALabelOfOnlySpecksIsReportedUnlessAskedFor) {
     return (i >= 19 && i <= 20 && j >= 2 && j <= 3 && k >= 2 && k <= 3) ? 2 : 0;
   });
   const auto path = (testing::scratch_dir("poisson-speck-label") / "speck.nrrd").string();
-  ASSERT_TRUE(volume::write_label_volume(v, path).ok());
+  ASSERT_THAT(volume::write_label_volume(v, path), testing::IsOk());
 
   // Every label by default: the ball is meshed, the speck's label reported.
   const MeshResult result = mesh_file(path);

@@ -59,7 +59,7 @@ TEST(SmoothSurface, ZeroIterationsLeavesTheSurfaceAlone) {
   SmoothingParams off;
   off.iterations = 0;
   auto same = smooth_surface(staircase, off, RunContext{});
-  ASSERT_TRUE(same.ok());
+  ASSERT_THAT(same, testing::IsOk());
   EXPECT_EQ(same->points, staircase.points);
   EXPECT_EQ(same->triangles, staircase.triangles);
 }

@@ -29,7 +29,7 @@ TriangleMesh block_surface() {
   });
   const auto stats = volume::compute_label_statistics(v);
   auto surfaces = extract_surfaces(v, stats, {1}, RunContext{});
-  EXPECT_TRUE(surfaces.ok());
+  EXPECT_THAT(surfaces, testing::IsOk());
   return surfaces.ok() ? (*surfaces)[0].mesh : TriangleMesh{};
 }
 

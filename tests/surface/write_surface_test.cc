@@ -37,7 +37,7 @@ TriangleMesh torus_surface() {
   const auto phantom = volume::make_phantom(volume::PhantomShape::kTorus);
   const auto stats = volume::compute_label_statistics(phantom.volume);
   auto surfaces = extract_surfaces(phantom.volume, stats, {1}, RunContext{});
-  EXPECT_TRUE(surfaces.ok());
+  EXPECT_THAT(surfaces, testing::IsOk());
   return (*surfaces)[0].mesh;
 }
 
@@ -59,7 +59,7 @@ TEST_P(WriteSurface, ReadsBackWithTheSameCounts) {
       testing::scratch_dir(std::string("write-") + std::string(surface_format_name(format)));
   const auto path =
       (dir / (std::string("torus.") + std::string(surface_format_name(format)))).string();
-  ASSERT_TRUE(write_surface(mesh, path, format).ok());
+  ASSERT_THAT(write_surface(mesh, path, format), testing::IsOk());
   std::pair<int64_t, int64_t> counts{-1, -1};
   switch (format) {
     case SurfaceFormat::kStl:
@@ -108,7 +108,7 @@ TEST(WriteSurface, FilesSayTheirFrameAndLabel) {
     return (dir / (std::string("liver.") + std::string(surface_format_name(format)))).string();
   };
   for (auto format : all_surface_formats())
-    ASSERT_TRUE(write_surface(mesh, path_for(format), format, info).ok());
+    ASSERT_THAT(write_surface(mesh, path_for(format), format, info), testing::IsOk());
 
   EXPECT_EQ(read_bytes(path_for(SurfaceFormat::kStl)).substr(0, 33),
             "SPACE=RAS labelmesh label 5 Liver");

@@ -1,7 +1,9 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 // The early-return macros: a failed step's status is what the caller
-// returns, and a successful one's value is what the caller gets.
+// returns, and a successful one's value is what the caller gets. The IsOk
+// matcher: what it says when a result is not ok.
 #include "core/util/status_macros.h"
+#include "support/status_matchers.h"
 
 #include <gtest/gtest.h>
 
@@ -33,7 +35,7 @@ absl::Status checked(int value) {
 
 TEST(StatusMacros, AssignOrReturnGivesTheValueOrTheError) {
   const auto sum = unboxed_twice(20);
-  ASSERT_TRUE(sum.ok());
+  ASSERT_THAT(sum, testing::IsOk());
   EXPECT_EQ(*sum, 41);
   const auto failed = unboxed_twice(-1);
   EXPECT_EQ(failed.status().code(), absl::StatusCode::kOutOfRange);
@@ -41,9 +43,31 @@ TEST(StatusMacros, AssignOrReturnGivesTheValueOrTheError) {
 }
 
 TEST(StatusMacros, ReturnIfErrorTakesStatusesAndStatusOrs) {
-  EXPECT_TRUE(checked(3).ok());
+  EXPECT_THAT(checked(3), testing::IsOk());
   EXPECT_EQ(checked(-3).code(), absl::StatusCode::kOutOfRange);
   EXPECT_EQ(checked(7).code(), absl::StatusCode::kInternal);
+}
+
+// A result shaped like grpc::Status: ok() and a message apart.
+struct RpcResult {
+  bool ok() const { return message.empty(); }
+  std::string error_message() const { return message; }
+  std::string message;
+};
+
+// What IsOk says about `value` when it fails.
+template <typename T>
+std::string explained(const T& value) {
+  ::testing::StringMatchResultListener listener;
+  EXPECT_FALSE(::testing::ExplainMatchResult(testing::IsOk(), value, &listener));
+  return listener.str();
+}
+
+TEST(StatusMatchers, IsOkSaysWhatAFailedResultSays) {
+  EXPECT_EQ(explained(absl::NotFoundError("no liver")), "whose status is NOT_FOUND: no liver");
+  EXPECT_EQ(explained(boxed(-1)), "whose status is OUT_OF_RANGE: negative");
+  EXPECT_EQ(explained(RpcResult{"queue full"}), "whose status is queue full");
+  EXPECT_THAT(RpcResult{}, testing::IsOk());
 }
 
 }  // namespace

@@ -482,7 +482,7 @@ TEST(DicomSegHeader, RefusesAHeaderOverItsBudget) {
   const auto dir = testing::scratch_dir("DicomSegHeader.Budget");
   const std::string bytes = dcmqi_bytes();
   expect_invalid(parse_bytes(dir, bytes, 2000), "", "runs past the 2000-byte limit on the header");
-  EXPECT_TRUE(parse_bytes(dir, bytes, kDcmqiPixelDataValue).ok());
+  EXPECT_THAT(parse_bytes(dir, bytes, kDcmqiPixelDataValue), testing::IsOk());
 }
 
 TEST(DicomSegHeader, RefusesSequencesNestedMoreThanEightDeep) {
@@ -624,7 +624,7 @@ TEST(DicomSegHeader, FailsCleanlyWhereverTheFileIsCut) {
   for (const char* name : {"dcmqi-24x38x3-seg.dcm", "highdicom-seg_image_ct_binary.dcm"}) {
     const std::string bytes = testing::read_bytes(seg_file(name));
     testing::write_file(path, bytes);
-    EXPECT_TRUE(parse_dicom_seg_header(path.string()).ok()) << name;
+    EXPECT_THAT(parse_dicom_seg_header(path.string()), testing::IsOk()) << name;
     // Shortening the one file in place visits every length from size - 1 to 0.
     for (size_t size = bytes.size(); size-- > 0;) {
       std::filesystem::resize_file(path, size);

@@ -182,7 +182,7 @@ TEST(LabelComponents, SmallCavitiesAreFilledLargeAndOpenOnesKept) {
   // Off by default: nothing filled.
   options.fill_cavities_below = 0;
   const auto kept = find_label_components(v, stats.labels[0], options, RunContext{});
-  ASSERT_TRUE(kept.ok());
+  ASSERT_THAT(kept, testing::IsOk());
   EXPECT_EQ(kept->filled_cavities, 0u);
   EXPECT_EQ(kept->components[0].voxels, 14u * 14 * 14 - 64 - 3 - 9);
 }
@@ -249,7 +249,7 @@ TEST(LabelComponents, FilledCavitiesMatchAFloodFromOutside) {
     options.fill_cavities_below = kBelow;
     const auto stats = compute_label_statistics(v);
     const auto found = find_label_components(v, stats.labels[0], options, RunContext{});
-    ASSERT_TRUE(found.ok());
+    ASSERT_THAT(found, testing::IsOk());
     EXPECT_EQ(found->filled_cavities, expected_cavities) << "round " << round;
     EXPECT_EQ(found->filled_voxels, expected_voxels) << "round " << round;
     int extent[6];
@@ -279,7 +279,7 @@ TEST(LabelComponents, APocketTouchingTheOutsideOnlyAtAnEdgeIsEnclosed) {
   options.fill_cavities_below = 64;
   const auto stats = compute_label_statistics(v);
   const auto found = find_label_components(v, stats.labels[0], options, RunContext{});
-  ASSERT_TRUE(found.ok());
+  ASSERT_THAT(found, testing::IsOk());
   EXPECT_EQ(found->filled_cavities, 1u);
   EXPECT_EQ(found->filled_voxels, 1u);
   EXPECT_EQ(*static_cast<int32_t*>(found->ids->GetScalarPointer(4, 4, 5)), 1);

@@ -253,7 +253,7 @@ TEST(DicomSeg, LayersKeptApartCountAgainstTheVoxelLimit) {
   EXPECT_TRUE(absl::StrContains(status.message(), "2 layers of 42240 voxels")) << status;
   EXPECT_TRUE(absl::StrContains(status.message(), "exceeds the limit of 42240")) << status;
   limits.max_voxels = 2 * 16 * 16 * 165;
-  EXPECT_TRUE(read_label_volume(path, limits, RunContext{}).ok());
+  EXPECT_THAT(read_label_volume(path, limits, RunContext{}), testing::IsOk());
 }
 
 TEST(DicomSeg, SparseFramesLandOnTheSliceGridAcrossTheGap) {
@@ -287,7 +287,7 @@ TEST(DicomSeg, SegmentsNumberedOutOfOrderAreRefused) {
   const std::string path = seg_file("dcmqi-24x38x3-seg.dcm");
   auto header = internal::parse_dicom_seg_header(path);
   ASSERT_THAT(header, testing::IsOk());
-  ASSERT_TRUE(dicom_seg_grid(path, *header, ReadLimits{}).ok());
+  ASSERT_THAT(dicom_seg_grid(path, *header, ReadLimits{}), testing::IsOk());
   header->segment_numbers = {2};
   header->frame_segments = {2, 2, 2};
   const absl::Status status = dicom_seg_grid(path, *header, ReadLimits{}).status();

@@ -45,7 +45,7 @@ TEST_P(FormatRoundTrip, KeepsPlacementAndLabels) {
   const auto dir =
       testing::scratch_dir("roundtrip-" + std::to_string(std::hash<std::string>{}(file)));
   const auto path = (dir / file).string();
-  ASSERT_TRUE(write_label_volume(phantom.volume, path).ok());
+  ASSERT_THAT(write_label_volume(phantom.volume, path), testing::IsOk());
   const LabelVolume read = read_or_die(path);
   expect_same_geometry(read.geometry, phantom.volume.geometry);
   const auto expected = compute_label_statistics(phantom.volume);

@@ -326,7 +326,7 @@ TEST(SlicerSeg, TheVoxelLimitCountsEveryLayer) {
                interleave({empty, empty}), false);
   ReadLimits limits;
   limits.max_voxels = 2 * kVoxels;
-  EXPECT_TRUE(check_volume_header(path, limits).ok());
+  EXPECT_THAT(check_volume_header(path, limits), testing::IsOk());
   limits.max_voxels = 2 * kVoxels - 1;
   auto refused = check_volume_header(path, limits);
   ASSERT_FALSE(refused.ok());

@@ -248,7 +248,7 @@ TEST(VolumeHeader, VoxelLimitIsConfigurable) {
   const auto dir = testing::scratch_dir("limit");
   const auto path = (dir / "small.nii").string();
   testing::write_file(path, Nifti1Bytes(10, 10, 10).bytes());
-  EXPECT_TRUE(check_volume_header(path).ok());
+  EXPECT_THAT(check_volume_header(path), testing::IsOk());
   ReadLimits limits;
   limits.max_voxels = 999;
   const auto refused = check_volume_header(path, limits);
@@ -282,7 +282,7 @@ TEST(VolumeHeader, WholePayloadCheckFindsWhatTheSizeTrailerHides) {
   ASSERT_TRUE(testing::write_gzip(good, bytes));
   auto header = check_volume_header(good);
   ASSERT_THAT(header, testing::IsOk());
-  EXPECT_TRUE(check_whole_payload(*header).ok());
+  EXPECT_THAT(check_whole_payload(*header), testing::IsOk());
 
   const std::string compressed = testing::read_bytes(good);
   ASSERT_GT(compressed.size(), 100u);
@@ -297,7 +297,7 @@ TEST(VolumeHeader, WholePayloadCheckFindsWhatTheSizeTrailerHides) {
   for (const auto& path : {crc_path, cut_path}) {
     SCOPED_TRACE(path);
     auto damaged = check_volume_header(path);
-    ASSERT_TRUE(damaged.ok()) << "the header check alone was expected to pass";
+    ASSERT_THAT(damaged, testing::IsOk()) << "the header check alone was expected to pass";
     const absl::Status whole = check_whole_payload(*damaged);
     EXPECT_THAT(whole, testing::StatusIs(absl::StatusCode::kInvalidArgument));
     EXPECT_NE(std::string(whole.message()).find(path), std::string::npos) << whole.message();

@@ -10,6 +10,7 @@
 #include <cmath>
 
 #include "core/quality/element_quality.h"
+#include "support/status_matchers.h"
 
 namespace labelmesh::volume_mesh {
 namespace {
@@ -62,7 +63,7 @@ TEST(ImproveTetMesh, ThreeAroundAnEdgeBecomeTwoRegularTetrahedra) {
   const double volume = total_volume(m);
   const double before = lowest_quality(m);
   ImproveFigures figures;
-  ASSERT_TRUE(improve_tet_mesh(m, {.target_quality = 0.9}, RunContext{}, figures).ok());
+  ASSERT_THAT(improve_tet_mesh(m, {.target_quality = 0.9}, RunContext{}, figures), testing::IsOk());
   EXPECT_EQ(figures.flips_3_2, 1u);
   ASSERT_EQ(m.tetrahedra.size(), 2u);
   EXPECT_NEAR(lowest_quality(m), 1.0, 1e-12);
@@ -87,7 +88,7 @@ TEST(ImproveTetMesh, TwoFlatTetrahedraBecomeThree) {
   const double volume = total_volume(m);
   const double before = lowest_quality(m);
   ImproveFigures figures;
-  ASSERT_TRUE(improve_tet_mesh(m, {.target_quality = 0.9}, RunContext{}, figures).ok());
+  ASSERT_THAT(improve_tet_mesh(m, {.target_quality = 0.9}, RunContext{}, figures), testing::IsOk());
   EXPECT_EQ(figures.flips_2_3, 1u);
   EXPECT_EQ(m.tetrahedra.size(), 3u);
   EXPECT_GT(lowest_quality(m), before + 0.1);
@@ -127,7 +128,7 @@ TEST(ImproveTetMesh, SmoothingLiftsTheWorstElementAndKeepsTheBoundary) {
   const double before = lowest_quality(m);
   ASSERT_GT(before, 0);
   ImproveFigures figures;
-  ASSERT_TRUE(improve_tet_mesh(m, {}, RunContext{}, figures).ok());
+  ASSERT_THAT(improve_tet_mesh(m, {}, RunContext{}, figures), testing::IsOk());
   EXPECT_GT(figures.vertices_moved, 0u);
   EXPECT_GT(lowest_quality(m), 0.5);
   EXPECT_GT(lowest_quality(m), before + 0.3);
@@ -165,13 +166,15 @@ TEST(ImproveTetMesh, ASliverUnderTheSurfaceIsPeeledWithinTheDepthBound) {
   ASSERT_LT(lowest_quality(m), 0.2);
   ImproveFigures figures;
   // Deeper than the bound: the sliver stays.
-  ASSERT_TRUE(improve_tet_mesh(m, {.max_peel_depth_mm = 0.05}, RunContext{}, figures).ok());
+  ASSERT_THAT(improve_tet_mesh(m, {.max_peel_depth_mm = 0.05}, RunContext{}, figures),
+              testing::IsOk());
   EXPECT_EQ(figures.slivers_peeled, 0u);
   EXPECT_LT(lowest_quality(m), 0.2);
   EXPECT_EQ(m.tetrahedra.size(), 4u);
 
   m = roof_sliver(0.1);
-  ASSERT_TRUE(improve_tet_mesh(m, {.max_peel_depth_mm = 0.2}, RunContext{}, figures).ok());
+  ASSERT_THAT(improve_tet_mesh(m, {.max_peel_depth_mm = 0.2}, RunContext{}, figures),
+              testing::IsOk());
   EXPECT_EQ(figures.slivers_peeled, 1u);
   EXPECT_EQ(m.tetrahedra.size(), 3u);
   EXPECT_GT(lowest_quality(m), 0.2);
@@ -181,14 +184,15 @@ TEST(ImproveTetMesh, ASliverUnderTheSurfaceIsPeeledWithinTheDepthBound) {
   EXPECT_NEAR(total_volume(m), volume - sliver_volume, 1e-12);
   EXPECT_EQ(m.points.size(), 6u);
   EXPECT_EQ(m.labels, (std::vector<int32_t>{3, 4, 3}));
-  EXPECT_TRUE(check_tet_mesh(m).ok());
+  EXPECT_THAT(check_tet_mesh(m), testing::IsOk());
 }
 
 TEST(ImproveTetMesh, ASliverBorderingAnotherLabelIsNotPeeled) {
   TetMesh m = roof_sliver(0.1);
   m.labels[1] = 5;  // b,e,c,d: the sliver's face b,c,d is now an interface
   ImproveFigures figures;
-  ASSERT_TRUE(improve_tet_mesh(m, {.max_peel_depth_mm = 0.2}, RunContext{}, figures).ok());
+  ASSERT_THAT(improve_tet_mesh(m, {.max_peel_depth_mm = 0.2}, RunContext{}, figures),
+              testing::IsOk());
   EXPECT_EQ(figures.slivers_peeled, 0u);
   EXPECT_NEAR(total_volume(m), total_volume(roof_sliver(0.1)), 1e-12);
 }
@@ -201,7 +205,8 @@ TEST(ImproveTetMesh, ASliverWhoseOtherEdgeIsOnTheSurfaceIsNotPeeled) {
   m.labels.erase(m.labels.begin() + 2);
   const double volume = total_volume(m);
   ImproveFigures figures;
-  ASSERT_TRUE(improve_tet_mesh(m, {.max_peel_depth_mm = 0.2}, RunContext{}, figures).ok());
+  ASSERT_THAT(improve_tet_mesh(m, {.max_peel_depth_mm = 0.2}, RunContext{}, figures),
+              testing::IsOk());
   EXPECT_EQ(figures.slivers_peeled, 0u);
   EXPECT_NEAR(total_volume(m), volume, 1e-12);
 }
@@ -211,7 +216,7 @@ TEST(ImproveTetMesh, AGoodMeshIsLeftAlone) {
   m.points[13] = {1, 1, 1};
   const TetMesh before = m;
   ImproveFigures figures;
-  ASSERT_TRUE(improve_tet_mesh(m, {.target_quality = 0.5}, RunContext{}, figures).ok());
+  ASSERT_THAT(improve_tet_mesh(m, {.target_quality = 0.5}, RunContext{}, figures), testing::IsOk());
   EXPECT_EQ(m.tetrahedra, before.tetrahedra);
   EXPECT_EQ(m.points, before.points);
   EXPECT_EQ(figures.sweeps, 0);
@@ -248,10 +253,10 @@ TEST(ImproveTetMesh, SmoothingClimbsBetweenTwoTiedWorstTetrahedra) {
   const double volume = total_volume(m);
   ASSERT_NEAR(lowest_quality(m), 0.151, 0.001);
   ImproveFigures figures;
-  ASSERT_TRUE(improve_tet_mesh(m, {}, RunContext{}, figures).ok());
+  ASSERT_THAT(improve_tet_mesh(m, {}, RunContext{}, figures), testing::IsOk());
   EXPECT_GE(figures.vertices_moved + figures.vertices_inserted, 1u);
   EXPECT_GT(lowest_quality(m), 0.19);
-  EXPECT_TRUE(check_tet_mesh(m).ok());
+  EXPECT_THAT(check_tet_mesh(m), testing::IsOk());
   EXPECT_EQ(m.tetrahedra.size(), 4u);
   EXPECT_NEAR(total_volume(m), volume, 1e-12);
   // One interior point, whichever operation placed it last: a point an

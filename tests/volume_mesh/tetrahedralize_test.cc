@@ -351,7 +351,7 @@ TEST(Tetrahedralize, StopRequestCancelsAndProgressReachesOne) {
     EXPECT_EQ(update.stage, "tetgen");
     fractions.push_back(update.fraction);
   };
-  ASSERT_TRUE(tetrahedralize(surface, 1, TetgenParams{}, watched, figures).ok());
+  ASSERT_THAT(tetrahedralize(surface, 1, TetgenParams{}, watched, figures), testing::IsOk());
   ASSERT_GE(fractions.size(), 2u);
   EXPECT_EQ(fractions.front(), 0.0);
   EXPECT_EQ(fractions.back(), 1.0);

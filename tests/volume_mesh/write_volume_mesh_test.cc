@@ -200,7 +200,7 @@ TEST(WriteVolumeMesh, VtuReadsBackWithLabelsAndQuality) {
   const auto quality = qualities(mesh);
   const auto dir = testing::scratch_dir("write-volume-vtu");
   const auto path = path_in(dir, VolumeFormat::kVtu);
-  ASSERT_TRUE(write_volume_mesh(mesh, quality, path, VolumeFormat::kVtu).ok());
+  ASSERT_THAT(write_volume_mesh(mesh, quality, path, VolumeFormat::kVtu), testing::IsOk());
 
   vtkNew<vtkXMLUnstructuredGridReader> reader;
   reader->SetFileName(path.c_str());
@@ -233,7 +233,7 @@ TEST(WriteVolumeMesh, MshCarriesLabelsAsPhysicalTags) {
   const auto quality = qualities(mesh);
   const auto dir = testing::scratch_dir("write-volume-msh");
   const auto path = path_in(dir, VolumeFormat::kMsh);
-  ASSERT_TRUE(write_volume_mesh(mesh, quality, path, VolumeFormat::kMsh).ok());
+  ASSERT_THAT(write_volume_mesh(mesh, quality, path, VolumeFormat::kMsh), testing::IsOk());
   const std::string text = read_text(path);
   EXPECT_EQ(text.rfind("$MeshFormat\n2.2 0 8\n$EndMeshFormat\n", 0), 0u);
   EXPECT_NE(text.find("$PhysicalNames\n2\n3 1 \"label_1\"\n3 2 \"label_2\"\n"), std::string::npos);
@@ -252,7 +252,7 @@ TEST(WriteVolumeMesh, MeditCarriesLabelsAsRefsWithOutwardBoundaries) {
   const TetMesh& mesh = two_labels();
   const auto dir = testing::scratch_dir("write-volume-mesh");
   const auto path = path_in(dir, VolumeFormat::kMedit);
-  ASSERT_TRUE(write_volume_mesh(mesh, {}, path, VolumeFormat::kMedit).ok());
+  ASSERT_THAT(write_volume_mesh(mesh, {}, path, VolumeFormat::kMedit), testing::IsOk());
   const auto summary = meshio_summary(dir, path);
   expect_meshio_counts(summary, mesh);
   EXPECT_EQ(summary.at("tetra:medit:ref"), "1 2");
@@ -291,7 +291,7 @@ TEST(WriteVolumeMesh, TetgenNodeAndEleCarryLabelsAsRegions) {
   const TetMesh& mesh = two_labels();
   const auto dir = testing::scratch_dir("write-volume-node");
   const auto path = path_in(dir, VolumeFormat::kTetgen);
-  ASSERT_TRUE(write_volume_mesh(mesh, {}, path, VolumeFormat::kTetgen).ok());
+  ASSERT_THAT(write_volume_mesh(mesh, {}, path, VolumeFormat::kTetgen), testing::IsOk());
   EXPECT_TRUE(std::filesystem::exists(dir / "two-labels.ele"));
   const auto summary = meshio_summary(dir, path);
   expect_meshio_counts(summary, mesh);
@@ -305,7 +305,7 @@ TEST(WriteVolumeMesh, AbaqusElementsArePositiveAndSurfacesLieOnTheBoundary) {
   const TetMesh& mesh = two_labels();
   const auto dir = testing::scratch_dir("write-volume-inp");
   const auto path = path_in(dir, VolumeFormat::kAbaqus);
-  ASSERT_TRUE(write_volume_mesh(mesh, {}, path, VolumeFormat::kAbaqus).ok());
+  ASSERT_THAT(write_volume_mesh(mesh, {}, path, VolumeFormat::kAbaqus), testing::IsOk());
 
   std::map<long, Point> nodes;
   std::map<long, std::array<long, 4>> elements;
@@ -424,7 +424,7 @@ TEST(WriteVolumeMesh, NamesAndTheFrameReachEveryFormat) {
   for (VolumeFormat format : all_volume_formats()) {
     SCOPED_TRACE(std::string(volume_format_name(format)));
     const auto path = path_in(dir, format);
-    ASSERT_TRUE(write_volume_mesh(mesh, {}, path, format, info).ok());
+    ASSERT_THAT(write_volume_mesh(mesh, {}, path, format, info), testing::IsOk());
     const auto summary = meshio_summary(dir, path);
     expect_meshio_counts(summary, mesh);
     std::istringstream point0(summary.at("point0"));
@@ -482,7 +482,7 @@ TEST(WriteVolumeMesh, XdmfCarriesCellTagsAndFacetTags) {
   info.interfaces = &faces;
   const auto dir = testing::scratch_dir("write-volume-xdmf");
   const auto path = path_in(dir, VolumeFormat::kXdmf);
-  ASSERT_TRUE(write_volume_mesh(mesh, quality, path, VolumeFormat::kXdmf, info).ok());
+  ASSERT_THAT(write_volume_mesh(mesh, quality, path, VolumeFormat::kXdmf, info), testing::IsOk());
 
   const auto cells = meshio_summary(dir, path);
   expect_meshio_counts(cells, mesh);
