@@ -54,10 +54,9 @@ absl::StatusOr<ServerConnection> ServerConnection::open(const ConnectionFlags& f
     }
     if (!flags.tls_cert.empty()) {
       LABELMESH_ASSIGN_OR_RETURN(auto cert, read_file(flags.tls_cert, "tls-cert"));
-      auto key = read_file(flags.tls_key, "tls-key");
-      if (!key.ok()) return key.status();
+      LABELMESH_ASSIGN_OR_RETURN(auto key, read_file(flags.tls_key, "tls-key"));
       options.pem_cert_chain = cert;
-      options.pem_private_key = *key;
+      options.pem_private_key = key;
     }
     credentials = grpc::SslCredentials(options);
   } else {

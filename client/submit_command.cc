@@ -92,9 +92,8 @@ absl::StatusOr<v1::SubmitReply> upload_once(const ServerConnection& connection,
   auto writer = stub->Submit(context.get(), &reply);
   v1::SubmitRequest request;
   v1::JobSpec& spec = *request.mutable_spec();
-  auto options = to_mesh_options(flags.pipeline);
-  if (!options.ok()) return options.status();
-  *spec.mutable_options() = *options;
+  LABELMESH_ASSIGN_OR_RETURN(auto options, to_mesh_options(flags.pipeline));
+  *spec.mutable_options() = options;
   // The server knows a format by its name's extension: a DICOM file named
   // otherwise (dcmqi's label.seg, a PACS file) is sent as one.
   std::string file_name = std::filesystem::path(flags.path).filename().string();

@@ -39,14 +39,12 @@ absl::StatusOr<std::string> read_text_file(const std::string& path, const std::s
 absl::StatusOr<std::shared_ptr<grpc::ServerCredentials>> credentials(const ServerConfig& config) {
   if (!config.tls()) return grpc::InsecureServerCredentials();
   LABELMESH_ASSIGN_OR_RETURN(auto cert, read_text_file(config.tls_cert, "tls-cert"));
-  auto key = read_text_file(config.tls_key, "tls-key");
-  if (!key.ok()) return key.status();
+  LABELMESH_ASSIGN_OR_RETURN(auto key, read_text_file(config.tls_key, "tls-key"));
   grpc::SslServerCredentialsOptions options;
-  options.pem_key_cert_pairs.push_back({*key, cert});
+  options.pem_key_cert_pairs.push_back({key, cert});
   if (!config.client_ca.empty()) {
-    auto ca = read_text_file(config.client_ca, "client-ca");
-    if (!ca.ok()) return ca.status();
-    options.pem_root_certs = *ca;
+    LABELMESH_ASSIGN_OR_RETURN(auto ca, read_text_file(config.client_ca, "client-ca"));
+    options.pem_root_certs = ca;
     options.client_certificate_request = GRPC_SSL_REQUEST_AND_REQUIRE_CLIENT_CERTIFICATE_AND_VERIFY;
   }
   return grpc::SslServerCredentials(options);
@@ -80,8 +78,7 @@ absl::StatusOr<std::unique_ptr<LabelmeshServer>> LabelmeshServer::start(ServerCo
 
   LABELMESH_ASSIGN_OR_RETURN(auto authenticator, ClientAuthenticator::from_config(c));
   server->authenticator_ = std::move(authenticator);
-  auto creds = credentials(c);
-  if (!creds.ok()) return creds.status();
+  LABELMESH_ASSIGN_OR_RETURN(auto creds, credentials(c));
 
   server->metrics_ = std::make_unique<Metrics>(c.queue_capacity);
   if (!c.metrics_listen.empty()) {
@@ -98,7 +95,7 @@ absl::StatusOr<std::unique_ptr<LabelmeshServer>> LabelmeshServer::start(ServerCo
   // Reflection cannot check a caller: it is served only where every caller
   // is anonymous anyway. Health says only SERVING or not, for probes.
   builder.SetOption(std::make_unique<ReflectionOption>(server->authenticator_->anonymous()));
-  builder.AddListeningPort(c.listen, *creds, &server->port_);
+  builder.AddListeningPort(c.listen, creds, &server->port_);
   if (server->service_) builder.RegisterService(server->service_.get());
   builder.SetMaxReceiveMessageSize(c.max_message_bytes);
   builder.SetMaxSendMessageSize(c.max_message_bytes);
@@ -129,9 +126,10 @@ absl::Status LabelmeshServer::open_spool() {
   LABELMESH_ASSIGN_OR_RETURN(auto spool, Spool::open(c.spool_dir));
   spool_ = std::make_unique<Spool>(std::move(spool));
   kill_stale_workers(spool_->root());
-  auto audit = AuditLog::open(c.audit_log.empty() ? spool_->root() + "/audit.log" : c.audit_log);
-  if (!audit.ok()) return audit.status();
-  audit_ = std::move(*audit);
+  LABELMESH_ASSIGN_OR_RETURN(
+      auto audit,
+      AuditLog::open(c.audit_log.empty() ? spool_->root() + "/audit.log" : c.audit_log));
+  audit_ = std::move(audit);
   table_ = std::make_unique<JobTable>(*spool_, c.queue_capacity, *metrics_);
   table_->recover(c.result_ttl);
   store_ = table_.get();
@@ -147,20 +145,19 @@ absl::Status LabelmeshServer::open_cluster() {
   settings.connection_name = absl::StrCat("labelmeshd ", c.role);
   settings.queue.ack_wait = c.cluster_ack_wait;
   if (c.role == "worker") {
-    auto workers = ClusterWorkerRole::start(c, settings, *files_, *metrics_);
-    if (!workers.ok()) return workers.status();
-    cluster_workers_ = std::move(*workers);
+    LABELMESH_ASSIGN_OR_RETURN(auto workers,
+                               ClusterWorkerRole::start(c, settings, *files_, *metrics_));
+    cluster_workers_ = std::move(workers);
     return absl::OkStatus();
   }
   // The frontend keeps only its audit log locally.
   std::error_code error;
   std::filesystem::create_directories(c.spool_dir, error);
-  auto audit = AuditLog::open(c.audit_log.empty() ? c.spool_dir + "/audit.log" : c.audit_log);
-  if (!audit.ok()) return audit.status();
-  audit_ = std::move(*audit);
-  auto connection = cluster::ClusterConnection::open(settings);
-  if (!connection.ok()) return connection.status();
-  cluster_ = std::move(*connection);
+  LABELMESH_ASSIGN_OR_RETURN(
+      auto audit, AuditLog::open(c.audit_log.empty() ? c.spool_dir + "/audit.log" : c.audit_log));
+  audit_ = std::move(audit);
+  LABELMESH_ASSIGN_OR_RETURN(auto connection, cluster::ClusterConnection::open(settings));
+  cluster_ = std::move(connection);
   // Every run ends within the job timeout; a job RUNNING well past it (and
   // past the ack waits of its redeliveries) has lost its workers.
   const absl::Duration abandoned_after = c.job_timeout + 2 * c.cluster_ack_wait + absl::Minutes(1);

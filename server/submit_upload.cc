@@ -133,15 +133,13 @@ absl::Status SubmitUpload::run(v1::SubmitReply& reply) {
   if (auto status = store.available(); !status.ok())
     return refused(Refusal::kStoreUnavailable, status);
   const ShareKeys keys = share_keys(identity_, context_.peer());
-  auto stream = services_.streams.open(keys.client, keys.host);
-  if (!stream.ok()) return stream.status();
+  LABELMESH_ASSIGN_OR_RETURN(auto stream, services_.streams.open(keys.client, keys.host));
   // The spec is the first step: a client that sends nothing is dropped too.
   auto ticket =
       services_.watchdog.watch(&context_, config.stream_idle_timeout, config.transfer_deadline,
                                "upload", services_.transfer_rate);
   // Shares of the upload slots: one client, or one host, cannot take them all.
-  auto upload_slot = services_.uploads.open(keys.client, keys.host);
-  if (!upload_slot.ok()) return upload_slot.status();
+  LABELMESH_ASSIGN_OR_RETURN(auto upload_slot, services_.uploads.open(keys.client, keys.host));
   v1::SubmitRequest first;
   if (!reader_.Read(&first) || !first.has_spec())
     return ticket->cancellation_or(bad_request("the first message must hold the job spec"));

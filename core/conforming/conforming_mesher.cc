@@ -135,9 +135,9 @@ absl::StatusOr<volume_mesh::TetMesh> mesh_conforming(const volume::LabelVolume& 
   }
   context.report("interfaces", 0);
   std::array<double, 3> spacing{};
-  auto interfaces = grid_interfaces(volume, labels, params, context, figures, spacing);
-  if (!interfaces.ok()) return interfaces.status();
-  InterfaceSurface surface = std::move(*interfaces);
+  LABELMESH_ASSIGN_OR_RETURN(auto interfaces,
+                             grid_interfaces(volume, labels, params, context, figures, spacing));
+  InterfaceSurface surface = std::move(interfaces);
   if (auto status = remove_crossings(surface, params.max_crossing_repairs, context, figures);
       !status.ok()) {
     return status;

@@ -214,8 +214,7 @@ namespace labelmesh::volume::internal {
 absl::StatusOr<VolumeHeader> check_dicom_seg_volume_header(const std::string& path,
                                                            const ReadLimits& limits) {
   LABELMESH_ASSIGN_OR_RETURN(auto header, parse_dicom_seg_header(path));
-  auto grid = dicom_seg_grid(path, header, limits);
-  if (!grid.ok()) return grid.status();
+  LABELMESH_ASSIGN_OR_RETURN(auto grid, dicom_seg_grid(path, header, limits));
   // BINARY frames are one bit a pixel, packed without padding between frames.
   const uint64_t pixels = uint64_t(header.rows) * header.columns * header.frames;
   const uint64_t needed = header.bits_allocated == 1 ? (pixels + 7) / 8 : pixels;
@@ -229,7 +228,7 @@ absl::StatusOr<VolumeHeader> check_dicom_seg_volume_header(const std::string& pa
   volume.format = ImageFormat::kDicomSeg;
   // Labels are segment numbers, up to 65,535.
   volume.scalar_type = ScalarType::kUInt16;
-  volume.geometry = grid->geometry;
+  volume.geometry = grid.geometry;
   volume.data_path = path;
   volume.file_offset = header.pixel_data_offset;
   return volume;

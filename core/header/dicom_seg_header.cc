@@ -379,9 +379,8 @@ absl::StatusOr<uint64_t> Walker::walk_elements(uint64_t pos, uint64_t end, bool 
             : (known && known->vr == "SQ") || (e.length == kUndefinedLength && e.tag != kPixelData);
     if (sequence) {
       if (e.tag == kPlanePositionSlideSequence) out_.has_plane_position_slide = true;
-      auto next = walk_sequence(e, end, depth + 1, scope, groups);
-      if (!next.ok()) return next.status();
-      pos = *next;
+      LABELMESH_ASSIGN_OR_RETURN(auto next, walk_sequence(e, end, depth + 1, scope, groups));
+      pos = next;
       continue;
     }
     if (e.length == kUndefinedLength) {
@@ -568,8 +567,8 @@ absl::StatusOr<DicomSegHeader> Walker::run() {
                            ": compressed or deflated DICOM SEG is not supported"));
   }
 
-  auto end = walk_elements(pos, kNoEnd, false, 0, Scope::kDataSet, nullptr);
-  if (!end.ok()) return end.status();
+  LABELMESH_ASSIGN_OR_RETURN(auto end,
+                             walk_elements(pos, kNoEnd, false, 0, Scope::kDataSet, nullptr));
 
   if (per_frame_seen_ && out_.frame_positions.size() != out_.frames) {
     return field_error(path_, tag_name(kPerFrameGroups),

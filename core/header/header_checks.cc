@@ -126,14 +126,13 @@ absl::Status check_raw_payload(std::string_view path, uint64_t offset, uint64_t 
 absl::Status check_encoded_payload(std::string_view path, uint64_t file_offset,
                                    DataEncoding encoding, uint64_t compressed_bytes,
                                    uint64_t needed) {
-  auto size = file_size(path);
-  if (!size.ok()) return size.status();
+  LABELMESH_ASSIGN_OR_RETURN(auto size, file_size(path));
   if (encoding == DataEncoding::kGzip && compressed_bytes == 0 && needed < (uint64_t{1} << 32) &&
-      *size >= file_offset + 18) {
+      size >= file_offset + 18) {
     // ISIZE, the last four bytes of a gzip member, is its decoded size modulo
     // 2^32: a free check for the common single-member file.
     std::ifstream in(std::string(path), std::ios::binary);
-    in.seekg(static_cast<std::streamoff>(*size - 4));
+    in.seekg(static_cast<std::streamoff>(size - 4));
     unsigned char tail[4] = {0, 0, 0, 0};
     in.read(reinterpret_cast<char*>(tail), 4);
     const uint32_t isize = uint32_t{tail[0]} | uint32_t{tail[1]} << 8 | uint32_t{tail[2]} << 16 |

@@ -47,11 +47,12 @@ absl::StatusOr<VolumeHeader> check_inr_header(const std::string& path, bool gzip
     return field_error(path, "header",
                        cat("is ", header_size, " bytes; INR headers are a multiple of 256"));
   }
-  auto text = parse_text_header(
-      path, std::string_view(*bytes).substr(0, end),
-      {.separator = "=", .comment = "#", .last_key = "", .key_value_marker = ""}, end + 1);
-  if (!text.ok()) return text.status();
-  const TextHeader& h = *text;
+  LABELMESH_ASSIGN_OR_RETURN(
+      auto text,
+      parse_text_header(path, std::string_view(*bytes).substr(0, end),
+                        {.separator = "=", .comment = "#", .last_key = "", .key_value_marker = ""},
+                        end + 1));
+  const TextHeader& h = text;
 
   std::array<int64_t, 3> dims{};
   const char* dim_keys[3] = {"XDIM", "YDIM", "ZDIM"};
@@ -112,12 +113,10 @@ absl::StatusOr<VolumeHeader> check_inr_header(const std::string& path, bool gzip
   const char* spacing_keys[3] = {"VX", "VY", "VZ"};
   const char* origin_keys[3] = {"TX", "TY", "TZ"};
   for (int axis = 0; axis < 3; ++axis) {
-    auto spacing = number_field(path, h, spacing_keys[axis], 1.0);
-    if (!spacing.ok()) return spacing.status();
-    g.spacing[axis] = *spacing;
-    auto origin = number_field(path, h, origin_keys[axis], 0.0);
-    if (!origin.ok()) return origin.status();
-    g.origin[axis] = *origin;
+    LABELMESH_ASSIGN_OR_RETURN(auto spacing, number_field(path, h, spacing_keys[axis], 1.0));
+    g.spacing[axis] = spacing;
+    LABELMESH_ASSIGN_OR_RETURN(auto origin, number_field(path, h, origin_keys[axis], 0.0));
+    g.origin[axis] = origin;
   }
   LABELMESH_RETURN_IF_ERROR(check_spacing(path, "VX/VY/VZ", g.spacing));
 

@@ -63,12 +63,13 @@ absl::StatusOr<VolumeHeader> check_metaimage_header(const std::string& path,
                                                     const ReadLimits& limits) {
   auto bytes = read_prefix(path, limits.max_header_bytes, false);
   if (!bytes.ok()) return bytes.status();
-  auto text = parse_text_header(
-      path, *bytes,
-      {.separator = "=", .comment = "", .last_key = "ElementDataFile", .key_value_marker = ""},
-      limits.max_header_bytes);
-  if (!text.ok()) return text.status();
-  const TextHeader& h = *text;
+  LABELMESH_ASSIGN_OR_RETURN(
+      auto text,
+      parse_text_header(
+          path, *bytes,
+          {.separator = "=", .comment = "", .last_key = "ElementDataFile", .key_value_marker = ""},
+          limits.max_header_bytes));
+  const TextHeader& h = text;
 
   if (auto type = h.find("ObjectType"); type && !equals_ignore_case(*type, "Image")) {
     return field_error(path, "ObjectType", "is not Image");
@@ -78,48 +79,44 @@ absl::StatusOr<VolumeHeader> check_metaimage_header(const std::string& path,
   auto dim_text = h.find("DimSize");
   if (!dim_text) return field_error(path, "DimSize", "is missing");
   LABELMESH_ASSIGN_OR_RETURN(auto dim_values, parse_numbers(path, "DimSize", *dim_text, 3));
-  auto whole = whole_sizes(path, "DimSize", dim_values);
-  if (!whole.ok()) return whole.status();
-  const std::array<int64_t, 3> dims = *whole;
+  LABELMESH_ASSIGN_OR_RETURN(auto whole, whole_sizes(path, "DimSize", dim_values));
+  const std::array<int64_t, 3> dims = whole;
   LABELMESH_RETURN_IF_ERROR(check_dims(path, "DimSize", dims, limits));
 
   auto element_type = h.find("ElementType");
   if (!element_type) return field_error(path, "ElementType", "is missing");
-  auto type = metaimage_scalar_type(path, *element_type);
-  if (!type.ok()) return type.status();
+  LABELMESH_ASSIGN_OR_RETURN(auto type, metaimage_scalar_type(path, *element_type));
   if (auto channels = h.find("ElementNumberOfChannels"); channels && *channels != "1") {
     return field_error(path, "ElementNumberOfChannels", "must be 1 for a label volume");
   }
-  auto binary = optional_bool(path, h, "BinaryData", true);
-  if (!binary.ok()) return binary.status();
-  if (!*binary) return field_error(path, "BinaryData", "ASCII voxel data is not supported");
+  LABELMESH_ASSIGN_OR_RETURN(auto binary, optional_bool(path, h, "BinaryData", true));
+  if (!binary) return field_error(path, "BinaryData", "ASCII voxel data is not supported");
 
-  auto spacing = numbers_of(path, h, {"ElementSpacing", "ElementSize"}, 3, {1, 1, 1});
-  if (!spacing.ok()) return spacing.status();
-  auto origin = numbers_of(path, h, {"Offset", "Origin", "Position"}, 3, {0, 0, 0});
-  if (!origin.ok()) return origin.status();
-  auto matrix = numbers_of(path, h, {"TransformMatrix", "Rotation", "Orientation"}, 9,
-                           {1, 0, 0, 0, 1, 0, 0, 0, 1});
-  if (!matrix.ok()) return matrix.status();
+  LABELMESH_ASSIGN_OR_RETURN(auto spacing,
+                             numbers_of(path, h, {"ElementSpacing", "ElementSize"}, 3, {1, 1, 1}));
+  LABELMESH_ASSIGN_OR_RETURN(auto origin,
+                             numbers_of(path, h, {"Offset", "Origin", "Position"}, 3, {0, 0, 0}));
+  LABELMESH_ASSIGN_OR_RETURN(auto matrix,
+                             numbers_of(path, h, {"TransformMatrix", "Rotation", "Orientation"}, 9,
+                                        {1, 0, 0, 0, 1, 0, 0, 0, 1}));
 
   VolumeHeader header;
   header.format = ImageFormat::kMetaImage;
-  header.scalar_type = *type;
+  header.scalar_type = type;
   ImageGeometry& g = header.geometry;
   g.dims = dims;
   for (int axis = 0; axis < 3; ++axis) {
-    g.spacing[axis] = (*spacing)[axis];
-    g.origin[axis] = (*origin)[axis];
-    for (int row = 0; row < 3; ++row) g.direction[3 * row + axis] = (*matrix)[3 * axis + row];
+    g.spacing[axis] = spacing[axis];
+    g.origin[axis] = origin[axis];
+    for (int row = 0; row < 3; ++row) g.direction[3 * row + axis] = matrix[3 * axis + row];
   }
   LABELMESH_RETURN_IF_ERROR(check_spacing(path, "ElementSpacing", g.spacing));
   LABELMESH_RETURN_IF_ERROR(normalise_direction(path, "TransformMatrix", g.direction));
 
-  auto msb = h.find("BinaryDataByteOrderMSB")
-                 ? optional_bool(path, h, "BinaryDataByteOrderMSB", false)
-                 : optional_bool(path, h, "ElementByteOrderMSB", false);
-  if (!msb.ok()) return msb.status();
-  header.big_endian = *msb;
+  LABELMESH_ASSIGN_OR_RETURN(auto msb, h.find("BinaryDataByteOrderMSB")
+                                           ? optional_bool(path, h, "BinaryDataByteOrderMSB", false)
+                                           : optional_bool(path, h, "ElementByteOrderMSB", false));
+  header.big_endian = msb;
   auto compressed = optional_bool(path, h, "CompressedData", false);
   if (!compressed.ok()) return compressed.status();
 
@@ -158,9 +155,9 @@ absl::StatusOr<VolumeHeader> check_metaimage_header(const std::string& path,
   if (*data_size < header.file_offset) return field_error(path, "voxel data", "is missing");
   header.compressed_bytes = *data_size - header.file_offset;
   if (auto size_text = h.find("CompressedDataSize")) {
-    auto declared = parse_numbers(path, "CompressedDataSize", *size_text, 1);
-    if (!declared.ok()) return declared.status();
-    const double value = (*declared)[0];
+    LABELMESH_ASSIGN_OR_RETURN(auto declared,
+                               parse_numbers(path, "CompressedDataSize", *size_text, 1));
+    const double value = declared[0];
     if (value < 1 || value != std::floor(value) || value > double(header.compressed_bytes)) {
       return field_error(path, "CompressedDataSize",
                          cat("is ", show(value), " but the file holds ", header.compressed_bytes,

@@ -249,8 +249,7 @@ absl::StatusOr<VolumeHeader> check_nifti_header(const std::string& path, bool gz
   }
   if (!std::isfinite(intercept)) return field_error(path, "scl_inter", "is not finite");
 
-  auto affine = nifti_affine(path, n);
-  if (!affine.ok()) return affine.status();
+  LABELMESH_ASSIGN_OR_RETURN(auto affine, nifti_affine(path, n));
 
   VolumeHeader header;
   header.format = ImageFormat::kNifti;
@@ -270,8 +269,8 @@ absl::StatusOr<VolumeHeader> check_nifti_header(const std::string& path, bool gz
   const double flip[3] = {-1, -1, 1};
   for (int row = 0; row < 3; ++row) {
     for (int col = 0; col < 3; ++col)
-      g.direction[3 * row + col] = flip[row] * (*affine)[4 * row + col];
-    g.origin[row] = flip[row] * (*affine)[4 * row + 3];
+      g.direction[3 * row + col] = flip[row] * affine[4 * row + col];
+    g.origin[row] = flip[row] * affine[4 * row + 3];
   }
   for (int col = 0; col < 3; ++col) {
     g.spacing[col] = std::sqrt(g.direction[col] * g.direction[col] +

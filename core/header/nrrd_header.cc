@@ -162,11 +162,12 @@ absl::StatusOr<VolumeHeader> check_nrrd_header(const std::string& path, const Re
   if (!std::string_view(bytes).starts_with("NRRD000")) {
     return field_error(path, "magic", "the file does not start with NRRD000X");
   }
-  auto text = parse_text_header(
-      path, bytes, {.separator = ": ", .comment = "#", .last_key = "", .key_value_marker = ":="},
-      limits.max_header_bytes);
-  if (!text.ok()) return text.status();
-  const TextHeader& h = *text;
+  LABELMESH_ASSIGN_OR_RETURN(
+      auto text, parse_text_header(
+                     path, bytes,
+                     {.separator = ": ", .comment = "#", .last_key = "", .key_value_marker = ":="},
+                     limits.max_header_bytes));
+  const TextHeader& h = text;
 
   auto dimension = h.find("dimension");
   if (!dimension || (*dimension != "3" && *dimension != "4")) {
@@ -177,18 +178,15 @@ absl::StatusOr<VolumeHeader> check_nrrd_header(const std::string& path, const Re
       space_dimension && *space_dimension != "3") {
     return field_error(path, "space dimension", "must be 3");
   }
-  auto axes = nrrd_sizes(path, h, layered, limits);
-  if (!axes.ok()) return axes.status();
-  auto segments = parse_slicer_segments(path, h.key_values, axes->layers);
-  if (!segments.ok()) return segments.status();
-  if (layered && segments->empty()) {
+  LABELMESH_ASSIGN_OR_RETURN(auto axes, nrrd_sizes(path, h, layered, limits));
+  LABELMESH_ASSIGN_OR_RETURN(auto segments, parse_slicer_segments(path, h.key_values, axes.layers));
+  if (layered && segments.empty()) {
     return field_error(path, "dimension",
                        "is 4, which is read only as a 3D Slicer segmentation (Segment<i>_ keys)");
   }
   auto type_name = h.find("type");
   if (!type_name) return field_error(path, "type", "is missing");
-  auto type = nrrd_scalar_type(path, *type_name);
-  if (!type.ok()) return type.status();
+  LABELMESH_ASSIGN_OR_RETURN(auto type, nrrd_scalar_type(path, *type_name));
   LABELMESH_RETURN_IF_ERROR(check_kinds(path, h, layered));
   for (std::string_view skip : {"byte skip", "byteskip", "line skip", "lineskip"}) {
     if (auto value = h.find(skip); value && *value != "0") {
@@ -198,17 +196,16 @@ absl::StatusOr<VolumeHeader> check_nrrd_header(const std::string& path, const Re
 
   VolumeHeader header;
   header.format = ImageFormat::kNrrd;
-  header.scalar_type = *type;
-  header.layers = axes->layers;
-  header.segments = std::move(*segments);
+  header.scalar_type = type;
+  header.layers = axes.layers;
+  header.segments = std::move(segments);
   ImageGeometry& g = header.geometry;
-  g.dims = axes->dims;
+  g.dims = axes.dims;
 
   std::array<double, 3> to_lps{1, 1, 1};
   if (auto space = h.find("space")) {
-    auto flips = nrrd_space_to_lps(path, *space);
-    if (!flips.ok()) return flips.status();
-    to_lps = *flips;
+    LABELMESH_ASSIGN_OR_RETURN(auto flips, nrrd_space_to_lps(path, *space));
+    to_lps = flips;
   }
   if (auto all_directions = h.find("space directions")) {
     auto directions = grid_part(*all_directions, layered);
@@ -218,12 +215,12 @@ absl::StatusOr<VolumeHeader> check_nrrd_header(const std::string& path, const Re
     if (contains(*directions, "none")) {
       return field_error(path, "space directions", "every grid axis needs a direction");
     }
-    auto vectors = parse_numbers(path, "space directions", *directions, 9);
-    if (!vectors.ok()) return vectors.status();
+    LABELMESH_ASSIGN_OR_RETURN(auto vectors,
+                               parse_numbers(path, "space directions", *directions, 9));
     for (int axis = 0; axis < 3; ++axis) {
       double norm2 = 0;
       for (int row = 0; row < 3; ++row) {
-        const double v = to_lps[row] * (*vectors)[3 * axis + row];
+        const double v = to_lps[row] * vectors[3 * axis + row];
         g.direction[3 * row + axis] = v;
         norm2 += v * v;
       }
@@ -234,15 +231,13 @@ absl::StatusOr<VolumeHeader> check_nrrd_header(const std::string& path, const Re
   } else if (auto all_spacings = h.find("spacings")) {
     auto spacings = grid_part(*all_spacings, layered);
     if (!spacings) return field_error(path, "spacings", "the list axis must come first, as nan");
-    auto values = parse_numbers(path, "spacings", *spacings, 3);
-    if (!values.ok()) return values.status();
-    g.spacing = {(*values)[0], (*values)[1], (*values)[2]};
+    LABELMESH_ASSIGN_OR_RETURN(auto values, parse_numbers(path, "spacings", *spacings, 3));
+    g.spacing = {values[0], values[1], values[2]};
     LABELMESH_RETURN_IF_ERROR(check_spacing(path, "spacings", g.spacing));
   }
   if (auto origin = h.find("space origin")) {
-    auto values = parse_numbers(path, "space origin", *origin, 3);
-    if (!values.ok()) return values.status();
-    for (int row = 0; row < 3; ++row) g.origin[row] = to_lps[row] * (*values)[row];
+    LABELMESH_ASSIGN_OR_RETURN(auto values, parse_numbers(path, "space origin", *origin, 3));
+    for (int row = 0; row < 3; ++row) g.origin[row] = to_lps[row] * values[row];
   }
 
   auto encoding = h.find("encoding");
@@ -254,7 +249,7 @@ absl::StatusOr<VolumeHeader> check_nrrd_header(const std::string& path, const Re
   } else {
     return field_error(path, "encoding", "only raw and gzip voxel data are supported");
   }
-  if (scalar_size(*type) > 1) {
+  if (scalar_size(type) > 1) {
     auto endian = h.find("endian");
     if (!endian || (*endian != "little" && *endian != "big")) {
       return field_error(path, "endian", "must be little or big for multi-byte voxels");

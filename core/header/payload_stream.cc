@@ -105,10 +105,10 @@ absl::StatusOr<uint64_t> PayloadStream::skip(uint64_t n) {
   const auto sink = std::make_unique_for_overwrite<char[]>(sink_size);
   uint64_t skipped = 0;
   while (skipped < n) {
-    auto got = read(sink.get(), std::min<uint64_t>(n - skipped, sink_size));
-    if (!got.ok()) return got.status();
-    if (*got == 0) break;
-    skipped += *got;
+    LABELMESH_ASSIGN_OR_RETURN(auto got,
+                               read(sink.get(), std::min<uint64_t>(n - skipped, sink_size)));
+    if (got == 0) break;
+    skipped += got;
   }
   return skipped;
 }

@@ -186,20 +186,19 @@ absl::StatusOr<SlicerSegment> parse_segment(std::string_view path, int index,
   LABELMESH_ASSIGN_OR_RETURN(auto name, segment_name(path, index, keys));
   segment.description.name = std::move(name);
   if (keys.colour != nullptr) {
-    auto colour = segment_colour(path, index, *keys.colour);
-    if (!colour.ok()) return colour.status();
-    segment.description.colour = *colour;
+    LABELMESH_ASSIGN_OR_RETURN(auto colour, segment_colour(path, index, *keys.colour));
+    segment.description.colour = colour;
   }
   if (keys.value != nullptr) {
-    auto value = whole_number(path, key_name(index, "LabelValue"), *keys.value, 1,
-                              std::numeric_limits<int32_t>::max());
-    if (!value.ok()) return value.status();
-    segment.value = static_cast<int32_t>(*value);
+    LABELMESH_ASSIGN_OR_RETURN(auto value,
+                               whole_number(path, key_name(index, "LabelValue"), *keys.value, 1,
+                                            std::numeric_limits<int32_t>::max()));
+    segment.value = static_cast<int32_t>(value);
   }
   if (keys.layer != nullptr) {
-    auto layer = whole_number(path, key_name(index, "Layer"), *keys.layer, 0, layers - 1);
-    if (!layer.ok()) return layer.status();
-    segment.layer = static_cast<int>(*layer);
+    LABELMESH_ASSIGN_OR_RETURN(
+        auto layer, whole_number(path, key_name(index, "Layer"), *keys.layer, 0, layers - 1));
+    segment.layer = static_cast<int>(layer);
   } else if (layer_per_segment) {
     segment.layer = index;
   }
@@ -232,9 +231,9 @@ absl::StatusOr<std::vector<SlicerSegment>> parse_slicer_segments(
   std::vector<SlicerSegment> segments;
   segments.reserve(grouped.size());
   for (const auto& [index, keys] : grouped) {
-    auto segment = parse_segment(path, index, keys, layers, layer_per_segment);
-    if (!segment.ok()) return segment.status();
-    segments.push_back(std::move(*segment));
+    LABELMESH_ASSIGN_OR_RETURN(auto segment,
+                               parse_segment(path, index, keys, layers, layer_per_segment));
+    segments.push_back(std::move(segment));
   }
   LABELMESH_RETURN_IF_ERROR(check_distinct_values(path, segments));
   const std::vector<int32_t> labels = slicer_labels(segments);

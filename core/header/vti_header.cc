@@ -67,11 +67,10 @@ absl::StatusOr<VolumeHeader> check_vti_header(const std::string& path, const Rea
 
   auto extent_text = find_attribute(*image, "WholeExtent");
   if (!extent_text) return field_error(path, "WholeExtent", "is missing");
-  auto extent = parse_numbers(path, "WholeExtent", *extent_text, 6);
-  if (!extent.ok()) return extent.status();
+  LABELMESH_ASSIGN_OR_RETURN(auto extent, parse_numbers(path, "WholeExtent", *extent_text, 6));
   std::array<int64_t, 3> dims{};
   for (int axis = 0; axis < 3; ++axis) {
-    const double lo = (*extent)[2 * axis], hi = (*extent)[2 * axis + 1];
+    const double lo = extent[2 * axis], hi = extent[2 * axis + 1];
     if (lo != std::floor(lo) || hi != std::floor(hi) || std::abs(lo) > 1e12 ||
         std::abs(hi) > 1e12) {
       return field_error(path, "WholeExtent", "must hold whole numbers");
@@ -86,28 +85,25 @@ absl::StatusOr<VolumeHeader> check_vti_header(const std::string& path, const Rea
   ImageGeometry& g = header.geometry;
   g.dims = dims;
   if (auto text = find_attribute(*image, "Spacing")) {
-    auto values = parse_numbers(path, "Spacing", *text, 3);
-    if (!values.ok()) return values.status();
-    g.spacing = {(*values)[0], (*values)[1], (*values)[2]};
+    LABELMESH_ASSIGN_OR_RETURN(auto values, parse_numbers(path, "Spacing", *text, 3));
+    g.spacing = {values[0], values[1], values[2]};
   }
   LABELMESH_RETURN_IF_ERROR(check_spacing(path, "Spacing", g.spacing));
   if (auto text = find_attribute(*image, "Direction")) {
-    auto values = parse_numbers(path, "Direction", *text, 9);
-    if (!values.ok()) return values.status();
-    std::copy(values->begin(), values->end(), g.direction.begin());
+    LABELMESH_ASSIGN_OR_RETURN(auto values, parse_numbers(path, "Direction", *text, 9));
+    std::copy(values.begin(), values.end(), g.direction.begin());
     LABELMESH_RETURN_IF_ERROR(normalise_direction(path, "Direction", g.direction));
   }
   std::array<double, 3> vtk_origin{0, 0, 0};
   if (auto text = find_attribute(*image, "Origin")) {
-    auto values = parse_numbers(path, "Origin", *text, 3);
-    if (!values.ok()) return values.status();
-    vtk_origin = {(*values)[0], (*values)[1], (*values)[2]};
+    LABELMESH_ASSIGN_OR_RETURN(auto values, parse_numbers(path, "Origin", *text, 3));
+    vtk_origin = {values[0], values[1], values[2]};
   }
   // Our voxel (0,0,0) is VTK's extent minimum.
   g.origin = vtk_origin;
   for (int row = 0; row < 3; ++row) {
     for (int axis = 0; axis < 3; ++axis) {
-      g.origin[row] += g.direction[3 * row + axis] * (*extent)[2 * axis] * g.spacing[axis];
+      g.origin[row] += g.direction[3 * row + axis] * extent[2 * axis] * g.spacing[axis];
     }
   }
   // A far extent start times a large spacing can leave the finite doubles.
@@ -121,9 +117,8 @@ absl::StatusOr<VolumeHeader> check_vti_header(const std::string& path, const Rea
   if (!array) return field_error(path, "PointData", "holds no DataArray");
   auto type_name = find_attribute(*array, "type");
   if (!type_name) return field_error(path, "DataArray type", "is missing");
-  auto type = vti_scalar_type(path, *type_name);
-  if (!type.ok()) return type.status();
-  header.scalar_type = *type;
+  LABELMESH_ASSIGN_OR_RETURN(auto type, vti_scalar_type(path, *type_name));
+  header.scalar_type = type;
   if (auto components = find_attribute(*array, "NumberOfComponents");
       components && *components != "1") {
     return field_error(path, "NumberOfComponents", "must be 1 for a label volume");

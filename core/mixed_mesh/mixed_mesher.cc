@@ -115,10 +115,10 @@ absl::StatusOr<MixedMesh> mesh_mixed(const surface::TriangleMesh& surface, int32
   // The core's pieces are known cavities, and TetGen needs no run to find
   // them, unless the surface has cavities of its own (nested shells).
   const bool known = !core->cavity_points.empty() && one_piece(surface);
-  auto tets = volume_mesh::tetrahedralize_around(
-      layer_boundary(surface, *core), label, params.tetgen, known ? &core->cavity_points : nullptr,
-      context, figures.tetgen);
-  if (!tets.ok()) return tets.status();
+  LABELMESH_ASSIGN_OR_RETURN(auto tets,
+                             volume_mesh::tetrahedralize_around(
+                                 layer_boundary(surface, *core), label, params.tetgen,
+                                 known ? &core->cavity_points : nullptr, context, figures.tetgen));
 
   // TetGen keeps input points exactly: the shell's points are found again by
   // their coordinates, so the tetrahedra share the pyramids' nodes.
@@ -126,15 +126,15 @@ absl::StatusOr<MixedMesh> mesh_mixed(const surface::TriangleMesh& surface, int32
   std::map<std::array<double, 3>, uint32_t> shared;
   for (const auto& t : core->shell)
     for (uint32_t v : t) shared.emplace(mesh.points[v], v);
-  std::vector<uint32_t> index(tets->points.size());
+  std::vector<uint32_t> index(tets.points.size());
   size_t matched = 0;
-  for (size_t i = 0; i < tets->points.size(); ++i) {
-    if (const auto found = shared.find(tets->points[i]); found != shared.end()) {
+  for (size_t i = 0; i < tets.points.size(); ++i) {
+    if (const auto found = shared.find(tets.points[i]); found != shared.end()) {
       index[i] = found->second;
       ++matched;
     } else {
       index[i] = static_cast<uint32_t>(mesh.points.size());
-      mesh.points.push_back(tets->points[i]);
+      mesh.points.push_back(tets.points[i]);
     }
   }
   if (matched != shared.size()) {
@@ -142,7 +142,7 @@ absl::StatusOr<MixedMesh> mesh_mixed(const surface::TriangleMesh& surface, int32
         cat("label ", label, ": ", shared.size() - matched,
             " of the core's boundary points are missing from TetGen's mesh"));
   }
-  for (const auto& t : tets->tetrahedra)
+  for (const auto& t : tets.tetrahedra)
     mesh.add(CellType::kTetra, {index[t[0]], index[t[1]], index[t[2]], index[t[3]]}, label);
   return mesh;
 }

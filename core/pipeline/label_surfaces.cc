@@ -59,9 +59,9 @@ absl::StatusOr<Pieces> kept_component_surfaces(const volume::LabelVolume& volume
   }
   pieces.counts.kept = static_cast<uint32_t>(kept.size());
   if (kept.empty()) return pieces;
-  auto meshes = surface::extract_component_surfaces(components, kept, volume.geometry, context);
-  if (!meshes.ok()) return meshes.status();
-  pieces.meshes = std::move(*meshes);
+  LABELMESH_ASSIGN_OR_RETURN(
+      auto meshes, surface::extract_component_surfaces(components, kept, volume.geometry, context));
+  pieces.meshes = std::move(meshes);
   pieces.components = std::move(components);
   pieces.ids = std::move(kept);
   return pieces;
@@ -445,16 +445,16 @@ absl::Status add_label_surfaces(const volume::LabelVolume& volume,
       context.report("level_set", 0);
       return try_surface(
           method, refine, [&](size_t i, const Sizing& sizing) -> absl::StatusOr<TriangleMesh> {
-            auto field = surface::component_field(pieces->components, pieces->ids[i],
-                                                  volume.geometry, kMaskSigmaVoxels);
-            if (!field.ok()) return field.status();
+            LABELMESH_ASSIGN_OR_RETURN(auto field,
+                                       surface::component_field(pieces->components, pieces->ids[i],
+                                                                volume.geometry, kMaskSigmaVoxels));
             surface::LevelSetParams level_set;
             level_set.min_angle_deg = params.poisson.min_angle_deg;
             level_set.level = kMaskLevel;
             level_set.max_edge_mm = sizing.max_edge_mm;
             level_set.max_distance_mm = sizing.max_distance_mm;
             auto mesh =
-                surface::mesh_level_set(*field, level_set, pieces->meshes[i].points, context);
+                surface::mesh_level_set(field, level_set, pieces->meshes[i].points, context);
             if (mesh.status().code() == absl::StatusCode::kResourceExhausted)
               mask_did_not_settle = true;
             return mesh;

@@ -237,10 +237,9 @@ absl::StatusOr<LabelComponents> find_label_components(const LabelVolume& volume,
                         result.filled_voxels);
   }
 
-  auto runs = find_runs(box, mask, context);
-  if (!runs.ok()) return runs.status();
+  LABELMESH_ASSIGN_OR_RETURN(auto runs, find_runs(box, mask, context));
   context.report("components", 0.5);
-  geometry::DisjointSets sets = label_runs(box, *runs);
+  geometry::DisjointSets sets = label_runs(box, runs);
 
   // Ids in order of first appearance: runs are in memory order.
   result.ids = vtkSmartPointer<vtkImageData>::New();
@@ -254,8 +253,8 @@ absl::StatusOr<LabelComponents> find_label_components(const LabelVolume& volume,
   auto* ids = static_cast<int32_t*>(result.ids->GetScalarPointer());
   std::fill(ids, ids + box.count(), 0);
   std::vector<int32_t> id_of_root(sets.size(), 0);
-  for (size_t r = 0; r < runs->runs.size(); ++r) {
-    const Run& run = runs->runs[r];
+  for (size_t r = 0; r < runs.runs.size(); ++r) {
+    const Run& run = runs.runs[r];
     int32_t& id = id_of_root[sets.find(static_cast<uint32_t>(r))];
     if (id == 0) {
       LabelComponent component;

@@ -194,12 +194,12 @@ absl::StatusOr<SlicerVolume> merge_slicer_layers(const std::string& path,
   }
   int32_t most = 0;
   for (const auto& segment : header.segments) most = std::max(most, segment.description.label);
-  auto merged = most <= std::numeric_limits<uint16_t>::max()
-                    ? merge_into<vtkUnsignedShortArray>(path, header, values, limits, context)
-                    : merge_into<vtkIntArray>(path, header, values, limits, context);
-  if (!merged.ok()) return merged.status();
-  volume.voxels = std::move(merged->front());
-  volume.more_layers.assign(merged->begin() + 1, merged->end());
+  LABELMESH_ASSIGN_OR_RETURN(
+      auto merged, most <= std::numeric_limits<uint16_t>::max()
+                       ? merge_into<vtkUnsignedShortArray>(path, header, values, limits, context)
+                       : merge_into<vtkIntArray>(path, header, values, limits, context));
+  volume.voxels = std::move(merged.front());
+  volume.more_layers.assign(merged.begin() + 1, merged.end());
   return volume;
 }
 

@@ -93,10 +93,8 @@ absl::StatusOr<std::pair<const uint8_t*, size_t>> pixel_bytes(const std::string&
 absl::StatusOr<LabelVolume> read_dicom_seg(const std::string& path, const ReadLimits& limits,
                                            const RunContext& context) {
   silence_dcmtk();
-  auto header = internal::parse_dicom_seg_header(path);
-  if (!header.ok()) return header.status();
-  auto grid = dicom_seg_grid(path, *header, limits);
-  if (!grid.ok()) return grid.status();
+  LABELMESH_ASSIGN_OR_RETURN(auto header, internal::parse_dicom_seg_header(path));
+  LABELMESH_ASSIGN_OR_RETURN(auto grid, dicom_seg_grid(path, header, limits));
   LABELMESH_RETURN_IF_ERROR(context.check_stop());
 
   DcmFileFormat file;
@@ -110,9 +108,9 @@ absl::StatusOr<LabelVolume> read_dicom_seg(const std::string& path, const ReadLi
   }
   // DCMTK drops segment items it cannot read; then its segment n is not the
   // file's, and names would land on the wrong labels.
-  if (segmentation->getNumberOfSegments() != header->segments) {
+  if (segmentation->getNumberOfSegments() != header.segments) {
     return field_error(path, "(0062,0002) Segment Sequence",
-                       absl::StrCat(header->segments - segmentation->getNumberOfSegments(),
+                       absl::StrCat(header.segments - segmentation->getNumberOfSegments(),
                                     " segment items are malformed"));
   }
   LABELMESH_ASSIGN_OR_RETURN(auto pixels, pixel_bytes(path, *file.getDataset()));
@@ -121,19 +119,19 @@ absl::StatusOr<LabelVolume> read_dicom_seg(const std::string& path, const ReadLi
   const size_t byte_count = pixels.second;
   context.report("read", 0.5);
 
-  const uint64_t rows = header->rows, columns = header->columns;
+  const uint64_t rows = header.rows, columns = header.columns;
   const uint64_t frame_pixels = rows * columns;
-  const bool binary = header->bits_allocated == 1;
+  const bool binary = header.bits_allocated == 1;
   const uint64_t needed =
-      binary ? (frame_pixels * header->frames + 7) / 8 : frame_pixels * header->frames;
+      binary ? (frame_pixels * header.frames + 7) / 8 : frame_pixels * header.frames;
   if (byte_count < needed) {
     return field_error(path, "(7FE0,0010) Pixel Data",
                        absl::StrCat("holds ", byte_count, " bytes, ", needed, " needed"));
   }
   // A FRACTIONAL value v is inside when v / max >= threshold.
-  const double least_inside = limits.fractional_threshold * header->maximum_fractional_value;
+  const double least_inside = limits.fractional_threshold * header.maximum_fractional_value;
 
-  const ImageGeometry& g = grid->geometry;
+  const ImageGeometry& g = grid.geometry;
   auto labels = vtkSmartPointer<vtkUnsignedShortArray>::New();
   labels->SetNumberOfComponents(1);
   labels->SetNumberOfTuples(g.voxel_count());
@@ -145,9 +143,9 @@ absl::StatusOr<LabelVolume> read_dicom_seg(const std::string& path, const ReadLi
   };
   // Voxels two segments both claim, per pair (lower number first).
   std::map<std::pair<uint16_t, uint16_t>, uint64_t> shared;
-  for (uint32_t f = 0; f < header->frames; ++f) {
-    const uint16_t segment = header->frame_segments[f];
-    const uint64_t slice_start = uint64_t(grid->frame_slice[f]) * frame_pixels;
+  for (uint32_t f = 0; f < header.frames; ++f) {
+    const uint16_t segment = header.frame_segments[f];
+    const uint64_t slice_start = uint64_t(grid.frame_slice[f]) * frame_pixels;
     const uint64_t first = uint64_t(f) * frame_pixels;
     for (uint64_t p = 0; p < frame_pixels; ++p) {
       if (!inside(first + p)) continue;
@@ -193,11 +191,11 @@ absl::StatusOr<LabelVolume> read_dicom_seg(const std::string& path, const ReadLi
     labels = nullptr;  // its memory goes to the layers
     // Each segment's frames, by segment index: the grid checks that
     // segment n is item n - 1 and that every frame names one of them.
-    const std::vector<int32_t> numbers(header->segment_numbers.begin(),
-                                       header->segment_numbers.end());
+    const std::vector<int32_t> numbers(header.segment_numbers.begin(),
+                                       header.segment_numbers.end());
     std::vector<std::vector<uint32_t>> frames_of(numbers.size());
-    for (uint32_t f = 0; f < header->frames; ++f)
-      frames_of[header->frame_segments[f] - 1].push_back(f);
+    for (uint32_t f = 0; f < header.frames; ++f)
+      frames_of[header.frame_segments[f] - 1].push_back(f);
     uint64_t frames_visited = 0;
     auto layers = separate_segments(
         path, numbers, numbers.size(), uint64_t(g.voxel_count()), VTK_UNSIGNED_SHORT, limits,
@@ -206,7 +204,7 @@ absl::StatusOr<LabelVolume> read_dicom_seg(const std::string& path, const ReadLi
             if ((frames_visited++ & 63) == 0) {
               LABELMESH_RETURN_IF_ERROR(context.check_stop());
             }
-            const uint64_t slice_start = uint64_t(grid->frame_slice[f]) * frame_pixels;
+            const uint64_t slice_start = uint64_t(grid.frame_slice[f]) * frame_pixels;
             const uint64_t first = uint64_t(f) * frame_pixels;
             for (uint64_t p = 0; p < frame_pixels; ++p) {
               if (inside(first + p)) sink(segment, slice_start + p);
@@ -224,7 +222,7 @@ absl::StatusOr<LabelVolume> read_dicom_seg(const std::string& path, const ReadLi
       volume.more_layers.push_back(std::move(image));
     }
   }
-  for (uint16_t number : header->segment_numbers) {
+  for (uint16_t number : header.segment_numbers) {
     DcmSegment* segment = segmentation->getSegment(number);
     if (segment == nullptr) continue;
     volume.descriptions.push_back(describe(number, *segment));

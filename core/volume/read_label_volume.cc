@@ -104,10 +104,10 @@ absl::StatusOr<DecodedVoxels> read_with_vtk(const std::string& path, const Volum
 // Our reader for INR, NRRD and MetaImage: one contiguous block, raw, gzip or
 // zlib; header.layers values a voxel (a layered Slicer segmentation).
 absl::StatusOr<DecodedVoxels> read_block(const std::string& path, const VolumeHeader& header) {
-  auto stream = internal::PayloadStream::open(header.data_path, header.file_offset, header.encoding,
-                                              header.compressed_bytes);
-  if (!stream.ok()) return stream.status();
-  if (auto skipped = (*stream)->skip(header.decoded_offset);
+  LABELMESH_ASSIGN_OR_RETURN(
+      auto stream, internal::PayloadStream::open(header.data_path, header.file_offset,
+                                                 header.encoding, header.compressed_bytes));
+  if (auto skipped = stream->skip(header.decoded_offset);
       !skipped.ok() || *skipped != header.decoded_offset) {
     return field_error(path, "voxel data", "is missing");
   }
@@ -116,11 +116,11 @@ absl::StatusOr<DecodedVoxels> read_block(const std::string& path, const VolumeHe
   array->SetNumberOfComponents(1);
   array->SetNumberOfTuples(header.geometry.voxel_count() * header.layers);
   const uint64_t bytes = header.data_bytes();
-  auto got = (*stream)->read(static_cast<char*>(array->GetVoidPointer(0)), bytes);
-  if (!got.ok()) return got.status();
-  if (*got != bytes) {
+  LABELMESH_ASSIGN_OR_RETURN(auto got,
+                             stream->read(static_cast<char*>(array->GetVoidPointer(0)), bytes));
+  if (got != bytes) {
     return field_error(path, "voxel data",
-                       cat("is truncated: expected ", bytes, " bytes, found ", *got));
+                       cat("is truncated: expected ", bytes, " bytes, found ", got));
   }
   const bool swap = header.big_endian != (std::endian::native == std::endian::big);
   const int size = scalar_size(header.scalar_type);
@@ -193,23 +193,22 @@ absl::StatusOr<LabelVolume> read_label_volume(const std::string& path, const Rea
   const bool own_reader = header.format == ImageFormat::kInr ||
                           header.format == ImageFormat::kNrrd ||
                           header.format == ImageFormat::kMetaImage;
-  auto decoded = own_reader ? read_block(path, header) : read_with_vtk(path, header);
-  if (!decoded.ok()) return decoded.status();
-  if (decoded->array->GetNumberOfComponents() != 1 ||
-      decoded->array->GetNumberOfTuples() != header.geometry.voxel_count() * header.layers) {
+  LABELMESH_ASSIGN_OR_RETURN(auto decoded,
+                             own_reader ? read_block(path, header) : read_with_vtk(path, header));
+  if (decoded.array->GetNumberOfComponents() != 1 ||
+      decoded.array->GetNumberOfTuples() != header.geometry.voxel_count() * header.layers) {
     return field_error(path, "voxel data", "does not hold one value per voxel");
   }
   LABELMESH_RETURN_IF_ERROR(context.check_stop());
-  auto labels = to_label_array(path, header, decoded->array);
-  if (!labels.ok()) return labels.status();
+  LABELMESH_ASSIGN_OR_RETURN(auto labels, to_label_array(path, header, decoded.array));
 
   LabelVolume volume;
   if (!header.segments.empty()) {
-    auto slicer = merge_slicer_layers(path, header, *labels, limits, context);
-    if (!slicer.ok()) return slicer.status();
-    *labels = slicer->voxels;
-    volume.descriptions = std::move(slicer->descriptions);
-    for (const auto& layer : slicer->more_layers) {
+    LABELMESH_ASSIGN_OR_RETURN(auto slicer,
+                               merge_slicer_layers(path, header, labels, limits, context));
+    labels = slicer.voxels;
+    volume.descriptions = std::move(slicer.descriptions);
+    for (const auto& layer : slicer.more_layers) {
       auto image = vtkSmartPointer<vtkImageData>::New();
       image->SetDimensions(static_cast<int>(header.geometry.dims[0]),
                            static_cast<int>(header.geometry.dims[1]),
@@ -221,12 +220,12 @@ absl::StatusOr<LabelVolume> read_label_volume(const std::string& path, const Rea
   volume.format = header.format;
   volume.file_voxel_type = std::string(scalar_type_name(header.scalar_type));
   volume.geometry = header.geometry;
-  if (decoded->reversed_k) volume.geometry.reverse_axis(2);
+  if (decoded.reversed_k) volume.geometry.reverse_axis(2);
   volume.voxels = vtkSmartPointer<vtkImageData>::New();
   volume.voxels->SetDimensions(static_cast<int>(header.geometry.dims[0]),
                                static_cast<int>(header.geometry.dims[1]),
                                static_cast<int>(header.geometry.dims[2]));
-  volume.voxels->GetPointData()->SetScalars(*labels);
+  volume.voxels->GetPointData()->SetScalars(labels);
   context.report("read", 1.0);
   return volume;
 }

@@ -14,12 +14,11 @@ absl::StatusOr<std::unique_ptr<ClusterConnection>> ClusterConnection::open(
   connection->client = std::move(*client);
   LABELMESH_ASSIGN_OR_RETURN(auto queue, JobQueue::open(*connection->client, settings.queue));
   connection->queue = std::move(queue);
-  auto states = JobStates::open(*connection->client, settings.states_bucket);
-  if (!states.ok()) return states.status();
-  connection->states = std::move(*states);
-  auto events = EventLog::open(*connection->client, settings.events);
-  if (!events.ok()) return events.status();
-  connection->events = std::move(*events);
+  LABELMESH_ASSIGN_OR_RETURN(auto states,
+                             JobStates::open(*connection->client, settings.states_bucket));
+  connection->states = std::move(states);
+  LABELMESH_ASSIGN_OR_RETURN(auto events, EventLog::open(*connection->client, settings.events));
+  connection->events = std::move(events);
   connection->jobs =
       std::make_unique<ClusterJobs>(*connection->states, *connection->queue, *connection->events);
   return connection;

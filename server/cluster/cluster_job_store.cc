@@ -153,17 +153,15 @@ absl::Status ClusterJobStore::erase(const std::string& job_id) const {
 
 absl::StatusOr<v1::JobState> ClusterJobStore::remove(const std::string& job_id) {
   LABELMESH_ASSIGN_OR_RETURN(auto found, record(job_id));
-  auto removed = cluster_.jobs->remove(job_id);
-  if (!removed.ok()) return removed.status();
+  LABELMESH_ASSIGN_OR_RETURN(auto removed, cluster_.jobs->remove(job_id));
   // A running job's worker removes its files once it stops.
-  if (*removed) files_.remove_job(job_id);
+  if (removed) files_.remove_job(job_id);
   spdlog::info("job {} deleted by a client", job_id);
   return found.job().state();
 }
 
 absl::StatusOr<v1::Job> ClusterJobStore::cancel(const std::string& job_id) {
-  auto found = record(job_id);
-  if (!found.ok()) return found.status();
+  LABELMESH_ASSIGN_OR_RETURN(auto found, record(job_id));
   LABELMESH_ASSIGN_OR_RETURN(auto cancelled, cluster_.jobs->cancel(job_id));
   return with_timestamps(cancelled.job());
 }
@@ -186,10 +184,9 @@ absl::Status ClusterJobStore::replay_ended(const v1::JobRecord& record, uint64_t
                                            EventListener* listener) {
   LABELMESH_ASSIGN_OR_RETURN(auto follower, cluster_.events->follow(record.job().job_id(), from));
   for (;;) {
-    auto next = (follower)->next(kReplayWait);
-    if (!next.ok()) return next.status();
-    if (!next->has_value()) break;
-    const v1::JobEvent event = watched_event(**next);
+    LABELMESH_ASSIGN_OR_RETURN(auto next, (follower)->next(kReplayWait));
+    if (!next.has_value()) break;
+    const v1::JobEvent event = watched_event(*next);
     const bool last = is_last(event);
     listener->on_event(event, last);
     if (last) return absl::OkStatus();

@@ -66,9 +66,8 @@ absl::StatusOr<std::string> SharedArtifacts::resolve(std::string_view relative) 
 }
 
 absl::Status SharedArtifacts::put(std::string_view relative, std::string_view bytes) const {
-  auto path = resolve(relative);
-  if (!path.ok()) return path.status();
-  const fs::path target(*path);
+  LABELMESH_ASSIGN_OR_RETURN(auto path, resolve(relative));
+  const fs::path target(path);
   std::error_code error;
   fs::create_directories(target.parent_path(), error);
   if (error) return server::spool_io_error(target.parent_path().string(), error.value());
