@@ -198,7 +198,7 @@ absl::StatusOr<SlicerVolume> merge_slicer_layers(const std::string& path,
       auto merged, most <= std::numeric_limits<uint16_t>::max()
                        ? merge_into<vtkUnsignedShortArray>(path, header, values, limits, context)
                        : merge_into<vtkIntArray>(path, header, values, limits, context));
-  volume.voxels = std::move(merged.front());
+  volume.voxels = merged.front();
   volume.more_layers.assign(merged.begin() + 1, merged.end());
   return volume;
 }
