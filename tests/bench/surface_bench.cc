@@ -167,6 +167,12 @@ int bench_volume(const std::string& path, int rounds) {
       rounds, median(ours_s), median(slicer_s), median(ratios),
       *std::min_element(ratios.begin(), ratios.end()),
       *std::max_element(ratios.begin(), ratios.end()));
+  // Where our last run's time went; stages of labels meshed side by side
+  // add up, so they sum to more than the run's wall time.
+  std::printf("  our last run's stages, seconds summed over labels:");
+  for (const auto& stage : result->stages)
+    std::printf(" %s %.2f", stage.name.c_str(), stage.seconds);
+  std::printf("\n");
 
   // The Slicer-like surfaces measured as ours are, against the voxels.
   auto volume = volume::read_label_volume(path, {}, RunContext{});
