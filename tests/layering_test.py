@@ -39,9 +39,21 @@ def code_model(build):
     for entry in model["configurations"][0]["targets"]:
         target = json.loads((replies / entry["jsonFile"]).read_text())
         sources = {s["path"] for s in target.get("sources", []) if is_project_file(s["path"], build)}
-        depends = {d["id"].split("::")[0] for d in target.get("dependencies", [])}
+        depends = {d["id"].split("::")[0] for d in target.get("dependencies", [])
+                   if not only_ordered_after(target, d)}
         targets[target["name"]] = (sources, depends)
     return targets
+
+
+def only_ordered_after(target, dependency):
+    """Whether `dependency` of `target` comes from add_dependencies (built
+    first, not linked): such a target's headers are not the target's to use."""
+    graph = target.get("backtraceGraph", {})
+    node = dependency.get("backtrace")
+    if node is None:
+        return False
+    command = graph["nodes"][node].get("command")
+    return command is not None and graph["commands"][command] == "add_dependencies"
 
 
 def is_project_file(path, build):

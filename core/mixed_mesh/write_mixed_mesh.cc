@@ -27,7 +27,7 @@
 #include "core/util/status_macros.h"
 #include "core/util/text.h"
 #include "core/util/text_file.h"
-#include "core/util/vtk_error_flag.h"
+#include "core/volume/vtk_error_flag.h"
 #include "core/volume_mesh/mesh_file_parts.h"
 
 namespace labelmesh::mixed_mesh {

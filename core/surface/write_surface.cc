@@ -21,7 +21,7 @@
 #include <vtkXMLPolyDataWriter.h>
 
 #include "core/util/text.h"
-#include "core/util/vtk_error_flag.h"
+#include "core/volume/vtk_error_flag.h"
 
 namespace labelmesh::surface {
 namespace {

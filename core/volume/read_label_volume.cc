@@ -17,9 +17,9 @@
 #include "core/header/payload_stream.h"
 #include "core/util/status_macros.h"
 #include "core/util/text.h"
-#include "core/util/vtk_error_flag.h"
 #include "core/volume/merge_slicer_layers.h"
 #include "core/volume/read_dicom_seg.h"
+#include "core/volume/vtk_error_flag.h"
 
 namespace labelmesh::volume {
 namespace {

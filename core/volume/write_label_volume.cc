@@ -20,7 +20,7 @@
 #include "core/header/volume_header.h"
 #include "core/util/status_macros.h"
 #include "core/util/text.h"
-#include "core/util/vtk_error_flag.h"
+#include "core/volume/vtk_error_flag.h"
 
 namespace labelmesh::volume {
 namespace {

@@ -11,7 +11,7 @@
 #include <vtkXMLUnstructuredGridWriter.h>
 
 #include "core/util/text.h"
-#include "core/util/vtk_error_flag.h"
+#include "core/volume/vtk_error_flag.h"
 
 namespace labelmesh::volume_mesh {
 
