@@ -567,8 +567,7 @@ absl::StatusOr<DicomSegHeader> Walker::run() {
                            ": compressed or deflated DICOM SEG is not supported"));
   }
 
-  LABELMESH_ASSIGN_OR_RETURN(auto end,
-                             walk_elements(pos, kNoEnd, false, 0, Scope::kDataSet, nullptr));
+  LABELMESH_RETURN_IF_ERROR(walk_elements(pos, kNoEnd, false, 0, Scope::kDataSet, nullptr));
 
   if (per_frame_seen_ && out_.frame_positions.size() != out_.frames) {
     return field_error(path_, tag_name(kPerFrameGroups),

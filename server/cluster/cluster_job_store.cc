@@ -161,7 +161,7 @@ absl::StatusOr<v1::JobState> ClusterJobStore::remove(const std::string& job_id) 
 }
 
 absl::StatusOr<v1::Job> ClusterJobStore::cancel(const std::string& job_id) {
-  LABELMESH_ASSIGN_OR_RETURN(auto found, record(job_id));
+  LABELMESH_RETURN_IF_ERROR(record(job_id));
   LABELMESH_ASSIGN_OR_RETURN(auto cancelled, cluster_.jobs->cancel(job_id));
   return with_timestamps(cancelled.job());
 }

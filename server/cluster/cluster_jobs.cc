@@ -69,8 +69,7 @@ absl::StatusOr<v1::JobRecord> ClusterJobs::submit(v1::JobRecord record) {
     auto recorded = get(job_id);
     if (!recorded.ok()) return recorded.status();
     if (recorded->job().state() == v1::JOB_STATE_QUEUED) {
-      LABELMESH_ASSIGN_OR_RETURN(auto queued,
-                                 queue_.enqueue(job_id, queue_key(*recorded), made(*recorded)));
+      LABELMESH_RETURN_IF_ERROR(queue_.enqueue(job_id, queue_key(*recorded), made(*recorded)));
     }
     return recorded;
   }
