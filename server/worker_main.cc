@@ -145,6 +145,8 @@ absl::Status run_job(const std::string& job_dir, const std::string& out_dir, int
       return absl::InternalError("the worker cannot read its job record");
     }
   }
+  // Never meshed with defaults in place of options the record lacks.
+  if (!record.job().has_options()) return absl::InternalError("the job record holds no options");
   LABELMESH_ASSIGN_OR_RETURN(auto params, params_from_options(record.job().options()));
   // The server's share of the cores for each worker (kJobThreadsVariable).
   if (const char* threads = std::getenv(kJobThreadsVariable)) {

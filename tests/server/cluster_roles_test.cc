@@ -10,6 +10,7 @@
 #include <thread>
 
 #include "cluster/nats_server.h"
+#include "core/job/job_options.h"
 #include "core/volume/phantom.h"
 #include "grpc/health/v1/health.grpc.pb.h"
 #include "labelmesh/v1/service.grpc.pb.h"
@@ -104,6 +105,8 @@ class ClusterRolesTest : public ::testing::Test {
     record.mutable_job()->set_job_id(id);
     record.mutable_job()->set_owner("ann");
     record.mutable_job()->set_created_at(server::unix_now());
+    // A frontend stores the options with every default filled in.
+    *record.mutable_job()->mutable_options() = make_options(MeshParams{});
     record.set_input_extension(".nii.gz");
     EXPECT_THAT(store_->accept(record, upload), testing::IsOk());
     return id;
