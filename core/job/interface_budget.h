@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 // How large a conforming mesh's interfaces may grow before its grid is
-// coarsened (coarsen_labels.h), apart from the code that does it.
+// coarsened (conforming/coarsen_labels.h), apart from the code that does it.
 #pragma once
 
 #include <cstdint>

@@ -12,7 +12,7 @@
 namespace labelmesh::surface {
 
 // Low-pass smoothing of the staircase surface before its points go to Poisson
-// (smooth_surface.h).
+// (surface/smooth_surface.h).
 struct SmoothingParams {
   // Filter iterations (the degree of the Chebyshev approximation); 0 turns
   // smoothing off. More iterations give a sharper cut-off, not more smoothing.
@@ -22,7 +22,7 @@ struct SmoothingParams {
   double pass_band = 0.1;
 };
 
-// How vertex normals weigh their triangles (vertex_normals.h).
+// How vertex normals weigh their triangles (surface/vertex_normals.h).
 enum class NormalWeighting {
   // Mean of the unit normals of incident triangles (the paper's choice, and
   // the default): on Marching Cubes surfaces, whose triangles come in a few

@@ -35,7 +35,7 @@ struct TetgenParams {
 // parameter is out of TetGen's range.
 absl::Status check_tetgen_params(const TetgenParams& params);
 
-// The improvement pass after TetGen (improve_tet_mesh.h).
+// The improvement pass after TetGen (volume_mesh/improve_tet_mesh.h).
 struct ImproveParams {
   // Tetrahedra with Q below this are worked on; the rest only take part as
   // neighbours. Above the Table 1 "questionable" bound of 0.2, so the pass

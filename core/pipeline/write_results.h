@@ -13,7 +13,7 @@
 namespace labelmesh {
 
 // Writes surface-label<N>[-<name>].<ext> (output_names.h) per surface and
-// format, the scene files (scene_format.h), volume.<ext> per volume format,
+// format, the scene files (job/scene_format.h), volume.<ext> per volume format,
 // then report.json and report.html, in `out_dir` (created if missing), every
 // mesh in params.frame. Fills each result's `files` and `scene_files`.
 absl::Status write_results(MeshResult& result, const MeshParams& params, const std::string& out_dir,

@@ -13,7 +13,7 @@
 
 namespace labelmesh::volume {
 
-// The header and grid are checked first (dicom_seg_grid.h), then DCMTK's
+// The header and grid are checked first (header/dicom_seg_grid.h), then DCMTK's
 // dcmseg reads the segments and the pixel data. A FRACTIONAL pixel counts as
 // inside when value / Maximum Fractional Value >= limits.fractional_threshold.
 // Segments that overlap are an error naming them and the voxels they share,
