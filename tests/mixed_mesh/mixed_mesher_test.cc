@@ -115,7 +115,9 @@ TEST_P(MixedMesher, BothLayersAreValidAndFillTheSurface) {
   EXPECT_EQ(q.tetrahedra, 0u);
   EXPECT_EQ(q.invalid, 0u);
   EXPECT_GE(q.jacobian_ratio_min, 0.3);
-  if (q.pyramid_aspect_ratio_min) EXPECT_GE(*q.pyramid_aspect_ratio_min, 0.2);
+  if (q.pyramid_aspect_ratio_min) {
+    EXPECT_GE(*q.pyramid_aspect_ratio_min, 0.2);
+  }
   EXPECT_GE(double(q.cell_summary.good), 0.99 * double(mesh->size()));
   EXPECT_GE(double(q.hexahedra), 0.7 * double(mesh->size()));
   EXPECT_NEAR(q.volume_mm3, enclosed, 0.01 * enclosed);

@@ -49,7 +49,9 @@ void expect_balanced(const MixedMesh& mesh) {
     }
   }
   for (size_t v = 0; v < mesh.points.size(); ++v)
-    if (most[v] > 0) EXPECT_LE(most[v], 2 * least[v] + 1e-9) << "node " << v;
+    if (most[v] > 0) {
+      EXPECT_LE(most[v], 2 * least[v] + 1e-9) << "node " << v;
+    }
 }
 
 // Nodes in the middle of a cell's edge or of a cell's square face: the
@@ -110,8 +112,12 @@ TEST(OctreeTransitions, EveryPatternIsValidConformingAndFillsItsOctant) {
     EXPECT_THAT(check_conformity(mesh), testing::IsOk()) << "trial " << trial;
     EXPECT_EQ(hanging_nodes(mesh), 0u) << "trial " << trial;
     expect_balanced(mesh);
-    if (q.pyramid_aspect_ratio_min) EXPECT_GE(*q.pyramid_aspect_ratio_min, 0.45);
-    if (q.tetrahedra > 0) EXPECT_GE(q.tetra_summary.min, 0.5);
+    if (q.pyramid_aspect_ratio_min) {
+      EXPECT_GE(*q.pyramid_aspect_ratio_min, 0.45);
+    }
+    if (q.tetrahedra > 0) {
+      EXPECT_GE(q.tetra_summary.min, 0.5);
+    }
     EXPECT_EQ(q.cell_summary.good, int64_t(mesh.size()));
     transitions += figures.transition_octants;
     pyramids += q.pyramids;
