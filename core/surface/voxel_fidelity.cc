@@ -2,6 +2,7 @@
 #include "core/surface/voxel_fidelity.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <vector>
@@ -236,7 +237,13 @@ std::vector<Vec3> index_points(const TriangleMesh& mesh, const volume::ImageGeom
 
 }  // namespace
 
-double axis_aligned_share(const TriangleMesh& mesh, const volume::ImageGeometry& geometry) {
+namespace {
+
+// The axis-aligned share with each triangle's normal from `facing`, given the
+// triangle's LPS corners and its centroid.
+template <typename Facing>
+double share_facing_axes(const TriangleMesh& mesh, const volume::ImageGeometry& geometry,
+                         const Facing& facing) {
   const double cosine = std::cos(kAxisAlignedDeg * M_PI / 180);
   const auto& d = geometry.direction;
   // The voxel axes in LPS: the direction matrix's columns.
@@ -252,18 +259,35 @@ double axis_aligned_share(const TriangleMesh& mesh, const volume::ImageGeometry&
     for (int k = 0; k < 3; ++k)
       cap = cap || centroid[k] < 0 || centroid[k] > double(geometry.dims[k] - 1);
     if (cap) continue;
-    const Vec3 normal = geometry::cross(geometry::sub(b, a), geometry::sub(c, a));
-    const double twice_area = geometry::norm(normal);
+    const double twice_area =
+        geometry::norm(geometry::cross(geometry::sub(b, a), geometry::sub(c, a)));
     if (twice_area == 0) continue;
     total += twice_area;
+    const Vec3 normal = facing(a, b, c);
+    const double length = geometry::norm(normal);
     for (const auto& axis : axes) {
-      if (std::abs(geometry::dot(normal, axis)) >= cosine * twice_area) {
+      if (std::abs(geometry::dot(normal, axis)) >= cosine * length) {
         aligned += twice_area;
         break;
       }
     }
   }
   return total > 0 ? aligned / total : 0;
+}
+
+}  // namespace
+
+double axis_aligned_share(const TriangleMesh& mesh, const volume::ImageGeometry& geometry) {
+  return share_facing_axes(mesh, geometry, [](const Vec3& a, const Vec3& b, const Vec3& c) {
+    return geometry::cross(geometry::sub(b, a), geometry::sub(c, a));
+  });
+}
+
+double axis_aligned_share(const TriangleMesh& mesh, const volume::ImageGeometry& geometry,
+                          const std::function<Vec3(const Vec3&)>& normal_at) {
+  return share_facing_axes(mesh, geometry, [&](const Vec3& a, const Vec3& b, const Vec3& c) {
+    return normal_at(geometry::scale(geometry::add(a, geometry::add(b, c)), 1.0 / 3));
+  });
 }
 
 double corresponding_hausdorff_voxels(const TriangleMesh& mesh, const TriangleMesh& staircase,

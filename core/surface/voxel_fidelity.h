@@ -7,10 +7,12 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 
 #include "absl/status/statusor.h"
 #include "core/surface/triangle_mesh.h"
 #include "core/util/run_context.h"
+#include "core/util/vec3.h"
 #include "core/volume/label_statistics.h"
 #include "core/volume/label_volume.h"
 
@@ -55,6 +57,11 @@ absl::StatusOr<VoxelFidelity> measure_voxel_fidelity(const TriangleMesh& mesh,
 // The share of `mesh`'s area facing along a voxel axis of `geometry`
 // (kAxisAlignedDeg), leaving out triangles outside the voxel centres' box.
 double axis_aligned_share(const TriangleMesh& mesh, const volume::ImageGeometry& geometry);
+
+// The same share with each triangle facing along `normal_at` its centroid
+// (LPS) instead of its own normal: a true shape's share, sampled on `mesh`.
+double axis_aligned_share(const TriangleMesh& mesh, const volume::ImageGeometry& geometry,
+                          const std::function<geometry::Vec3(const geometry::Vec3&)>& normal_at);
 
 // The Hausdorff distance, in voxels along each axis, between `mesh` and
 // `staircase` when both have the same triangles (a point moved from its

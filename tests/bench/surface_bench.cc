@@ -8,7 +8,8 @@
 //              surfaces (both pipelines alternating, from reading the file),
 //              the axis-aligned area share per label (median), and how many
 //              labels each pipeline keeps within the voxel tolerance.
-// Usage: labelmesh_surface_bench [phantoms|volumes|all] [ROUNDS] [FILE ...]
+//   shares     the phantoms' axis-aligned area share beside the true shape's;
+// Usage: labelmesh_surface_bench [phantoms|shares|volumes|all] [ROUNDS] [FILE ...]
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -124,6 +125,48 @@ int bench_phantoms() {
                   shape.name.c_str(), grid.name, e_mc.rms_mm, e_mc.normal_p95_deg, e_slicer.rms_mm,
                   e_slicer.normal_p95_deg, e_ours.rms_mm, e_ours.normal_p95_deg,
                   e_ours.rms_mm / smallest, method.c_str());
+    }
+  }
+  return failures;
+}
+
+// The axis-aligned share of each surface beside the true shape's (the true
+// normals at our triangles' centres): what a perfect surface would score.
+int bench_shares() {
+  struct Grid {
+    const char* name;
+    std::array<double, 3> spacing;
+    double degrees;
+  };
+  const std::vector<Grid> grids{{"3 mm", {3, 3, 3}, 0},
+                                {"0.98x0.98x2 mm", {0.976562, 0.976562, 2}, 0},
+                                {"1x1x3 mm", {1, 1, 3}, 0},
+                                {"0.6x0.6x4 mm", {0.6, 0.6, 4}, 0},
+                                {"1x1x3 mm oblique", {1, 1, 3}, 25}};
+  const std::vector<AnalyticShape> shapes{testing::sphere_shape(25),
+                                          testing::ellipsoid_shape(32, 22, 15),
+                                          testing::torus_shape(25, 9), testing::column_shape(20)};
+  std::printf("%-10s %-18s | axis-aligned %%: true  MC  Slicer-like  ours (method)\n", "shape",
+              "grid");
+  int failures = 0;
+  for (const auto& grid : grids) {
+    for (const auto& shape : shapes) {
+      const auto volume = testing::sample_shape(shape, grid.spacing, grid.degrees);
+      const auto statistics = volume::compute_label_statistics(volume);
+      auto mc = surface::extract_surfaces(volume, statistics, {1}, RunContext{});
+      const auto slicer = testing::slicer_like_surfaces(volume, statistics, {1});
+      std::string method;
+      const auto ours = our_surface(volume, method);
+      if (!mc.ok() || slicer.empty() || ours.triangles.empty()) {
+        ++failures;
+        continue;
+      }
+      const auto& g = volume.geometry;
+      std::printf("%-10s %-18s | %5.1f %5.1f %5.1f %5.1f (%s)\n", shape.name.c_str(), grid.name,
+                  100 * surface::axis_aligned_share(ours, g, shape.normal),
+                  100 * surface::axis_aligned_share(mc->front().mesh, g),
+                  100 * surface::axis_aligned_share(slicer.front().mesh, g),
+                  100 * surface::axis_aligned_share(ours, g), method.c_str());
     }
   }
   return failures;
@@ -258,6 +301,7 @@ int main(int argc, char** argv) {
   }
   int failures = 0;
   if (what == "phantoms" || what == "all") failures += bench_phantoms();
+  if (what == "shares" || what == "all") failures += bench_shares();
   if (what == "volumes" || what == "all")
     for (const auto& f : files) failures += bench_volume(f, rounds);
   return failures == 0 ? 0 : 1;

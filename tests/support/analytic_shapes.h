@@ -71,6 +71,17 @@ inline AnalyticShape torus_shape(double major, double minor, std::string name = 
           [=](const Vec3& p) { return unit(tube(p)); }, major + minor + 6};
 }
 
+// A round column of radius `r` about z, longer than any grid that samples it:
+// its walls only, cut at the volume's edges as organs are by a CT slab.
+inline AnalyticShape column_shape(double r) {
+  return {"column", [r](const Vec3& p) { return std::hypot(p[0], p[1]) < r; },
+          [r](const Vec3& p) { return std::abs(std::hypot(p[0], p[1]) - r); },
+          [](const Vec3& p) {
+            return unit(Vec3{p[0], p[1], 0});
+          },
+          r + 6};
+}
+
 // A grid of `spacing` voxels whose axes are rotated by `degrees` about
 // (1, 1, 1) (0: axis-aligned), covering the shape, centred at the origin.
 inline volume::LabelVolume sample_shape(const AnalyticShape& shape,
