@@ -61,9 +61,12 @@ inline AnalyticShape ellipsoid_shape(double a, double b, double c) {
 
 // A ring of radius `major` around z with a round cross-section of `minor`.
 inline AnalyticShape torus_shape(double major, double minor, std::string name = "torus") {
+  // From the nearest point of the ring: on the axis every ring point is as
+  // near, so any will do (the axis is never inside).
   const auto tube = [=](const Vec3& p) {
     const double rho = std::hypot(p[0], p[1]);
-    const double scale = rho > 0 ? major / rho : 0;
+    if (rho == 0) return Vec3{-major, 0, p[2]};
+    const double scale = major / rho;
     return Vec3{p[0] - p[0] * scale, p[1] - p[1] * scale, p[2]};
   };
   return {std::move(name), [=](const Vec3& p) { return geometry::norm(tube(p)) < minor; },
