@@ -7,6 +7,7 @@
 #include <unordered_map>
 #include <utility>
 
+#include "core/conforming/widen_small_angles.h"
 #include "core/util/side_by_side.h"
 #include "core/util/vec3.h"
 #include "core/volume/voxel_access.h"
@@ -376,17 +377,6 @@ void restore_volumes(const Net& net, const std::vector<Vec3>& centre, const Vec3
   }
 }
 
-double smallest_angle_cosine_max(const Vec3& a, const Vec3& b, const Vec3& c) {
-  // The largest cosine among the triangle's angles: the smallest angle's.
-  const auto cosine = [](const Vec3& at, const Vec3& p, const Vec3& q) {
-    const Vec3 u = geometry::sub(p, at);
-    const Vec3 w = geometry::sub(q, at);
-    const double lengths = geometry::norm(u) * geometry::norm(w);
-    return lengths > 0 ? geometry::dot(u, w) / lengths : 1.0;
-  };
-  return std::max({cosine(a, b, c), cosine(b, c, a), cosine(c, a, b)});
-}
-
 // On a grid with thicker slices along some axis, a quad is as long as the
 // slice along that axis and as short as the pixel along the others: its
 // triangles would be needles, and so would the tetrahedra on them. Each quad
@@ -487,6 +477,28 @@ InterfaceSurface label_interfaces(const volume::LabelVolume& volume,
   std::vector<Vec3> points = net.centre;
   smooth(stencil, net.centre, half_box, params, points);
   if (params.restore_volumes) restore_volumes(net, net.centre, half_box, points);
+  std::vector<Vec3> before_widening;
+  if (params.widen_angles_below_deg > 0) {
+    before_widening = points;
+    // Junction points stay on their curves, fixed points where they are.
+    std::vector<Slide> slides(points.size());
+    for (size_t p = 0; p < points.size(); ++p) {
+      const uint32_t first = stencil.start[p], last = stencil.start[p + 1];
+      if (first == last) continue;
+      if (net.label_count[p] <= 2) {
+        slides[p].kind = Slide::Kind::kSurface;
+      } else {
+        slides[p].kind = Slide::Kind::kCurve;
+        slides[p].curve = {stencil.neighbours[first], stencil.neighbours[first + 1]};
+      }
+    }
+    // Across the surface by at most half a box of the grid's own voxels.
+    const Vec3 across{0.5 * half * geometry.spacing[0], 0.5 * half * geometry.spacing[1],
+                      0.5 * half * geometry.spacing[2]};
+    const auto widened = widen_small_angles(net.quads, net.quad_sides, slides, net.centre, half_box,
+                                            across, params.widen_angles_below_deg, points);
+    figures.widened_points = widened.points_moved;
+  }
   if (params.subdivide_thick_quads) subdivide_quads(geometry.spacing, net, points, net.centre);
 
   InterfaceSurface surface;
@@ -499,6 +511,8 @@ InterfaceSurface label_interfaces(const volume::LabelVolume& volume,
   for (size_t p = 0; p < points.size(); ++p) {
     surface.points.push_back(to_patient(points[p]));
     surface.staircase.push_back(to_patient(net.centre[p]));
+    if (p < before_widening.size() && before_widening[p] != points[p])
+      surface.widened.push_back({static_cast<uint32_t>(p), to_patient(before_widening[p])});
     figures.max_offset_mm =
         std::max(figures.max_offset_mm,
                  geometry::norm(geometry::sub(surface.points.back(), surface.staircase.back())));
@@ -517,16 +531,12 @@ InterfaceSurface label_interfaces(const volume::LabelVolume& volume,
   surface.padded_first = padded.first;
   for (size_t q = 0; q < net.quads.size(); ++q) {
     const auto& quad = net.quads[q];
-    const auto& x = surface.points;
-    const double split_02 = std::max(smallest_angle_cosine_max(x[quad[0]], x[quad[1]], x[quad[2]]),
-                                     smallest_angle_cosine_max(x[quad[0]], x[quad[2]], x[quad[3]]));
-    const double split_13 = std::max(smallest_angle_cosine_max(x[quad[0]], x[quad[1]], x[quad[3]]),
-                                     smallest_angle_cosine_max(x[quad[1]], x[quad[2]], x[quad[3]]));
     std::array<std::array<uint32_t, 3>, 2> pair =
-        split_02 <= split_13 ? std::array<std::array<uint32_t, 3>, 2>{{{quad[0], quad[1], quad[2]},
-                                                                       {quad[0], quad[2], quad[3]}}}
-                             : std::array<std::array<uint32_t, 3>, 2>{
-                                   {{quad[0], quad[1], quad[3]}, {quad[1], quad[2], quad[3]}}};
+        best_quad_split(quad, surface.points).along_02
+            ? std::array<std::array<uint32_t, 3>, 2>{{{quad[0], quad[1], quad[2]},
+                                                      {quad[0], quad[2], quad[3]}}}
+            : std::array<std::array<uint32_t, 3>, 2>{
+                  {{quad[0], quad[1], quad[3]}, {quad[1], quad[2], quad[3]}}};
     for (auto& triangle : pair) {
       if (mirrored) std::swap(triangle[1], triangle[2]);
       surface.triangles.push_back(triangle);

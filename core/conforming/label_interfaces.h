@@ -39,6 +39,10 @@ struct InterfaceParams {
   // The box along each axis is this many times cube_fraction's (a grid cut
   // into thinner slices may let its points move as far as the thick ones').
   std::array<double, 3> box_scale{1, 1, 1};
+  // After smoothing, slide the points of quads whose triangles have an
+  // angle below this many degrees along the surface, inside their boxes,
+  // where that widens the angle (widen_small_angles.h); 0: leave them.
+  double widen_angles_below_deg = 0;
   // Cut each quad on a grid with thicker slices into near-square ones (for
   // tetrahedra); surfaces keep one quad per voxel face.
   bool subdivide_thick_quads = true;
@@ -54,6 +58,8 @@ struct InterfaceFigures {
   // The farthest any point lies from its staircase position, mm: the surface
   // is within this distance of the voxel boundary (both share triangles).
   double max_offset_mm = 0;
+  // Points slid along the surface to widen small angles.
+  size_t widened_points = 0;
   double seconds = 0;
 };
 

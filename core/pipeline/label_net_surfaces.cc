@@ -12,6 +12,7 @@
 #include "core/conforming/label_interfaces.h"
 #include "core/conforming/net_label_surface.h"
 #include "core/conforming/thick_slices.h"
+#include "core/conforming/widen_small_angles.h"
 #include "core/pipeline/label_surfaces.h"
 #include "core/surface/surface_checks.h"
 #include "core/surface/surface_statistics.h"
@@ -22,6 +23,10 @@
 namespace labelmesh {
 namespace {
 
+// Delivered surfaces have no triangle angle below this where sliding
+// points inside their boxes can widen it (conforming/widen_small_angles.h).
+constexpr double kWidenAnglesBelowDeg = 20;
+
 conforming::InterfaceParams interface_params(const NetOptions& options) {
   conforming::InterfaceParams params;
   params.smoothing_rounds = options.smoothing_rounds;
@@ -30,6 +35,7 @@ conforming::InterfaceParams interface_params(const NetOptions& options) {
   params.cube_fraction = options.cube_fraction;
   params.restore_volumes = options.restore_volumes;
   params.subdivide_thick_quads = false;
+  params.widen_angles_below_deg = kWidenAnglesBelowDeg;
   return params;
 }
 
@@ -112,6 +118,7 @@ absl::StatusOr<LayerNet> layer_net(const volume::LabelVolume& layer,
   if (!with_staircase) return made;
   conforming::InterfaceParams flat = interface_params(options);
   flat.smoothing_rounds = 0;
+  flat.widen_angles_below_deg = 0;
   made.staircase = conforming::label_interfaces(layer, here, flat, figures);
   return made;
 }
@@ -148,7 +155,7 @@ class LighterNets {
     lighter->net = std::move(made->net);
     {
       StageTimer timer(stages, "self_intersections");
-      lighter->crossings = surface::crossing_triangles(lighter->net.points, lighter->net.triangles);
+      lighter->crossings = conforming::crossings_after_taking_back_slides(lighter->net);
     }
     built_[layer] = std::move(lighter);
     return built_[layer].get();
@@ -451,8 +458,7 @@ absl::StatusOr<LabelNets> smoothed_nets(const std::vector<volume::LabelVolume>& 
 void find_net_crossings(LabelNets& built, std::vector<StageTiming>& stages) {
   StageTimer timer(stages, "self_intersections");
   for (size_t layer = 0; layer < built.nets.size(); ++layer)
-    built.crossings[layer] =
-        surface::crossing_triangles(built.nets[layer].points, built.nets[layer].triangles);
+    built.crossings[layer] = conforming::crossings_after_taking_back_slides(built.nets[layer]);
 }
 
 }  // namespace

@@ -1,0 +1,213 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+#include "core/conforming/widen_small_angles.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace labelmesh::conforming {
+namespace {
+
+using geometry::Vec3;
+
+// The largest cosine among the triangle's angles: its smallest angle's.
+double smallest_angle_cosine(const Vec3& a, const Vec3& b, const Vec3& c) {
+  const auto cosine = [](const Vec3& at, const Vec3& p, const Vec3& q) {
+    const Vec3 u = geometry::sub(p, at);
+    const Vec3 w = geometry::sub(q, at);
+    const double lengths = geometry::norm(u) * geometry::norm(w);
+    return lengths > 0 ? geometry::dot(u, w) / lengths : 1.0;
+  };
+  return std::max({cosine(a, b, c), cosine(b, c, a), cosine(c, a, b)});
+}
+
+// The quads around each point, as offsets into one list.
+struct QuadsAround {
+  std::vector<uint32_t> start;
+  std::vector<uint32_t> quads;
+};
+
+QuadsAround quads_around(const std::vector<std::array<uint32_t, 4>>& quads, size_t points) {
+  QuadsAround around;
+  around.start.assign(points + 1, 0);
+  for (const auto& quad : quads)
+    for (const uint32_t p : quad) ++around.start[p + 1];
+  for (size_t p = 0; p < points; ++p) around.start[p + 1] += around.start[p];
+  around.quads.resize(around.start[points]);
+  std::vector<uint32_t> filled(around.start.begin(), around.start.end() - 1);
+  for (uint32_t q = 0; q < quads.size(); ++q)
+    for (const uint32_t p : quads[q]) around.quads[filled[p]++] = q;
+  return around;
+}
+
+}  // namespace
+
+QuadSplit best_quad_split(const std::array<uint32_t, 4>& quad, const std::vector<Vec3>& points) {
+  const Vec3 &a = points[quad[0]], &b = points[quad[1]], &c = points[quad[2]], &d = points[quad[3]];
+  const double split_02 = std::max(smallest_angle_cosine(a, b, c), smallest_angle_cosine(a, c, d));
+  const double split_13 = std::max(smallest_angle_cosine(a, b, d), smallest_angle_cosine(b, c, d));
+  return split_02 <= split_13 ? QuadSplit{split_02, true} : QuadSplit{split_13, false};
+}
+
+WidenedAngles widen_small_angles(const std::vector<std::array<uint32_t, 4>>& quads,
+                                 const std::vector<std::array<int32_t, 2>>& quad_sides,
+                                 const std::vector<Slide>& slides, const std::vector<Vec3>& centre,
+                                 const Vec3& half_box, const Vec3& across, double below_deg,
+                                 std::vector<Vec3>& points) {
+  WidenedAngles result;
+  const double limit = std::cos(below_deg * M_PI / 180);
+  const QuadsAround around = quads_around(quads, points.size());
+  // The worst (largest) smallest-angle cosine among the quads around p.
+  const auto worst_around = [&](uint32_t p) {
+    double worst = -1;
+    for (uint32_t i = around.start[p]; i < around.start[p + 1]; ++i)
+      worst = std::max(worst, best_quad_split(quads[around.quads[i]], points).cosine);
+    return worst;
+  };
+  // Towards the middle of p's neighbours along the quads' edges, within the
+  // surface's tangent plane at p (its quads oriented alike).
+  const auto tangential_move = [&](uint32_t p) {
+    Vec3 normal{0, 0, 0}, middle{0, 0, 0};
+    int neighbours = 0;
+    for (uint32_t i = around.start[p]; i < around.start[p + 1]; ++i) {
+      const uint32_t q = around.quads[i];
+      const auto& c = quads[q];
+      Vec3 n = geometry::cross(geometry::sub(points[c[2]], points[c[0]]),
+                               geometry::sub(points[c[3]], points[c[1]]));
+      if (quad_sides[q][0] > quad_sides[q][1]) n = geometry::scale(n, -1);
+      normal = geometry::add(normal, n);
+      const auto k = std::find(c.begin(), c.end(), p) - c.begin();
+      middle = geometry::add(middle, geometry::add(points[c[(k + 1) % 4]], points[c[(k + 3) % 4]]));
+      neighbours += 2;
+    }
+    if (neighbours == 0) return Vec3{0, 0, 0};
+    Vec3 move = geometry::sub(geometry::scale(middle, 1.0 / neighbours), points[p]);
+    const double length = geometry::norm(normal);
+    if (length == 0) return move;
+    const Vec3 unit = geometry::scale(normal, 1 / length);
+    return geometry::sub(move, geometry::scale(unit, geometry::dot(move, unit)));
+  };
+
+  // Moves p where the smallest angle of its quads grows most: along the
+  // surface first; across it (along a voxel axis, the shape changing inside
+  // the box) where that is not enough. Whether it moved.
+  const auto widen_at = [&](uint32_t p) {
+    const double before = worst_around(p);
+    if (before <= limit) return false;
+    const Vec3 from = points[p];
+    std::vector<Vec3> along;
+    if (slides[p].kind == Slide::Kind::kSurface) {
+      const Vec3 move = tangential_move(p);
+      along = {move, geometry::scale(move, 0.5), geometry::scale(move, 0.25)};
+    } else {
+      const Vec3 curve = geometry::sub(points[slides[p].curve[1]], points[slides[p].curve[0]]);
+      for (const double fraction : {0.25, 0.125, -0.125, -0.25})
+        along.push_back(geometry::scale(curve, fraction));
+    }
+    std::vector<Vec3> across_moves;
+    for (int k = 0; k < 3; ++k)
+      for (const double sign : {-1.0, 1.0}) {
+        Vec3 move{0, 0, 0};
+        move[k] = sign * across[k];
+        across_moves.push_back(move);
+      }
+    double best = before;
+    Vec3 best_place = from;
+    const auto try_moves = [&](const std::vector<Vec3>& moves) {
+      for (const Vec3& move : moves) {
+        for (int k = 0; k < 3; ++k)
+          points[p][k] =
+              std::clamp(from[k] + move[k], centre[p][k] - half_box[k], centre[p][k] + half_box[k]);
+        const double worst = worst_around(p);
+        if (worst < best) {
+          best = worst;
+          best_place = points[p];
+        }
+      }
+    };
+    try_moves(along);
+    if (best > limit) try_moves(across_moves);
+    points[p] = best_place;
+    return points[p] != from;
+  };
+
+  // The slidable points of the quads below the limit among `quads_of`.
+  const auto points_of_thin_quads = [&](const auto& quads_of) {
+    std::vector<uint32_t> found;
+    quads_of([&](uint32_t q) {
+      if (best_quad_split(quads[q], points).cosine <= limit) return;
+      for (const uint32_t p : quads[q])
+        if (slides[p].kind != Slide::Kind::kFixed) found.push_back(p);
+    });
+    std::sort(found.begin(), found.end());
+    found.erase(std::unique(found.begin(), found.end()), found.end());
+    return found;
+  };
+  std::vector<uint32_t> candidates = points_of_thin_quads([&](const auto& visit) {
+    for (uint32_t q = 0; q < quads.size(); ++q) visit(q);
+  });
+  std::vector<bool> moved(points.size(), false);
+  // A few passes: a point that moves changes its neighbours' quads too.
+  constexpr int kPasses = 3;
+  for (int pass = 0; pass < kPasses && !candidates.empty(); ++pass) {
+    std::vector<uint32_t> moved_now;
+    for (const uint32_t p : candidates)
+      if (widen_at(p)) moved_now.push_back(p);
+    for (const uint32_t p : moved_now) moved[p] = true;
+    candidates = points_of_thin_quads([&](const auto& visit) {
+      for (const uint32_t p : moved_now)
+        for (uint32_t i = around.start[p]; i < around.start[p + 1]; ++i) visit(around.quads[i]);
+    });
+  }
+  result.points_moved = static_cast<size_t>(std::count(moved.begin(), moved.end(), true));
+  return result;
+}
+
+std::vector<uint32_t> take_back_crossing_slides(InterfaceSurface& surface,
+                                                const surface::TrianglePairs& crossing) {
+  std::vector<uint32_t> taken_back;
+  if (surface.widened.empty() || crossing.empty()) return taken_back;
+  std::vector<bool> in_crossing(surface.points.size(), false);
+  for (const auto& [s, t] : crossing)
+    for (const uint32_t triangle : {s, t})
+      for (const uint32_t p : surface.triangles[triangle]) in_crossing[p] = true;
+  auto& widened = surface.widened;
+  for (const auto& [point, before] : widened) {
+    if (!in_crossing[point]) continue;
+    surface.points[point] = before;
+    taken_back.push_back(point);
+  }
+  widened.erase(std::remove_if(widened.begin(), widened.end(),
+                               [&](const auto& slid) { return in_crossing[slid.first]; }),
+                widened.end());
+  return taken_back;
+}
+
+surface::TrianglePairs crossings_after_taking_back_slides(InterfaceSurface& surface) {
+  auto pairs = surface::crossing_triangles(surface.points, surface.triangles);
+  constexpr int kRounds = 3;
+  for (int round = 0; round < kRounds; ++round) {
+    const auto taken_back = take_back_crossing_slides(surface, pairs);
+    if (taken_back.empty()) break;
+    // Only pairs with a triangle around a point taken back can change.
+    std::vector<bool> moved(surface.points.size(), false);
+    for (const uint32_t p : taken_back) moved[p] = true;
+    std::vector<bool> near(surface.triangles.size(), false);
+    std::vector<uint32_t> among;
+    for (uint32_t t = 0; t < surface.triangles.size(); ++t) {
+      const auto& triangle = surface.triangles[t];
+      if (!moved[triangle[0]] && !moved[triangle[1]] && !moved[triangle[2]]) continue;
+      near[t] = true;
+      among.push_back(t);
+    }
+    pairs.erase(
+        std::remove_if(pairs.begin(), pairs.end(),
+                       [&](const auto& pair) { return near[pair.first] || near[pair.second]; }),
+        pairs.end());
+    const auto found = surface::crossing_triangles_near(surface.points, surface.triangles, among);
+    pairs.insert(pairs.end(), found.begin(), found.end());
+    std::sort(pairs.begin(), pairs.end());
+  }
+  return pairs;
+}
+
+}  // namespace labelmesh::conforming

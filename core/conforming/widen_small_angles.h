@@ -1,0 +1,67 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// Smoothing a surface net inside the voxels' boxes leaves a few thin
+// triangles: two points pressed into facing corners of their boxes, or three
+// nearly in a line. Each point of such a quad slides along the surface (in
+// its tangent plane) towards the middle of its neighbours, still inside its
+// box, when that widens the smallest angle around it. The surface keeps its
+// shape to first order and every voxel centre stays on its side.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "core/conforming/interface_surface.h"
+#include "core/surface/crossing_triangles.h"
+#include "core/util/vec3.h"
+
+namespace labelmesh::conforming {
+
+// The cosine of the smallest angle of quad (a, b, c, d) split along the
+// diagonal that gives the larger smallest angle, and that diagonal.
+struct QuadSplit {
+  double cosine = 1;
+  bool along_02 = true;  // triangles (0, 1, 2), (0, 2, 3); else (0, 1, 3), (1, 2, 3)
+};
+QuadSplit best_quad_split(const std::array<uint32_t, 4>& quad,
+                          const std::vector<geometry::Vec3>& points);
+
+// How a point may slide: not at all; within the surface's tangent plane
+// (a point between two labels); or along the line through its two
+// neighbours on a junction curve where three or more labels meet.
+struct Slide {
+  enum class Kind : uint8_t { kFixed, kSurface, kCurve };
+  Kind kind = Kind::kFixed;
+  std::array<uint32_t, 2> curve{0, 0};  // kCurve: the neighbours on the curve
+};
+
+struct WidenedAngles {
+  size_t points_moved = 0;
+};
+
+// Moves the points of quads whose best split has an angle below
+// `below_deg`, each within `half_box` of its `centre` along every axis:
+// along the surface first, and where that is not enough, by up to `across`
+// along a voxel axis. `quad_sides` orient the quads (a quad's normal points
+// from its lower side label to its higher one, as for every quad between
+// the same two labels). A point moves only when the smallest angle of its
+// quads grows, so the smallest angle over all quads never shrinks.
+WidenedAngles widen_small_angles(const std::vector<std::array<uint32_t, 4>>& quads,
+                                 const std::vector<std::array<int32_t, 2>>& quad_sides,
+                                 const std::vector<Slide>& slides,
+                                 const std::vector<geometry::Vec3>& centre,
+                                 const geometry::Vec3& half_box, const geometry::Vec3& across,
+                                 double below_deg, std::vector<geometry::Vec3>& points);
+
+// Puts the slid points of the `crossing` triangle pairs back where smoothing
+// left them (the surface's `widened` list); returns those points.
+std::vector<uint32_t> take_back_crossing_slides(InterfaceSurface& surface,
+                                                const surface::TrianglePairs& crossing);
+
+// The crossing triangle pairs of `surface` (surface/crossing_triangles.h)
+// once every slide in a crossing pair is taken back: the pairs around the
+// points taken back are found again, a few times at most.
+surface::TrianglePairs crossings_after_taking_back_slides(InterfaceSurface& surface);
+
+}  // namespace labelmesh::conforming

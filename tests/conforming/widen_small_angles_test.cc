@@ -1,0 +1,100 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+#include "core/conforming/widen_small_angles.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace labelmesh::conforming {
+namespace {
+
+using geometry::Vec3;
+
+// A flat 4 x 4 grid of points one unit apart (3 x 3 quads between label 1
+// and the outside), each in a box of 0.475 around its centre; the border
+// points are fixed.
+struct FlatNet {
+  std::vector<std::array<uint32_t, 4>> quads;
+  std::vector<std::array<int32_t, 2>> sides;
+  std::vector<Vec3> centre;
+  std::vector<Slide> slides;
+  std::vector<Vec3> points;
+};
+
+FlatNet flat_net() {
+  FlatNet net;
+  for (int y = 0; y < 4; ++y)
+    for (int x = 0; x < 4; ++x) {
+      net.centre.push_back({double(x), double(y), 0});
+      Slide slide;
+      if (x > 0 && x < 3 && y > 0 && y < 3) slide.kind = Slide::Kind::kSurface;
+      net.slides.push_back(slide);
+    }
+  for (uint32_t y = 0; y < 3; ++y)
+    for (uint32_t x = 0; x < 3; ++x) {
+      const uint32_t p = 4 * y + x;
+      net.quads.push_back({p, p + 1, p + 5, p + 4});
+      net.sides.push_back({0, 1});
+    }
+  net.points = net.centre;
+  return net;
+}
+
+double smallest_angle_deg(const FlatNet& net) {
+  double worst = -1;
+  for (const auto& quad : net.quads)
+    worst = std::max(worst, best_quad_split(quad, net.points).cosine);
+  return std::acos(worst) * 180 / M_PI;
+}
+
+TEST(WidenSmallAngles, TwoPointsPressedTogetherSlideApartAlongTheSurface) {
+  FlatNet net = flat_net();
+  // Points (1, 1) and (2, 1) pressed into the facing sides of their boxes.
+  net.points[5][0] += 0.45;
+  net.points[6][0] -= 0.45;
+  const double before = smallest_angle_deg(net);
+  ASSERT_LT(before, 10);
+  const Vec3 half_box{0.475, 0.475, 0.475};
+  const auto widened = widen_small_angles(net.quads, net.sides, net.slides, net.centre, half_box,
+                                          {0.2, 0.2, 0.2}, 20, net.points);
+  EXPECT_GE(widened.points_moved, 1u);
+  EXPECT_GE(smallest_angle_deg(net), 20);
+  for (size_t p = 0; p < net.points.size(); ++p) {
+    // Along a flat surface: it stays flat, each point in its box, the
+    // fixed ones where they were.
+    EXPECT_EQ(net.points[p][2], 0) << p;
+    for (int k = 0; k < 2; ++k) EXPECT_LE(std::abs(net.points[p][k] - net.centre[p][k]), 0.475);
+    if (net.slides[p].kind == Slide::Kind::kFixed) {
+      EXPECT_EQ(net.points[p], net.centre[p]);
+    }
+  }
+}
+
+TEST(WidenSmallAngles, WideAnglesAreLeftAlone) {
+  FlatNet net = flat_net();
+  net.points[5][0] += 0.2;
+  const auto moved_before = net.points;
+  const auto widened = widen_small_angles(net.quads, net.sides, net.slides, net.centre,
+                                          {0.475, 0.475, 0.475}, {0.2, 0.2, 0.2}, 20, net.points);
+  EXPECT_EQ(widened.points_moved, 0u);
+  EXPECT_EQ(net.points, moved_before);
+}
+
+TEST(WidenSmallAngles, SlidesInCrossingTrianglesAreTakenBack) {
+  InterfaceSurface surface;
+  surface.points = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {5, 5, 5}, {6, 5, 5}, {5, 6, 5}};
+  surface.triangles = {{0, 1, 2}, {3, 4, 5}};
+  surface.widened = {{1, {0.9, 0, 0}}, {4, {6.1, 5, 5}}};
+  // A pair that holds no slid point takes nothing back.
+  EXPECT_TRUE(take_back_crossing_slides(surface, {}).empty());
+  EXPECT_EQ(take_back_crossing_slides(surface, {{0, 0}}), std::vector<uint32_t>{1});
+  EXPECT_EQ(surface.points[1], (Vec3{0.9, 0, 0}));
+  EXPECT_EQ(surface.points[4], (Vec3{6, 5, 5}));
+  ASSERT_EQ(surface.widened.size(), 1u);
+  EXPECT_EQ(surface.widened[0].first, 4u);
+  EXPECT_TRUE(take_back_crossing_slides(surface, {{0, 0}}).empty());
+}
+
+}  // namespace
+}  // namespace labelmesh::conforming
