@@ -29,9 +29,9 @@ struct InterfaceSurface {
   // the box holds the selected labels and one voxel more all round.
   std::array<int64_t, 3> padded_dims{0, 0, 0};
   std::array<int64_t, 3> padded_first{-1, -1, -1};
-  // The points slid along the surface to widen small angles, each with the
-  // place smoothing left it (LPS mm): a slide that makes triangles cross is
-  // taken back (widen_small_angles.h).
+  // The points moved to widen small angles, each with the place smoothing
+  // left it (LPS mm): a move that makes triangles cross is taken back
+  // (widen_small_angles.h).
   std::vector<std::pair<uint32_t, std::array<double, 3>>> widened;
 };
 

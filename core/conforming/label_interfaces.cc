@@ -478,7 +478,9 @@ InterfaceSurface label_interfaces(const volume::LabelVolume& volume,
   smooth(stencil, net.centre, half_box, params, points);
   if (params.restore_volumes) restore_volumes(net, net.centre, half_box, points);
   std::vector<Vec3> before_widening;
-  if (params.widen_angles_below_deg > 0) {
+  // Widened nets keep two triangles per quad (the take-back splits quads
+  // again), so a net cut into smaller quads is not widened.
+  if (params.widen_angles_below_deg > 0 && !params.subdivide_thick_quads) {
     before_widening = points;
     // Junction points stay on their curves, fixed points where they are.
     std::vector<Slide> slides(points.size());
@@ -492,7 +494,7 @@ InterfaceSurface label_interfaces(const volume::LabelVolume& volume,
         slides[p].curve = {stencil.neighbours[first], stencil.neighbours[first + 1]};
       }
     }
-    // Across the surface by at most half a box of the grid's own voxels.
+    // Across the surface by a quarter of the grid's own voxel.
     const Vec3 across{0.5 * half * geometry.spacing[0], 0.5 * half * geometry.spacing[1],
                       0.5 * half * geometry.spacing[2]};
     const auto widened = widen_small_angles(net.quads, net.quad_sides, slides, net.centre, half_box,
@@ -551,7 +553,15 @@ InterfaceSurface label_interfaces(const volume::LabelVolume& volume,
 }
 
 void restore_staircase(InterfaceSurface& surface, const std::vector<uint32_t>& points) {
-  for (uint32_t p : points) surface.points[p] = surface.staircase[p];
+  std::vector<bool> restored(surface.points.size(), false);
+  for (uint32_t p : points) {
+    surface.points[p] = surface.staircase[p];
+    restored[p] = true;
+  }
+  auto& widened = surface.widened;
+  widened.erase(std::remove_if(widened.begin(), widened.end(),
+                               [&](const auto& slid) { return restored[slid.first]; }),
+                widened.end());
 }
 
 }  // namespace labelmesh::conforming

@@ -39,9 +39,9 @@ struct InterfaceParams {
   // The box along each axis is this many times cube_fraction's (a grid cut
   // into thinner slices may let its points move as far as the thick ones').
   std::array<double, 3> box_scale{1, 1, 1};
-  // After smoothing, slide the points of quads whose triangles have an
-  // angle below this many degrees along the surface, inside their boxes,
-  // where that widens the angle (widen_small_angles.h); 0: leave them.
+  // After smoothing, move the points of quads whose triangles have an angle
+  // below this many degrees inside their boxes where that widens the angle
+  // (widen_small_angles.h); 0: leave them. Not with subdivide_thick_quads.
   double widen_angles_below_deg = 0;
   // Cut each quad on a grid with thicker slices into near-square ones (for
   // tetrahedra); surfaces keep one quad per voxel face.

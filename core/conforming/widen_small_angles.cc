@@ -39,6 +39,33 @@ QuadsAround quads_around(const std::vector<std::array<uint32_t, 4>>& quads, size
   return around;
 }
 
+// Splits the quad of triangles t and t + 1 (sharing an edge) along the
+// diagonal that gives the larger smallest angle, keeping their winding.
+void resplit_quad(InterfaceSurface& surface, uint32_t t) {
+  auto& first = surface.triangles[t];
+  auto& second = surface.triangles[t + 1];
+  // first runs u -> v along the shared edge, x its third corner; second
+  // runs v -> u, y its third: the quad is u, y, v, x in order.
+  const auto in_second = [&](uint32_t corner) {
+    return std::find(second.begin(), second.end(), corner) != second.end();
+  };
+  int k = 0;
+  while (k < 3 && !(in_second(first[k]) && in_second(first[(k + 1) % 3]))) ++k;
+  if (k == 3) return;
+  const uint32_t u = first[k], v = first[(k + 1) % 3], x = first[(k + 2) % 3];
+  uint32_t y = second[0];
+  for (const uint32_t corner : second)
+    if (corner != u && corner != v) y = corner;
+  const auto& at = surface.points;
+  const double now = std::max(smallest_angle_cosine(at[u], at[v], at[x]),
+                              smallest_angle_cosine(at[v], at[u], at[y]));
+  const double other = std::max(smallest_angle_cosine(at[u], at[y], at[x]),
+                                smallest_angle_cosine(at[y], at[v], at[x]));
+  if (other >= now) return;
+  first = {u, y, x};
+  second = {y, v, x};
+}
+
 }  // namespace
 
 QuadSplit best_quad_split(const std::array<uint32_t, 4>& quad, const std::vector<Vec3>& points) {
@@ -81,6 +108,8 @@ WidenedAngles widen_small_angles(const std::vector<std::array<uint32_t, 4>>& qua
     }
     if (neighbours == 0) return Vec3{0, 0, 0};
     Vec3 move = geometry::sub(geometry::scale(middle, 1.0 / neighbours), points[p]);
+    // Where the quads' normals cancel (two sheets meeting at the point)
+    // there is no tangent plane: the move stays in the box all the same.
     const double length = geometry::norm(normal);
     if (length == 0) return move;
     const Vec3 unit = geometry::scale(normal, 1 / length);
@@ -164,41 +193,45 @@ WidenedAngles widen_small_angles(const std::vector<std::array<uint32_t, 4>>& qua
 
 std::vector<uint32_t> take_back_crossing_slides(InterfaceSurface& surface,
                                                 const surface::TrianglePairs& crossing) {
-  std::vector<uint32_t> taken_back;
-  if (surface.widened.empty() || crossing.empty()) return taken_back;
+  std::vector<uint32_t> resplit;
+  if (surface.widened.empty() || crossing.empty()) return resplit;
   std::vector<bool> in_crossing(surface.points.size(), false);
   for (const auto& [s, t] : crossing)
     for (const uint32_t triangle : {s, t})
       for (const uint32_t p : surface.triangles[triangle]) in_crossing[p] = true;
   auto& widened = surface.widened;
+  std::vector<bool> taken_back(surface.points.size(), false);
   for (const auto& [point, before] : widened) {
     if (!in_crossing[point]) continue;
     surface.points[point] = before;
-    taken_back.push_back(point);
+    taken_back[point] = true;
   }
   widened.erase(std::remove_if(widened.begin(), widened.end(),
-                               [&](const auto& slid) { return in_crossing[slid.first]; }),
+                               [&](const auto& slid) { return taken_back[slid.first]; }),
                 widened.end());
-  return taken_back;
+  for (uint32_t t = 0; t < surface.triangles.size(); t += 2) {
+    const auto& a = surface.triangles[t];
+    const auto& b = surface.triangles[t + 1];
+    const auto touched = [&](const std::array<uint32_t, 3>& triangle) {
+      return taken_back[triangle[0]] || taken_back[triangle[1]] || taken_back[triangle[2]];
+    };
+    if (!touched(a) && !touched(b)) continue;
+    resplit_quad(surface, t);
+    resplit.push_back(t);
+    resplit.push_back(t + 1);
+  }
+  return resplit;
 }
 
 surface::TrianglePairs crossings_after_taking_back_slides(InterfaceSurface& surface) {
   auto pairs = surface::crossing_triangles(surface.points, surface.triangles);
-  constexpr int kRounds = 3;
-  for (int round = 0; round < kRounds; ++round) {
-    const auto taken_back = take_back_crossing_slides(surface, pairs);
-    if (taken_back.empty()) break;
-    // Only pairs with a triangle around a point taken back can change.
-    std::vector<bool> moved(surface.points.size(), false);
-    for (const uint32_t p : taken_back) moved[p] = true;
+  // Each round takes back at least one slide, so the rounds end.
+  for (;;) {
+    const auto among = take_back_crossing_slides(surface, pairs);
+    if (among.empty()) break;
+    // Only pairs with a triangle of a quad taken back can change.
     std::vector<bool> near(surface.triangles.size(), false);
-    std::vector<uint32_t> among;
-    for (uint32_t t = 0; t < surface.triangles.size(); ++t) {
-      const auto& triangle = surface.triangles[t];
-      if (!moved[triangle[0]] && !moved[triangle[1]] && !moved[triangle[2]]) continue;
-      near[t] = true;
-      among.push_back(t);
-    }
+    for (const uint32_t t : among) near[t] = true;
     pairs.erase(
         std::remove_if(pairs.begin(), pairs.end(),
                        [&](const auto& pair) { return near[pair.first] || near[pair.second]; }),

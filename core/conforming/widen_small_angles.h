@@ -1,10 +1,11 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 // Smoothing a surface net inside the voxels' boxes leaves a few thin
 // triangles: two points pressed into facing corners of their boxes, or three
-// nearly in a line. Each point of such a quad slides along the surface (in
-// its tangent plane) towards the middle of its neighbours, still inside its
-// box, when that widens the smallest angle around it. The surface keeps its
-// shape to first order and every voxel centre stays on its side.
+// nearly in a line. Each point of such a quad slides towards the middle of
+// its neighbours in the surface's tangent plane (which keeps the shape to
+// first order), or where that is not enough moves a little along a voxel
+// axis (which changes it), whichever widens the smallest angle around it
+// most. It never leaves its box, so every voxel centre stays on its side.
 #pragma once
 
 #include <array>
@@ -28,25 +29,27 @@ QuadSplit best_quad_split(const std::array<uint32_t, 4>& quad,
                           const std::vector<geometry::Vec3>& points);
 
 // How a point may slide: not at all; within the surface's tangent plane
-// (a point between two labels); or along the line through its two
-// neighbours on a junction curve where three or more labels meet.
+// (a point between two labels); or, on a junction curve where three or more
+// labels meet, parallel to the line through its two neighbours there.
 struct Slide {
   enum class Kind : uint8_t { kFixed, kSurface, kCurve };
   Kind kind = Kind::kFixed;
   std::array<uint32_t, 2> curve{0, 0};  // kCurve: the neighbours on the curve
 };
 
+// What the widening did.
 struct WidenedAngles {
   size_t points_moved = 0;
 };
 
 // Moves the points of quads whose best split has an angle below
 // `below_deg`, each within `half_box` of its `centre` along every axis:
-// along the surface first, and where that is not enough, by up to `across`
-// along a voxel axis. `quad_sides` orient the quads (a quad's normal points
-// from its lower side label to its higher one, as for every quad between
-// the same two labels). A point moves only when the smallest angle of its
-// quads grows, so the smallest angle over all quads never shrinks.
+// along the surface first, and where that is not enough, by `across` along
+// a voxel axis. Positions, boxes and moves are in mm along the voxel axes.
+// `quad_sides` orient the quads (a quad's normal points from its lower side
+// label to its higher one, as for every quad between the same two labels).
+// A point moves only when the smallest angle of its quads grows, so the
+// smallest angle over all quads never shrinks.
 WidenedAngles widen_small_angles(const std::vector<std::array<uint32_t, 4>>& quads,
                                  const std::vector<std::array<int32_t, 2>>& quad_sides,
                                  const std::vector<Slide>& slides,
@@ -55,13 +58,15 @@ WidenedAngles widen_small_angles(const std::vector<std::array<uint32_t, 4>>& qua
                                  double below_deg, std::vector<geometry::Vec3>& points);
 
 // Puts the slid points of the `crossing` triangle pairs back where smoothing
-// left them (the surface's `widened` list); returns those points.
+// left them (the surface's `widened` list), and splits each of their quads
+// (triangles 2q and 2q + 1) again along the diagonal that gives the larger
+// smallest angle; returns the triangles of those quads.
 std::vector<uint32_t> take_back_crossing_slides(InterfaceSurface& surface,
                                                 const surface::TrianglePairs& crossing);
 
 // The crossing triangle pairs of `surface` (surface/crossing_triangles.h)
-// once every slide in a crossing pair is taken back: the pairs around the
-// points taken back are found again, a few times at most.
+// once no slid point is left in a crossing pair: the pairs around the quads
+// taken back are found again until none holds a slid point.
 surface::TrianglePairs crossings_after_taking_back_slides(InterfaceSurface& surface);
 
 }  // namespace labelmesh::conforming

@@ -235,12 +235,8 @@ std::vector<Vec3> index_points(const TriangleMesh& mesh, const volume::ImageGeom
   return at;
 }
 
-}  // namespace
-
-namespace {
-
 // The axis-aligned share with each triangle's normal from `facing`, given the
-// triangle's LPS corners and its centroid.
+// triangle's LPS corners.
 template <typename Facing>
 double share_facing_axes(const TriangleMesh& mesh, const volume::ImageGeometry& geometry,
                          const Facing& facing) {
@@ -265,6 +261,7 @@ double share_facing_axes(const TriangleMesh& mesh, const volume::ImageGeometry& 
     total += twice_area;
     const Vec3 normal = facing(a, b, c);
     const double length = geometry::norm(normal);
+    if (length == 0) continue;
     for (const auto& axis : axes) {
       if (std::abs(geometry::dot(normal, axis)) >= cosine * length) {
         aligned += twice_area;

@@ -11,8 +11,10 @@
 
 #include "core/conforming/label_interfaces.h"
 #include "core/conforming/net_label_surface.h"
+#include "core/conforming/widen_small_angles.h"
 #include "core/pipeline/label_net_surfaces.h"
 #include "core/pipeline/pipeline.h"
+#include "core/surface/crossing_triangles.h"
 #include "core/surface/surface_checks.h"
 #include "core/surface/surface_statistics.h"
 #include "core/surface/voxel_fidelity.h"
@@ -367,6 +369,34 @@ TEST(NetSurfacesRealData, MrLabelsAreFaithfulSmoothOrWarned) {
 // The whole-brain segmentation's 40 labels touch one another in every way
 // voxels can (along edges, at corners, around tunnels): each label's cut is
 // still a closed 2-manifold.
+// Moves that widen thin triangles and make triangles cross are taken back:
+// the pairs left are those a full search finds, and none holds a moved
+// point (the MRIcrop's net has such moves).
+TEST(NetSurfacesRealData, CrossingMovesAreTakenBack) {
+  LABELMESH_SKIP_WITHOUT_SHARED_DATA();
+  const auto path = testing::shared_data("MRIcrop-seg_converted.nii.gz");
+  if (!std::filesystem::exists(path)) GTEST_SKIP() << "missing " << path;
+  const auto volume = volume::read_label_volume(path, {}, {});
+  ASSERT_THAT(volume, testing::IsOk());
+  std::vector<int32_t> labels;
+  for (const auto& label : volume::compute_label_statistics(*volume).labels)
+    labels.push_back(label.label);
+  conforming::InterfaceFigures figures;
+  auto net =
+      conforming::label_interfaces(*volume, labels, net_interface_params(NetOptions{}), figures);
+  const size_t moved = net.widened.size();
+  EXPECT_EQ(moved, figures.widened_points);
+  ASSERT_GT(moved, 100u);
+  const auto pairs = conforming::crossings_after_taking_back_slides(net);
+  EXPECT_LT(net.widened.size(), moved);
+  EXPECT_EQ(pairs, surface::crossing_triangles(net.points, net.triangles));
+  std::vector<bool> still_moved(net.points.size(), false);
+  for (const auto& [point, before] : net.widened) still_moved[point] = true;
+  for (const auto& [s, t] : pairs)
+    for (const uint32_t triangle : {s, t})
+      for (const uint32_t p : net.triangles[triangle]) EXPECT_FALSE(still_moved[p]) << p;
+}
+
 TEST(NetSurfacesRealData, EveryBrainLabelIsAClosedManifold) {
   LABELMESH_SKIP_WITHOUT_SHARED_DATA();
   const auto path = testing::shared_data("iso2mesh_brain_seg_converted.nii.gz");
