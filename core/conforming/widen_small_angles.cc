@@ -209,7 +209,7 @@ std::vector<uint32_t> take_back_crossing_slides(InterfaceSurface& surface,
   widened.erase(std::remove_if(widened.begin(), widened.end(),
                                [&](const auto& slid) { return taken_back[slid.first]; }),
                 widened.end());
-  for (uint32_t t = 0; t < surface.triangles.size(); t += 2) {
+  for (uint32_t t = 0; t + 1 < surface.triangles.size(); t += 2) {
     const auto& a = surface.triangles[t];
     const auto& b = surface.triangles[t + 1];
     const auto touched = [&](const std::array<uint32_t, 3>& triangle) {
