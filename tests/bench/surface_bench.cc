@@ -16,6 +16,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -81,12 +82,36 @@ surface::TriangleMesh our_surface(const volume::LabelVolume& volume, std::string
   return {};
 }
 
+// A grid the phantoms are sampled on; `degrees` turns its axes about (1, 1, 1).
+struct Grid {
+  const char* name;
+  std::array<double, 3> spacing;
+  double degrees;
+};
+
+// Label 1 of a phantom by Marching Cubes, the Slicer-like pipeline and ours.
+struct PhantomSurfaces {
+  volume::LabelVolume volume;
+  surface::TriangleMesh marching_cubes;
+  surface::TriangleMesh slicer;
+  surface::TriangleMesh ours;
+  std::string method;  // the stage ours was delivered by
+};
+
+std::optional<PhantomSurfaces> phantom_surfaces(const AnalyticShape& shape, const Grid& grid) {
+  PhantomSurfaces made;
+  made.volume = testing::sample_shape(shape, grid.spacing, grid.degrees);
+  const auto statistics = volume::compute_label_statistics(made.volume);
+  auto mc = surface::extract_surfaces(made.volume, statistics, {1}, RunContext{});
+  auto slicer = testing::slicer_like_surfaces(made.volume, statistics, {1});
+  made.ours = our_surface(made.volume, made.method);
+  if (!mc.ok() || mc->empty() || slicer.empty() || made.ours.triangles.empty()) return std::nullopt;
+  made.marching_cubes = std::move(mc->front().mesh);
+  made.slicer = std::move(slicer.front().mesh);
+  return made;
+}
+
 int bench_phantoms() {
-  struct Grid {
-    const char* name;
-    std::array<double, 3> spacing;
-    double degrees;
-  };
   const std::vector<Grid> grids{{"3 mm", {3, 3, 3}, 0},
                                 {"1x1x3 mm", {1, 1, 3}, 0},
                                 {"0.6x0.6x4 mm", {0.6, 0.6, 4}, 0},
@@ -100,13 +125,8 @@ int bench_phantoms() {
   for (const auto& grid : grids) {
     const double smallest = *std::min_element(grid.spacing.begin(), grid.spacing.end());
     for (const auto& shape : shapes) {
-      const auto volume = testing::sample_shape(shape, grid.spacing, grid.degrees);
-      const auto statistics = volume::compute_label_statistics(volume);
-      auto mc = surface::extract_surfaces(volume, statistics, {1}, RunContext{});
-      const auto slicer = testing::slicer_like_surfaces(volume, statistics, {1});
-      std::string method;
-      const auto ours = our_surface(volume, method);
-      if (!mc.ok() || slicer.empty() || ours.triangles.empty()) {
+      const auto made = phantom_surfaces(shape, grid);
+      if (!made) {
         ++failures;
         continue;
       }
@@ -114,19 +134,19 @@ int bench_phantoms() {
       if (const char* out = std::getenv("LABELMESH_BENCH_OUT")) {
         std::string stem = std::string(out) + "/" + shape.name + "-" + grid.name;
         std::replace(stem.begin() + static_cast<long>(std::strlen(out)), stem.end(), ' ', '_');
-        (void)surface::write_surface(mc->front().mesh, stem + "-mc.stl",
+        (void)surface::write_surface(made->marching_cubes, stem + "-mc.stl",
                                      surface::SurfaceFormat::kStl);
-        (void)surface::write_surface(slicer.front().mesh, stem + "-slicer.stl",
+        (void)surface::write_surface(made->slicer, stem + "-slicer.stl",
                                      surface::SurfaceFormat::kStl);
-        (void)surface::write_surface(ours, stem + "-ours.stl", surface::SurfaceFormat::kStl);
+        (void)surface::write_surface(made->ours, stem + "-ours.stl", surface::SurfaceFormat::kStl);
       }
-      const auto e_mc = testing::shape_error(mc->front().mesh, shape);
-      const auto e_slicer = testing::shape_error(slicer.front().mesh, shape);
-      const auto e_ours = testing::shape_error(ours, shape);
+      const auto e_mc = testing::shape_error(made->marching_cubes, shape);
+      const auto e_slicer = testing::shape_error(made->slicer, shape);
+      const auto e_ours = testing::shape_error(made->ours, shape);
       std::printf("%-10s %-18s | %8.3f / %8.1f   | %8.3f / %8.1f   | %8.3f / %8.1f   | %.2f %s\n",
                   shape.name.c_str(), grid.name, e_mc.rms_mm, e_mc.normal_p95_deg, e_slicer.rms_mm,
                   e_slicer.normal_p95_deg, e_ours.rms_mm, e_ours.normal_p95_deg,
-                  e_ours.rms_mm / smallest, method.c_str());
+                  e_ours.rms_mm / smallest, made->method.c_str());
     }
   }
   return failures;
@@ -135,11 +155,6 @@ int bench_phantoms() {
 // The axis-aligned share of each surface beside the true shape's (the true
 // normals at our triangles' centres): what a perfect surface would score.
 int bench_shares() {
-  struct Grid {
-    const char* name;
-    std::array<double, 3> spacing;
-    double degrees;
-  };
   const std::vector<Grid> grids{{"3 mm", {3, 3, 3}, 0},
                                 {"0.98x0.98x2 mm", {0.976562, 0.976562, 2}, 0},
                                 {"1x1x3 mm", {1, 1, 3}, 0},
@@ -153,22 +168,17 @@ int bench_shares() {
   int failures = 0;
   for (const auto& grid : grids) {
     for (const auto& shape : shapes) {
-      const auto volume = testing::sample_shape(shape, grid.spacing, grid.degrees);
-      const auto statistics = volume::compute_label_statistics(volume);
-      auto mc = surface::extract_surfaces(volume, statistics, {1}, RunContext{});
-      const auto slicer = testing::slicer_like_surfaces(volume, statistics, {1});
-      std::string method;
-      const auto ours = our_surface(volume, method);
-      if (!mc.ok() || slicer.empty() || ours.triangles.empty()) {
+      const auto made = phantom_surfaces(shape, grid);
+      if (!made) {
         ++failures;
         continue;
       }
-      const auto& g = volume.geometry;
+      const auto& g = made->volume.geometry;
       std::printf("%-10s %-18s | %5.1f %5.1f %5.1f %5.1f (%s)\n", shape.name.c_str(), grid.name,
-                  100 * surface::axis_aligned_share(ours, g, shape.normal),
-                  100 * surface::axis_aligned_share(mc->front().mesh, g),
-                  100 * surface::axis_aligned_share(slicer.front().mesh, g),
-                  100 * surface::axis_aligned_share(ours, g), method.c_str());
+                  100 * surface::axis_aligned_share(made->ours, g, shape.normal),
+                  100 * surface::axis_aligned_share(made->marching_cubes, g),
+                  100 * surface::axis_aligned_share(made->slicer, g),
+                  100 * surface::axis_aligned_share(made->ours, g), made->method.c_str());
     }
   }
   return failures;
