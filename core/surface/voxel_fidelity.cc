@@ -235,8 +235,8 @@ std::vector<Vec3> index_points(const TriangleMesh& mesh, const volume::ImageGeom
   return at;
 }
 
-// The axis-aligned share with each triangle's normal from `facing`, given the
-// triangle's LPS corners.
+// The axis-aligned share with each triangle's normal from `facing`, given its
+// own (unnormalised) normal and its LPS corners.
 template <typename Facing>
 double share_facing_axes(const TriangleMesh& mesh, const volume::ImageGeometry& geometry,
                          const Facing& facing) {
@@ -255,11 +255,11 @@ double share_facing_axes(const TriangleMesh& mesh, const volume::ImageGeometry& 
     for (int k = 0; k < 3; ++k)
       cap = cap || centroid[k] < 0 || centroid[k] > double(geometry.dims[k] - 1);
     if (cap) continue;
-    const double twice_area =
-        geometry::norm(geometry::cross(geometry::sub(b, a), geometry::sub(c, a)));
+    const Vec3 face = geometry::cross(geometry::sub(b, a), geometry::sub(c, a));
+    const double twice_area = geometry::norm(face);
     if (twice_area == 0) continue;
     total += twice_area;
-    const Vec3 normal = facing(a, b, c);
+    const Vec3 normal = facing(face, a, b, c);
     const double length = geometry::norm(normal);
     if (length == 0) continue;
     for (const auto& axis : axes) {
@@ -275,16 +275,16 @@ double share_facing_axes(const TriangleMesh& mesh, const volume::ImageGeometry& 
 }  // namespace
 
 double axis_aligned_share(const TriangleMesh& mesh, const volume::ImageGeometry& geometry) {
-  return share_facing_axes(mesh, geometry, [](const Vec3& a, const Vec3& b, const Vec3& c) {
-    return geometry::cross(geometry::sub(b, a), geometry::sub(c, a));
-  });
+  return share_facing_axes(
+      mesh, geometry, [](const Vec3& face, const Vec3&, const Vec3&, const Vec3&) { return face; });
 }
 
 double axis_aligned_share(const TriangleMesh& mesh, const volume::ImageGeometry& geometry,
                           const std::function<Vec3(const Vec3&)>& normal_at) {
-  return share_facing_axes(mesh, geometry, [&](const Vec3& a, const Vec3& b, const Vec3& c) {
-    return normal_at(geometry::scale(geometry::add(a, geometry::add(b, c)), 1.0 / 3));
-  });
+  return share_facing_axes(
+      mesh, geometry, [&](const Vec3&, const Vec3& a, const Vec3& b, const Vec3& c) {
+        return normal_at(geometry::scale(geometry::add(a, geometry::add(b, c)), 1.0 / 3));
+      });
 }
 
 double corresponding_hausdorff_voxels(const TriangleMesh& mesh, const TriangleMesh& staircase,
