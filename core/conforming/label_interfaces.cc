@@ -2,6 +2,7 @@
 #include "core/conforming/label_interfaces.h"
 
 #include <algorithm>
+#include <barrier>
 #include <chrono>
 #include <cmath>
 #include <unordered_map>
@@ -35,9 +36,24 @@ struct PaddedLabels {
 PaddedLabels padded_labels(const volume::LabelVolume& volume, std::vector<int32_t> selected) {
   std::sort(selected.begin(), selected.end());
   const auto& dims = volume.geometry.dims;
+  // Asked for every voxel: a table over the selected labels' range where it
+  // is small (as label values are), else a search.
+  constexpr int64_t kLargestTable = int64_t{1} << 20;
+  const int32_t least = selected.empty() ? 0 : selected.front();
+  const int64_t range = selected.empty() ? 0 : int64_t{selected.back()} - least + 1;
+  std::vector<uint8_t> table;
+  if (range <= kLargestTable) {
+    table.assign(static_cast<size_t>(range), 0);
+    for (int32_t label : selected) table[static_cast<size_t>(label - least)] = 1;
+  }
   const auto chosen = [&](int32_t label) {
-    return label != kOutside &&
-           (selected.empty() || std::binary_search(selected.begin(), selected.end(), label));
+    if (label == kOutside) return false;
+    if (selected.empty()) return true;
+    if (!table.empty()) {
+      const int64_t slot = int64_t{label} - least;
+      return slot >= 0 && slot < range && table[static_cast<size_t>(slot)] != 0;
+    }
+    return std::binary_search(selected.begin(), selected.end(), label);
   };
   // The selected voxels' box, in volume indices.
   std::array<int64_t, 3> lo{dims[0], dims[1], dims[2]}, hi{-1, -1, -1};
@@ -113,32 +129,35 @@ uint8_t distinct_labels(const PaddedLabels& labels, int64_t a, int64_t b, int64_
   return count;
 }
 
-// The face-neighbouring voxel pairs with different labels, as the padded
-// linear index of the first voxel and the axis to the second, axis by axis
-// and each axis in index order.
-std::vector<std::pair<int, size_t>> differing_pairs(const PaddedLabels& labels) {
-  std::vector<std::pair<int, size_t>> pairs;
+// A face-neighbouring voxel pair: the first voxel, as padded coordinates
+// and linear index, and the axis to the second.
+struct VoxelPair {
+  std::array<int64_t, 3> voxel;
+  size_t index;
+  int axis;
+};
+
+// The face-neighbouring voxel pairs with different labels, axis by axis and
+// each axis in index order.
+std::vector<VoxelPair> differing_pairs(const PaddedLabels& labels) {
+  std::vector<VoxelPair> pairs;
   const auto& dims = labels.dims;
   const std::array<size_t, 3> stride{1, static_cast<size_t>(dims[0]),
                                      static_cast<size_t>(dims[0] * dims[1])};
   for (int axis = 0; axis < 3; ++axis) {
     for (int64_t z = 0; z < dims[2] - (axis == 2 ? 1 : 0); ++z) {
       for (int64_t y = 0; y < dims[1] - (axis == 1 ? 1 : 0); ++y) {
-        size_t i = static_cast<size_t>((z * dims[1] + y) * dims[0]);
-        const size_t end = i + static_cast<size_t>(dims[0]) - (axis == 0 ? 1 : 0);
-        for (; i < end; ++i)
-          if (labels.labels[i] != labels.labels[i + stride[axis]]) pairs.emplace_back(axis, i);
+        const size_t row = static_cast<size_t>((z * dims[1] + y) * dims[0]);
+        const int64_t end = dims[0] - (axis == 0 ? 1 : 0);
+        for (int64_t x = 0; x < end; ++x) {
+          const size_t i = row + static_cast<size_t>(x);
+          if (labels.labels[i] != labels.labels[i + stride[axis]])
+            pairs.push_back({{x, y, z}, i, axis});
+        }
       }
     }
   }
   return pairs;
-}
-
-// The padded voxel (x, y, z) of a padded linear index.
-std::array<int64_t, 3> padded_voxel(const PaddedLabels& labels, size_t i) {
-  const auto v = static_cast<int64_t>(i);
-  return {v % labels.dims[0], (v / labels.dims[0]) % labels.dims[1],
-          v / (labels.dims[0] * labels.dims[1])};
 }
 
 // The cube at `offset` (as in the quads: {1, 1}, {0, 1}, {0, 0}, {1, 0}
@@ -160,13 +179,16 @@ Net build_net(const PaddedLabels& labels, const std::array<double, 3>& spacing, 
   // cubes around it: mark those, then number them in index order.
   const auto pairs = differing_pairs(labels);
   constexpr uint32_t kMarked = 0;
-  for (const auto& [axis, i] : pairs) {
-    const auto p = padded_voxel(labels, i);
+  for (const auto& pair : pairs) {
     for (const auto& offset : kQuadOffsets) {
-      const auto cube = cube_around(p, axis, offset);
+      const auto cube = cube_around(pair.voxel, pair.axis, offset);
       cubes.point[cubes.index(cube[0], cube[1], cube[2])] = kMarked;
     }
   }
+  const size_t marked = static_cast<size_t>(
+      cubes.point.size() - std::count(cubes.point.begin(), cubes.point.end(), kNoPoint));
+  net.centre.reserve(marked);
+  net.label_count.reserve(marked);
   size_t i = 0;
   for (int64_t c = 0; c < cubes.dims[2]; ++c) {
     for (int64_t b = 0; b < cubes.dims[1]; ++b) {
@@ -189,11 +211,13 @@ Net build_net(const PaddedLabels& labels, const std::array<double, 3>& spacing, 
   const std::array<uint64_t, 3> stride{1, static_cast<uint64_t>(labels.dims[0]),
                                        static_cast<uint64_t>(labels.dims[0] * labels.dims[1])};
   net.quads.reserve(pairs.size());
-  for (const auto& [axis, i] : pairs) {
-    const auto p = padded_voxel(labels, i);
+  net.quad_sides.reserve(pairs.size());
+  net.quad_axis.reserve(pairs.size());
+  net.quad_voxels.reserve(pairs.size());
+  for (const auto& [voxel, i, axis] : pairs) {
     std::array<uint32_t, 4> quad{};
     for (int k = 0; k < 4; ++k) {
-      const auto cube = cube_around(p, axis, kQuadOffsets[k]);
+      const auto cube = cube_around(voxel, axis, kQuadOffsets[k]);
       quad[k] = cubes.point[cubes.index(cube[0], cube[1], cube[2])];
     }
     net.quads.push_back(quad);
@@ -274,41 +298,68 @@ constexpr size_t kThreadedSmoothingPoints = 20'000;
 
 void smooth(const Stencil& stencil, const std::vector<Vec3>& centre, const Vec3& half_box,
             const InterfaceParams& params, std::vector<Vec3>& points) {
-  std::vector<Vec3> next(points.size());
-  // Each point's next place reads only the current places: the points split
-  // between two threads, with the same result as one.
-  const auto step_range = [&](double factor, size_t begin, size_t end) {
+  const size_t n = points.size();
+  // Step s reads places[s % 2] and writes places[(s + 1) % 2]; an even
+  // number of steps ends in `points`.
+  std::vector<Vec3> next(n);
+  const std::array<Vec3*, 2> places{points.data(), next.data()};
+  const auto step_range = [&](int step, size_t begin, size_t end) {
+    const double factor = step % 2 == 0 ? params.shrink_step : params.inflate_step;
+    const uint32_t* __restrict start = stencil.start.data();
+    const uint32_t* __restrict neighbours = stencil.neighbours.data();
+    const Vec3* __restrict boxes = centre.data();
+    const Vec3* __restrict from = places[step % 2];
+    Vec3* __restrict to = places[(step + 1) % 2];
     for (size_t p = begin; p < end; ++p) {
-      const uint32_t first = stencil.start[p];
-      const uint32_t last = stencil.start[p + 1];
+      const uint32_t first = start[p];
+      const uint32_t last = start[p + 1];
       if (first == last) {
-        next[p] = points[p];
+        to[p] = from[p];
         continue;
       }
-      Vec3 mean{0, 0, 0};
-      for (uint32_t i = first; i < last; ++i)
-        mean = geometry::add(mean, points[stencil.neighbours[i]]);
-      mean = geometry::scale(mean, 1.0 / (last - first));
-      for (int k = 0; k < 3; ++k) {
-        const double moved = points[p][k] + factor * (mean[k] - points[p][k]);
-        next[p][k] = std::clamp(moved, centre[p][k] - half_box[k], centre[p][k] + half_box[k]);
+      double x = 0, y = 0, z = 0;
+      const auto add = [&](uint32_t i) {
+        const Vec3& q = from[neighbours[i]];
+        x += q[0];
+        y += q[1];
+        z += q[2];
+      };
+      // Most points have four neighbours: a branch that predicts well.
+      if (last - first == 4) {
+        add(first);
+        add(first + 1);
+        add(first + 2);
+        add(first + 3);
+      } else {
+        for (uint32_t i = first; i < last; ++i) add(i);
       }
+      const double inverse = 1.0 / (last - first);
+      const Vec3& at = from[p];
+      const Vec3& box = boxes[p];
+      to[p][0] = std::clamp(at[0] + factor * (x * inverse - at[0]), box[0] - half_box[0],
+                            box[0] + half_box[0]);
+      to[p][1] = std::clamp(at[1] + factor * (y * inverse - at[1]), box[1] - half_box[1],
+                            box[1] + half_box[1]);
+      to[p][2] = std::clamp(at[2] + factor * (z * inverse - at[2]), box[2] - half_box[2],
+                            box[2] + half_box[2]);
     }
   };
-  const auto step = [&](double factor) {
-    const size_t half = points.size() / 2;
-    if (points.size() < kThreadedSmoothingPoints) {
-      step_range(factor, 0, points.size());
-    } else {
-      side_by_side([&] { step_range(factor, half, points.size()); },
-                   [&] { step_range(factor, 0, half); });
-    }
-    points.swap(next);
-  };
-  for (int round = 0; round < params.smoothing_rounds; ++round) {
-    step(params.shrink_step);
-    step(params.inflate_step);
+  const int steps = 2 * params.smoothing_rounds;
+  if (n < kThreadedSmoothingPoints) {
+    for (int s = 0; s < steps; ++s) step_range(s, 0, n);
+    return;
   }
+  // Each point's next place reads only the current places: two threads
+  // share the points for the whole run and meet after every step, with
+  // the same result as one.
+  std::barrier<> stepped(2);
+  const auto run_half = [&](size_t begin, size_t end) {
+    for (int s = 0; s < steps; ++s) {
+      step_range(s, begin, end);
+      stepped.arrive_and_wait();
+    }
+  };
+  side_by_side([&] { run_half(n / 2, n); }, [&] { run_half(0, n / 2); });
 }
 
 // Each label's enclosed volume over its quads (split 0-1-2, 0-2-3), with
