@@ -362,18 +362,41 @@ void smooth(const Stencil& stencil, const std::vector<Vec3>& centre, const Vec3&
   side_by_side([&] { run_half(n / 2, n); }, [&] { run_half(0, n / 2); });
 }
 
+// Each quad's two sides as slots into one sorted list of the net's labels,
+// so that per-label sums are arrays rather than hash maps.
+struct SideSlots {
+  std::vector<int32_t> labels;                 // sorted, kOutside among them
+  std::vector<std::array<uint32_t, 2>> sides;  // per quad
+};
+
+SideSlots side_slots(const Net& net) {
+  SideSlots slots;
+  for (const auto& sides : net.quad_sides)
+    slots.labels.insert(slots.labels.end(), sides.begin(), sides.end());
+  std::sort(slots.labels.begin(), slots.labels.end());
+  slots.labels.erase(std::unique(slots.labels.begin(), slots.labels.end()), slots.labels.end());
+  const auto slot = [&](int32_t label) {
+    return static_cast<uint32_t>(std::lower_bound(slots.labels.begin(), slots.labels.end(), label) -
+                                 slots.labels.begin());
+  };
+  slots.sides.reserve(net.quad_sides.size());
+  for (const auto& sides : net.quad_sides) slots.sides.push_back({slot(sides[0]), slot(sides[1])});
+  return slots;
+}
+
 // Each label's enclosed volume over its quads (split 0-1-2, 0-2-3), with
-// points `x`: the quads are wound from sides[0] into sides[1], so a quad
-// adds to sides[0]'s volume and takes from sides[1]'s.
-std::unordered_map<int32_t, double> label_volumes(const Net& net, const std::vector<Vec3>& x) {
-  std::unordered_map<int32_t, double> volume;
+// points `x`, by slot: the quads are wound from sides[0] into sides[1], so a
+// quad adds to sides[0]'s volume and takes from sides[1]'s.
+std::vector<double> label_volumes(const Net& net, const SideSlots& slots,
+                                  const std::vector<Vec3>& x) {
+  std::vector<double> volume(slots.labels.size(), 0);
   for (size_t q = 0; q < net.quads.size(); ++q) {
     const auto& c = net.quads[q];
     const double v = (geometry::dot(x[c[0]], geometry::cross(x[c[1]], x[c[2]])) +
                       geometry::dot(x[c[0]], geometry::cross(x[c[2]], x[c[3]]))) /
                      6;
-    volume[net.quad_sides[q][0]] += v;
-    volume[net.quad_sides[q][1]] -= v;
+    volume[slots.sides[q][0]] += v;
+    volume[slots.sides[q][1]] -= v;
   }
   return volume;
 }
@@ -385,29 +408,35 @@ std::unordered_map<int32_t, double> label_volumes(const Net& net, const std::vec
 // their boxes.
 void restore_volumes(const Net& net, const std::vector<Vec3>& centre, const Vec3& half_box,
                      std::vector<Vec3>& points) {
-  const auto target = label_volumes(net, centre);
+  const SideSlots slots = side_slots(net);
+  const auto outside = static_cast<uint32_t>(
+      std::lower_bound(slots.labels.begin(), slots.labels.end(), kOutside) - slots.labels.begin());
+  const bool has_outside = outside < slots.labels.size() && slots.labels[outside] == kOutside;
+  const auto target = label_volumes(net, slots, centre);
+  constexpr uint32_t kUnowned = UINT32_MAX, kShared = UINT32_MAX - 1;
   for (int round = 0; round < 3; ++round) {
-    const auto now = label_volumes(net, points);
-    // Per point: the one label it bounds against the outside (or -1 when it
-    // touches another label too), and its area-weighted outward normal.
-    std::vector<int32_t> owner(points.size(), INT32_MIN);
+    const auto now = label_volumes(net, slots, points);
+    // Per point: the one label (slot) it bounds against the outside, or
+    // kShared when it touches another label too; and its area-weighted
+    // outward normal.
+    std::vector<uint32_t> owner(points.size(), kUnowned);
     std::vector<Vec3> normal(points.size(), Vec3{0, 0, 0});
-    std::unordered_map<int32_t, double> area;
+    std::vector<double> area(slots.labels.size(), 0);
     for (size_t q = 0; q < net.quads.size(); ++q) {
       const auto& c = net.quads[q];
-      const auto& sides = net.quad_sides[q];
-      const bool outer = sides[0] == kOutside || sides[1] == kOutside;
-      const int32_t label = sides[0] == kOutside ? sides[1] : sides[0];
+      const auto& sides = slots.sides[q];
+      const bool outer = has_outside && (sides[0] == outside || sides[1] == outside);
+      const uint32_t label = sides[0] == outside ? sides[1] : sides[0];
       // Twice the quad's vector area, pointing from sides[0] to sides[1].
       Vec3 n = geometry::add(geometry::cross(geometry::sub(points[c[1]], points[c[0]]),
                                              geometry::sub(points[c[2]], points[c[0]])),
                              geometry::cross(geometry::sub(points[c[2]], points[c[0]]),
                                              geometry::sub(points[c[3]], points[c[0]])));
-      if (sides[0] == kOutside) n = geometry::scale(n, -1);
+      if (sides[0] == outside) n = geometry::scale(n, -1);
       if (outer) area[label] += 0.5 * geometry::norm(n);
       for (uint32_t p : c) {
-        if (!outer || (owner[p] != INT32_MIN && owner[p] != label)) {
-          owner[p] = -1;
+        if (!outer || (owner[p] != kUnowned && owner[p] != label)) {
+          owner[p] = kShared;
           continue;
         }
         owner[p] = label;
@@ -415,9 +444,9 @@ void restore_volumes(const Net& net, const std::vector<Vec3>& centre, const Vec3
       }
     }
     for (size_t p = 0; p < points.size(); ++p) {
-      if (owner[p] < 0) continue;
-      const int32_t label = owner[p];
-      const double lost = target.at(label) - now.at(label);
+      if (owner[p] == kUnowned || owner[p] == kShared) continue;
+      const uint32_t label = owner[p];
+      const double lost = target[label] - now[label];
       const double length = geometry::norm(normal[p]);
       if (length == 0 || area[label] == 0) continue;
       const Vec3 step = geometry::scale(normal[p], lost / area[label] / length);
