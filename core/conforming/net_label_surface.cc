@@ -65,34 +65,35 @@ geometry::DisjointSets fan_classes(const std::vector<std::array<uint32_t, 3>>& t
 }
 
 // The net edges (keys) whose triangles still share one edge of output points
-// three or more times once each fan class is its own point.
+// three or more times once each fan class is its own point. A class belongs
+// to one net point, so only a net edge with more than two uses can be one:
+// those are the groups of `uses` (sorted by edge) longer than two.
 std::vector<uint64_t> edges_used_more_than_twice(
-    const std::vector<std::array<uint32_t, 3>>& triangles, geometry::DisjointSets& corners) {
-  struct Use {
-    uint64_t classes;
-    uint64_t key;
-  };
-  std::vector<Use> used;
-  used.reserve(3 * triangles.size());
-  for (uint32_t t = 0; t < triangles.size(); ++t) {
-    for (uint32_t k = 0; k < 3; ++k) {
-      const uint32_t ca = corners.find(3 * t + k), cb = corners.find(3 * t + (k + 1) % 3);
-      const uint32_t a = triangles[t][k], b = triangles[t][(k + 1) % 3];
-      used.push_back({ca < cb ? (uint64_t{ca} << 32) | cb : (uint64_t{cb} << 32) | ca,
-                      a < b ? (uint64_t{a} << 32) | b : (uint64_t{b} << 32) | a});
-    }
-  }
-  std::sort(used.begin(), used.end(),
-            [](const Use& x, const Use& y) { return x.classes < y.classes; });
+    const std::vector<std::array<uint32_t, 3>>& triangles, const std::vector<EdgeUse>& uses,
+    geometry::DisjointSets& corners) {
   std::vector<uint64_t> keys;
-  for (size_t first = 0; first < used.size();) {
+  std::vector<uint64_t> class_pairs;
+  for (size_t first = 0; first < uses.size();) {
     size_t last = first;
-    while (last < used.size() && used[last].classes == used[first].classes) ++last;
-    if (last - first > 2) keys.push_back(used[first].key);
+    const uint64_t key = uses[first].key;
+    while (last < uses.size() && uses[last].key == key) ++last;
+    if (last - first > 2) {
+      const auto a = static_cast<uint32_t>(key >> 32), b = static_cast<uint32_t>(key);
+      class_pairs.clear();
+      for (size_t i = first; i < last; ++i) {
+        const uint32_t t = uses[i].triangle;
+        class_pairs.push_back((uint64_t{corners.find(corner_at(triangles, t, a))} << 32) |
+                              corners.find(corner_at(triangles, t, b)));
+      }
+      std::sort(class_pairs.begin(), class_pairs.end());
+      for (size_t i = 2; i < class_pairs.size(); ++i)
+        if (class_pairs[i] == class_pairs[i - 2]) {
+          keys.push_back(key);
+          break;
+        }
+    }
     first = last;
   }
-  std::sort(keys.begin(), keys.end());
-  keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
   return keys;
 }
 
@@ -150,7 +151,7 @@ NetLabelSurface net_label_surface(const InterfaceSurface& net, int32_t label,
   // An edge whose two voxels the surface joins around both its ends
   // anyway still has four triangles once the points are split: there the
   // voxels are joined along the edge too, which keeps it manifold.
-  connect = edges_used_more_than_twice(triangles, corners);
+  connect = edges_used_more_than_twice(triangles, uses, corners);
   if (!connect.empty()) corners = fan_classes(triangles, uses, connect);
 
   // One output point per class; where a net point has several, each copy
