@@ -9,15 +9,36 @@ namespace {
 
 using geometry::Vec3;
 
-// The largest cosine among the triangle's angles: its smallest angle's.
-double smallest_angle_cosine(const Vec3& a, const Vec3& b, const Vec3& c) {
-  const auto cosine = [](const Vec3& at, const Vec3& p, const Vec3& q) {
-    const Vec3 u = geometry::sub(p, at);
-    const Vec3 w = geometry::sub(q, at);
-    const double lengths = geometry::norm(u) * geometry::norm(w);
-    return lengths > 0 ? geometry::dot(u, w) / lengths : 1.0;
-  };
-  return std::max({cosine(a, b, c), cosine(b, c, a), cosine(c, a, b)});
+// An edge from one point to another, and its length.
+struct Edge {
+  Vec3 along;
+  double length;
+};
+
+Edge edge(const Vec3& from, const Vec3& to) {
+  const Vec3 along = geometry::sub(to, from);
+  return {along, geometry::norm(along)};
+}
+
+Edge reversed(const Edge& e) { return {geometry::scale(e.along, -1), e.length}; }
+
+// The cosine of the angle between two edges leaving one corner (1 where
+// one has no length).
+double corner_cosine(const Edge& u, const Edge& w) {
+  const double lengths = u.length * w.length;
+  return lengths > 0 ? geometry::dot(u.along, w.along) / lengths : 1.0;
+}
+
+// The largest cosine among the angles of triangle (p, q, r), its smallest
+// angle's, from its edges p -> q, q -> r and p -> r: quads share edges
+// between their two splits, so each length is taken once.
+double smallest_angle_cosine(const Edge& pq, const Edge& qr, const Edge& pr) {
+  return std::max({corner_cosine(pq, pr), corner_cosine(qr, reversed(pq)),
+                   corner_cosine(reversed(pr), reversed(qr))});
+}
+
+double smallest_angle_cosine(const Vec3& p, const Vec3& q, const Vec3& r) {
+  return smallest_angle_cosine(edge(p, q), edge(q, r), edge(p, r));
 }
 
 // The quads around each point, as offsets into one list.
@@ -70,8 +91,12 @@ void resplit_quad(InterfaceSurface& surface, uint32_t t) {
 
 QuadSplit best_quad_split(const std::array<uint32_t, 4>& quad, const std::vector<Vec3>& points) {
   const Vec3 &a = points[quad[0]], &b = points[quad[1]], &c = points[quad[2]], &d = points[quad[3]];
-  const double split_02 = std::max(smallest_angle_cosine(a, b, c), smallest_angle_cosine(a, c, d));
-  const double split_13 = std::max(smallest_angle_cosine(a, b, d), smallest_angle_cosine(b, c, d));
+  const Edge ab = edge(a, b), bc = edge(b, c), cd = edge(c, d), ad = edge(a, d), ac = edge(a, c),
+             bd = edge(b, d);
+  const double split_02 =
+      std::max(smallest_angle_cosine(ab, bc, ac), smallest_angle_cosine(ac, cd, ad));
+  const double split_13 =
+      std::max(smallest_angle_cosine(ab, bd, ad), smallest_angle_cosine(bc, cd, bd));
   return split_02 <= split_13 ? QuadSplit{split_02, true} : QuadSplit{split_13, false};
 }
 
