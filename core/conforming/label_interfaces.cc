@@ -170,14 +170,16 @@ std::array<int64_t, 3> cube_around(std::array<int64_t, 3> p, int axis, std::arra
 
 constexpr std::array<std::array<int, 2>, 4> kQuadOffsets{{{1, 1}, {0, 1}, {0, 0}, {1, 0}}};
 
-Net build_net(const PaddedLabels& labels, const std::array<double, 3>& spacing, Cubes& cubes) {
+// The net's points, one per cube whose corners hold more than one label,
+// numbered in cube index order.
+Net net_points(const PaddedLabels& labels, const std::array<double, 3>& spacing,
+               const std::vector<VoxelPair>& pairs, Cubes& cubes) {
   Net net;
   cubes.dims = {labels.dims[0] - 1, labels.dims[1] - 1, labels.dims[2] - 1};
   cubes.point.assign(static_cast<size_t>(cubes.dims[0] * cubes.dims[1] * cubes.dims[2]), kNoPoint);
   // A cube's corners hold more than one label exactly when one of its edges
   // joins two different labels, and every such edge's quad uses the four
   // cubes around it: mark those, then number them in index order.
-  const auto pairs = differing_pairs(labels);
   constexpr uint32_t kMarked = 0;
   for (const auto& pair : pairs) {
     for (const auto& offset : kQuadOffsets) {
@@ -205,9 +207,14 @@ Net build_net(const PaddedLabels& labels, const std::array<double, 3>& spacing, 
       }
     }
   }
-  // One quad per pair of face neighbours with different labels, wound so its
-  // normal points from the first voxel to the second: the four cubes around
-  // their common axis, counter-clockwise seen from the second voxel.
+  return net;
+}
+
+// One quad per pair of face neighbours with different labels, wound so its
+// normal points from the first voxel to the second: the four cubes around
+// their common axis, counter-clockwise seen from the second voxel.
+void add_quads(const PaddedLabels& labels, const std::vector<VoxelPair>& pairs, const Cubes& cubes,
+               Net& net) {
   const std::array<uint64_t, 3> stride{1, static_cast<uint64_t>(labels.dims[0]),
                                        static_cast<uint64_t>(labels.dims[0] * labels.dims[1])};
   net.quads.reserve(pairs.size());
@@ -225,7 +232,6 @@ Net build_net(const PaddedLabels& labels, const std::array<double, 3>& spacing, 
     net.quad_axis.push_back(static_cast<uint8_t>(axis));
     net.quad_voxels.push_back({i, i + stride[axis]});
   }
-  return net;
 }
 
 // Neighbours each point averages over: every neighbour on a patch between
@@ -545,8 +551,13 @@ InterfaceSurface label_interfaces(const volume::LabelVolume& volume,
   const auto& geometry = volume.geometry;
   const PaddedLabels padded = padded_labels(volume, labels);
   Cubes cubes;
-  Net net = build_net(padded, geometry.spacing, cubes);
-  const Stencil stencil = smoothing_stencil(net, padded, cubes, figures);
+  const auto pairs = differing_pairs(padded);
+  Net net = net_points(padded, geometry.spacing, pairs, cubes);
+  // The quads and the smoothing stencil only read the numbered cubes and
+  // write apart: they are made side by side.
+  Stencil stencil;
+  side_by_side([&] { add_quads(padded, pairs, cubes, net); },
+               [&] { stencil = smoothing_stencil(net, padded, cubes, figures); });
   cubes.point.clear();
   cubes.point.shrink_to_fit();
 
@@ -588,17 +599,22 @@ InterfaceSurface label_interfaces(const volume::LabelVolume& volume,
     return geometry.to_physical({scaled[0] / geometry.spacing[0], scaled[1] / geometry.spacing[1],
                                  scaled[2] / geometry.spacing[2]});
   };
-  surface.points.reserve(points.size());
-  surface.staircase.reserve(points.size());
-  for (size_t p = 0; p < points.size(); ++p) {
-    surface.points.push_back(to_patient(points[p]));
-    surface.staircase.push_back(to_patient(net.centre[p]));
-    if (p < before_widening.size() && before_widening[p] != points[p])
+  surface.points.resize(points.size());
+  surface.staircase.resize(points.size());
+  std::array<double, 2> max_offset{0, 0};  // per half
+  in_two_halves(points.size(), [&](size_t begin, size_t end) {
+    double& offset = max_offset[begin == 0 ? 0 : 1];
+    for (size_t p = begin; p < end; ++p) {
+      surface.points[p] = to_patient(points[p]);
+      surface.staircase[p] = to_patient(net.centre[p]);
+      offset =
+          std::max(offset, geometry::norm(geometry::sub(surface.points[p], surface.staircase[p])));
+    }
+  });
+  figures.max_offset_mm = std::max(max_offset[0], max_offset[1]);
+  for (size_t p = 0; p < before_widening.size(); ++p)
+    if (before_widening[p] != points[p])
       surface.widened.push_back({static_cast<uint32_t>(p), to_patient(before_widening[p])});
-    figures.max_offset_mm =
-        std::max(figures.max_offset_mm,
-                 geometry::norm(geometry::sub(surface.points.back(), surface.staircase.back())));
-  }
 
   // A direction matrix with negative determinant mirrors space: windings
   // reverse so that normals still point from sides[0] to sides[1].
@@ -606,26 +622,29 @@ InterfaceSurface label_interfaces(const volume::LabelVolume& volume,
   const double det = d[0] * (d[4] * d[8] - d[5] * d[7]) - d[1] * (d[3] * d[8] - d[5] * d[6]) +
                      d[2] * (d[3] * d[7] - d[4] * d[6]);
   const bool mirrored = det < 0;
-  surface.triangles.reserve(2 * net.quads.size());
-  surface.sides.reserve(2 * net.quads.size());
-  surface.side_voxels.reserve(2 * net.quads.size());
+  surface.triangles.resize(2 * net.quads.size());
+  surface.sides.resize(2 * net.quads.size());
+  surface.side_voxels.resize(2 * net.quads.size());
   surface.padded_dims = padded.dims;
   surface.padded_first = padded.first;
-  for (size_t q = 0; q < net.quads.size(); ++q) {
-    const auto& quad = net.quads[q];
-    std::array<std::array<uint32_t, 3>, 2> pair =
-        best_quad_split(quad, surface.points).along_02
-            ? std::array<std::array<uint32_t, 3>, 2>{{{quad[0], quad[1], quad[2]},
-                                                      {quad[0], quad[2], quad[3]}}}
-            : std::array<std::array<uint32_t, 3>, 2>{
-                  {{quad[0], quad[1], quad[3]}, {quad[1], quad[2], quad[3]}}};
-    for (auto& triangle : pair) {
-      if (mirrored) std::swap(triangle[1], triangle[2]);
-      surface.triangles.push_back(triangle);
-      surface.sides.push_back(net.quad_sides[q]);
-      surface.side_voxels.push_back(net.quad_voxels[q]);
+  in_two_halves(net.quads.size(), [&](size_t begin, size_t end) {
+    for (size_t q = begin; q < end; ++q) {
+      const auto& quad = net.quads[q];
+      std::array<std::array<uint32_t, 3>, 2> pair =
+          best_quad_split(quad, surface.points).along_02
+              ? std::array<std::array<uint32_t, 3>, 2>{{{quad[0], quad[1], quad[2]},
+                                                        {quad[0], quad[2], quad[3]}}}
+              : std::array<std::array<uint32_t, 3>, 2>{
+                    {{quad[0], quad[1], quad[3]}, {quad[1], quad[2], quad[3]}}};
+      for (size_t k = 0; k < 2; ++k) {
+        auto& triangle = pair[k];
+        if (mirrored) std::swap(triangle[1], triangle[2]);
+        surface.triangles[2 * q + k] = triangle;
+        surface.sides[2 * q + k] = net.quad_sides[q];
+        surface.side_voxels[2 * q + k] = net.quad_voxels[q];
+      }
     }
-  }
+  });
   figures.points = surface.points.size();
   figures.triangles = surface.triangles.size();
   figures.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -2,6 +2,7 @@
 // Two pieces of work at once, on this thread and one more.
 #pragma once
 
+#include <cstddef>
 #include <exception>
 #include <thread>
 
@@ -28,6 +29,13 @@ void side_by_side(There&& there, Here&& here) {
   }
   thread.join();
   if (there_error) std::rethrow_exception(there_error);
+}
+
+// Runs work(begin, end) over [0, count) in two halves side by side; the
+// halves must write apart.
+template <typename Work>
+void in_two_halves(size_t count, Work&& work) {
+  side_by_side([&] { work(count / 2, count); }, [&] { work(size_t{0}, count / 2); });
 }
 
 }  // namespace labelmesh
