@@ -11,6 +11,7 @@
 //   shares     the phantoms' axis-aligned area share beside the true shape's;
 // Usage: labelmesh_surface_bench [phantoms|shares|volumes|all] [ROUNDS] [FILE ...]
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -195,7 +196,7 @@ struct VolumeFigures {
 
 // Our surfaces without the guard's checks: the file read, the shared net
 // built and smoothed as the pipeline does by default, and every label cut
-// out of it, the labels split between two threads as the pipeline's are.
+// out of it, on two threads as the pipeline's are.
 // On the volume's own grid: where the pipeline first cuts thick slices
 // thinner, this leaves that step out.
 void our_surfaces_alone(const std::string& path) {
@@ -207,11 +208,13 @@ void our_surfaces_alone(const std::string& path) {
   conforming::InterfaceFigures figures;
   const auto net = conforming::label_interfaces(*volume, labels,
                                                 net_interface_params(our_params().net), figures);
-  const auto cut = [&](size_t begin, size_t end) {
-    for (size_t i = begin; i < end; ++i)
+  // Each thread takes the next label in turn, as the pipeline's do.
+  std::atomic<size_t> next{0};
+  const auto cut = [&] {
+    for (size_t i = next++; i < labels.size(); i = next++)
       (void)conforming::net_label_surface(net, labels[i], volume->geometry);
   };
-  side_by_side([&] { cut(labels.size() / 2, labels.size()); }, [&] { cut(0, labels.size() / 2); });
+  side_by_side(cut, cut);
 }
 
 int bench_volume(const std::string& path, int rounds) {
