@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <barrier>
+#include <bit>
 #include <chrono>
 #include <cmath>
 #include <unordered_map>
@@ -98,14 +99,58 @@ PaddedLabels padded_labels(const volume::LabelVolume& volume, std::vector<int32_
 }
 
 // The cubes between voxel centres: cube (a, b, c) has the padded voxels
-// (a..a+1, b..b+1, c..c+1) as corners.
-struct Cubes {
-  std::array<int64_t, 3> dims{0, 0, 0};
-  std::vector<uint32_t> point;  // per cube: its point, or kNoPoint
+// (a..a+1, b..b+1, c..c+1) as corners. The cubes with a point are marked
+// and their points numbered in cube index order, so a cube's point is the
+// count of marked cubes before it: one bit per cube and a running count per
+// 64 cubes, a twentieth of the memory of a point number per cube.
+class Cubes {
+ public:
+  explicit Cubes(const std::array<int64_t, 3>& dims)
+      : dims_(dims), marked_((static_cast<size_t>(dims[0] * dims[1] * dims[2]) + 63) / 64, 0) {}
 
+  const std::array<int64_t, 3>& dims() const { return dims_; }
   size_t index(int64_t a, int64_t b, int64_t c) const {
-    return static_cast<size_t>((c * dims[1] + b) * dims[0] + a);
+    return static_cast<size_t>((c * dims_[1] + b) * dims_[0] + a);
   }
+  std::array<int64_t, 3> cube(size_t index) const {
+    const auto i = static_cast<int64_t>(index);
+    return {i % dims_[0], (i / dims_[0]) % dims_[1], i / (dims_[0] * dims_[1])};
+  }
+
+  void mark(size_t index) { marked_[index / 64] |= uint64_t{1} << (index % 64); }
+  // Numbers the marked cubes; after this `point` answers.
+  void number() {
+    before_.resize(marked_.size());
+    uint32_t count = 0;
+    for (size_t w = 0; w < marked_.size(); ++w) {
+      before_[w] = count;
+      count += static_cast<uint32_t>(std::popcount(marked_[w]));
+    }
+    points_ = count;
+  }
+  size_t points() const { return points_; }
+  // The cube's point, or kNoPoint.
+  uint32_t point(size_t index) const {
+    const uint64_t word = marked_[index / 64];
+    const uint64_t bit = uint64_t{1} << (index % 64);
+    if ((word & bit) == 0) return kNoPoint;
+    return before_[index / 64] + static_cast<uint32_t>(std::popcount(word & (bit - 1)));
+  }
+  // visit(cube index, point) for every marked cube, in index order.
+  template <typename Visit>
+  void for_each_point(Visit&& visit) const {
+    for (size_t w = 0; w < marked_.size(); ++w) {
+      uint32_t p = before_[w];
+      for (uint64_t word = marked_[w]; word != 0; word &= word - 1, ++p)
+        visit(64 * w + static_cast<size_t>(std::countr_zero(word)), p);
+    }
+  }
+
+ private:
+  std::array<int64_t, 3> dims_;
+  std::vector<uint64_t> marked_;  // bit i % 64 of word i / 64: cube i has a point
+  std::vector<uint32_t> before_;  // marked cubes in the words before
+  size_t points_ = 0;
 };
 
 struct Net {
@@ -174,39 +219,29 @@ constexpr std::array<std::array<int, 2>, 4> kQuadOffsets{{{1, 1}, {0, 1}, {0, 0}
 // numbered in cube index order.
 Net net_points(const PaddedLabels& labels, const std::array<double, 3>& spacing,
                const std::vector<VoxelPair>& pairs, Cubes& cubes) {
-  Net net;
-  cubes.dims = {labels.dims[0] - 1, labels.dims[1] - 1, labels.dims[2] - 1};
-  cubes.point.assign(static_cast<size_t>(cubes.dims[0] * cubes.dims[1] * cubes.dims[2]), kNoPoint);
   // A cube's corners hold more than one label exactly when one of its edges
   // joins two different labels, and every such edge's quad uses the four
   // cubes around it: mark those, then number them in index order.
-  constexpr uint32_t kMarked = 0;
   for (const auto& pair : pairs) {
     for (const auto& offset : kQuadOffsets) {
       const auto cube = cube_around(pair.voxel, pair.axis, offset);
-      cubes.point[cubes.index(cube[0], cube[1], cube[2])] = kMarked;
+      cubes.mark(cubes.index(cube[0], cube[1], cube[2]));
     }
   }
-  const size_t marked = static_cast<size_t>(
-      cubes.point.size() - std::count(cubes.point.begin(), cubes.point.end(), kNoPoint));
-  net.centre.reserve(marked);
-  net.label_count.reserve(marked);
-  size_t i = 0;
-  for (int64_t c = 0; c < cubes.dims[2]; ++c) {
-    for (int64_t b = 0; b < cubes.dims[1]; ++b) {
-      for (int64_t a = 0; a < cubes.dims[0]; ++a, ++i) {
-        if (cubes.point[i] == kNoPoint) continue;
-        cubes.point[i] = static_cast<uint32_t>(net.centre.size());
-        // Padded voxel a is voxel a + first; the cube's centre is half a
-        // voxel on.
-        const auto& f = labels.first;
-        net.centre.push_back({(double(a + f[0]) + 0.5) * spacing[0],
-                              (double(b + f[1]) + 0.5) * spacing[1],
-                              (double(c + f[2]) + 0.5) * spacing[2]});
-        net.label_count.push_back(distinct_labels(labels, a, b, c));
-      }
-    }
-  }
+  cubes.number();
+  Net net;
+  net.centre.reserve(cubes.points());
+  net.label_count.reserve(cubes.points());
+  cubes.for_each_point([&](size_t i, uint32_t) {
+    const auto [a, b, c] = cubes.cube(i);
+    // Padded voxel a is voxel a + first; the cube's centre is half a voxel
+    // on.
+    const auto& f = labels.first;
+    net.centre.push_back({(double(a + f[0]) + 0.5) * spacing[0],
+                          (double(b + f[1]) + 0.5) * spacing[1],
+                          (double(c + f[2]) + 0.5) * spacing[2]});
+    net.label_count.push_back(distinct_labels(labels, a, b, c));
+  });
   return net;
 }
 
@@ -225,7 +260,7 @@ void add_quads(const PaddedLabels& labels, const std::vector<VoxelPair>& pairs, 
     std::array<uint32_t, 4> quad{};
     for (int k = 0; k < 4; ++k) {
       const auto cube = cube_around(voxel, axis, kQuadOffsets[k]);
-      quad[k] = cubes.point[cubes.index(cube[0], cube[1], cube[2])];
+      quad[k] = cubes.point(cubes.index(cube[0], cube[1], cube[2]));
     }
     net.quads.push_back(quad);
     net.quad_sides.push_back({labels.labels[i], labels.labels[i + stride[axis]]});
@@ -254,47 +289,40 @@ Stencil smoothing_stencil(const Net& net, const PaddedLabels& labels, const Cube
   Stencil stencil;
   stencil.start.assign(n + 1, 0);
   stencil.neighbours.reserve(4 * n);
-  size_t i = 0;
-  for (int64_t c = 0; c < cubes.dims[2]; ++c) {
-    for (int64_t b = 0; b < cubes.dims[1]; ++b) {
-      for (int64_t a = 0; a < cubes.dims[0]; ++a, ++i) {
-        const uint32_t p = cubes.point[i];
-        if (p == kNoPoint) continue;
-        stencil.start[p] = static_cast<uint32_t>(stencil.neighbours.size());
-        const size_t first = stencil.neighbours.size();
-        const bool junction = net.label_count[p] > 2;
-        const std::array<int64_t, 3> cube{a, b, c};
-        for (const auto& [axis, sign] : kDirections) {
-          std::array<int64_t, 3> next = cube;
-          next[axis] += sign;
-          if (next[axis] < 0 || next[axis] >= cubes.dims[axis]) continue;
-          const uint32_t q = cubes.point[cubes.index(next[0], next[1], next[2])];
-          if (q == kNoPoint || (junction && net.label_count[q] <= 2)) continue;
-          // The shared face's voxels: along `axis` at the far side of
-          // whichever cube comes first, both ways along the other two.
-          std::array<int64_t, 3> corner = cube;
-          corner[axis] += sign > 0 ? 1 : 0;
-          const int u = (axis + 1) % 3, v = (axis + 2) % 3;
-          const int32_t label = labels.at(corner[0], corner[1], corner[2]);
-          bool uniform = true;
-          for (int k = 1; k < 4 && uniform; ++k) {
-            std::array<int64_t, 3> other = corner;
-            other[u] += k & 1;
-            other[v] += k >> 1;
-            uniform = labels.at(other[0], other[1], other[2]) == label;
-          }
-          if (!uniform) stencil.neighbours.push_back(q);
-        }
-        if (junction) {
-          ++figures.junction_points;
-          if (stencil.neighbours.size() - first != 2) {
-            stencil.neighbours.resize(first);
-            ++figures.fixed_points;
-          }
-        }
+  cubes.for_each_point([&](size_t i, uint32_t p) {
+    stencil.start[p] = static_cast<uint32_t>(stencil.neighbours.size());
+    const size_t first = stencil.neighbours.size();
+    const bool junction = net.label_count[p] > 2;
+    const std::array<int64_t, 3> cube = cubes.cube(i);
+    for (const auto& [axis, sign] : kDirections) {
+      std::array<int64_t, 3> next = cube;
+      next[axis] += sign;
+      if (next[axis] < 0 || next[axis] >= cubes.dims()[axis]) continue;
+      const uint32_t q = cubes.point(cubes.index(next[0], next[1], next[2]));
+      if (q == kNoPoint || (junction && net.label_count[q] <= 2)) continue;
+      // The shared face's voxels: along `axis` at the far side of
+      // whichever cube comes first, both ways along the other two.
+      std::array<int64_t, 3> corner = cube;
+      corner[axis] += sign > 0 ? 1 : 0;
+      const int u = (axis + 1) % 3, v = (axis + 2) % 3;
+      const int32_t label = labels.at(corner[0], corner[1], corner[2]);
+      bool uniform = true;
+      for (int k = 1; k < 4 && uniform; ++k) {
+        std::array<int64_t, 3> other = corner;
+        other[u] += k & 1;
+        other[v] += k >> 1;
+        uniform = labels.at(other[0], other[1], other[2]) == label;
+      }
+      if (!uniform) stencil.neighbours.push_back(q);
+    }
+    if (junction) {
+      ++figures.junction_points;
+      if (stencil.neighbours.size() - first != 2) {
+        stencil.neighbours.resize(first);
+        ++figures.fixed_points;
       }
     }
-  }
+  });
   stencil.start[n] = static_cast<uint32_t>(stencil.neighbours.size());
   return stencil;
 }
@@ -550,7 +578,7 @@ InterfaceSurface label_interfaces(const volume::LabelVolume& volume,
   figures = InterfaceFigures{};
   const auto& geometry = volume.geometry;
   const PaddedLabels padded = padded_labels(volume, labels);
-  Cubes cubes;
+  Cubes cubes({padded.dims[0] - 1, padded.dims[1] - 1, padded.dims[2] - 1});
   const auto pairs = differing_pairs(padded);
   Net net = net_points(padded, geometry.spacing, pairs, cubes);
   // The quads and the smoothing stencil only read the numbered cubes and
@@ -558,8 +586,6 @@ InterfaceSurface label_interfaces(const volume::LabelVolume& volume,
   Stencil stencil;
   side_by_side([&] { add_quads(padded, pairs, cubes, net); },
                [&] { stencil = smoothing_stencil(net, padded, cubes, figures); });
-  cubes.point.clear();
-  cubes.point.shrink_to_fit();
 
   const double half = 0.5 * params.cube_fraction;
   const Vec3 half_box{half * geometry.spacing[0] * params.box_scale[0],
