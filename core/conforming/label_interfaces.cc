@@ -176,10 +176,13 @@ uint8_t distinct_labels(const PaddedLabels& labels, int64_t a, int64_t b, int64_
 
 // A face-neighbouring voxel pair: the first voxel, as padded coordinates
 // and linear index, and the axis to the second.
+// Kept small: a CT slab has hundreds of thousands. Volumes hold at most
+// 2^31 voxels, so padded coordinates fit 32 bits.
 struct VoxelPair {
-  std::array<int64_t, 3> voxel;
-  size_t index;
-  int axis;
+  std::array<uint32_t, 3> padded;
+  uint32_t axis;
+
+  std::array<int64_t, 3> voxel() const { return {padded[0], padded[1], padded[2]}; }
 };
 
 // The face-neighbouring voxel pairs with different labels, axis by axis and
@@ -197,7 +200,9 @@ std::vector<VoxelPair> differing_pairs(const PaddedLabels& labels) {
         for (int64_t x = 0; x < end; ++x) {
           const size_t i = row + static_cast<size_t>(x);
           if (labels.labels[i] != labels.labels[i + stride[axis]])
-            pairs.push_back({{x, y, z}, i, axis});
+            pairs.push_back(
+                {{static_cast<uint32_t>(x), static_cast<uint32_t>(y), static_cast<uint32_t>(z)},
+                 static_cast<uint32_t>(axis)});
         }
       }
     }
@@ -224,7 +229,7 @@ Net net_points(const PaddedLabels& labels, const std::array<double, 3>& spacing,
   // cubes around it: mark those, then number them in index order.
   for (const auto& pair : pairs) {
     for (const auto& offset : kQuadOffsets) {
-      const auto cube = cube_around(pair.voxel, pair.axis, offset);
+      const auto cube = cube_around(pair.voxel(), static_cast<int>(pair.axis), offset);
       cubes.mark(cubes.index(cube[0], cube[1], cube[2]));
     }
   }
@@ -256,7 +261,11 @@ void add_quads(const PaddedLabels& labels, const std::vector<VoxelPair>& pairs, 
   net.quad_sides.reserve(pairs.size());
   net.quad_axis.reserve(pairs.size());
   net.quad_voxels.reserve(pairs.size());
-  for (const auto& [voxel, i, axis] : pairs) {
+  for (const auto& pair : pairs) {
+    const auto voxel = pair.voxel();
+    const auto axis = static_cast<int>(pair.axis);
+    const auto i =
+        static_cast<uint64_t>((voxel[2] * labels.dims[1] + voxel[1]) * labels.dims[0] + voxel[0]);
     std::array<uint32_t, 4> quad{};
     for (int k = 0; k < 4; ++k) {
       const auto cube = cube_around(voxel, axis, kQuadOffsets[k]);
@@ -330,20 +339,36 @@ Stencil smoothing_stencil(const Net& net, const PaddedLabels& labels, const Cube
 // Below this many points one thread smooths faster than two start.
 constexpr size_t kThreadedSmoothingPoints = 20'000;
 
+// A point's three coordinates and a spare in single precision: one step's
+// sums and clamps are a few vector operations, and the points take half the
+// memory. Smoothing moves points by whole fractions of a voxel; single
+// precision keeps them to a ten-thousandth of a millimetre on a 500 mm grid.
+using Lanes = float __attribute__((vector_size(16)));
+
+Lanes to_lanes(const Vec3& v) {
+  return Lanes{static_cast<float>(v[0]), static_cast<float>(v[1]), static_cast<float>(v[2]), 0};
+}
+
 void smooth(const Stencil& stencil, const std::vector<Vec3>& centre, const Vec3& half_box,
             const InterfaceParams& params, std::vector<Vec3>& points) {
   const size_t n = points.size();
   // Step s reads places[s % 2] and writes places[(s + 1) % 2]; an even
-  // number of steps ends in `points`.
-  std::vector<Vec3> next(n);
-  const std::array<Vec3*, 2> places{points.data(), next.data()};
+  // number of steps ends in the first.
+  std::vector<Lanes> now(n), next(n), boxes(n);
+  for (size_t p = 0; p < n; ++p) {
+    now[p] = to_lanes(points[p]);
+    boxes[p] = to_lanes(centre[p]);
+  }
+  const Lanes half = to_lanes(half_box);
+  const std::array<Lanes*, 2> places{now.data(), next.data()};
   const auto step_range = [&](int step, size_t begin, size_t end) {
-    const double factor = step % 2 == 0 ? params.shrink_step : params.inflate_step;
+    const auto factor =
+        static_cast<float>(step % 2 == 0 ? params.shrink_step : params.inflate_step);
     const uint32_t* __restrict start = stencil.start.data();
     const uint32_t* __restrict neighbours = stencil.neighbours.data();
-    const Vec3* __restrict boxes = centre.data();
-    const Vec3* __restrict from = places[step % 2];
-    Vec3* __restrict to = places[(step + 1) % 2];
+    const Lanes* __restrict box = boxes.data();
+    const Lanes* __restrict from = places[step % 2];
+    Lanes* __restrict to = places[(step + 1) % 2];
     for (size_t p = begin; p < end; ++p) {
       const uint32_t first = start[p];
       const uint32_t last = start[p + 1];
@@ -351,49 +376,40 @@ void smooth(const Stencil& stencil, const std::vector<Vec3>& centre, const Vec3&
         to[p] = from[p];
         continue;
       }
-      double x = 0, y = 0, z = 0;
-      const auto add = [&](uint32_t i) {
-        const Vec3& q = from[neighbours[i]];
-        x += q[0];
-        y += q[1];
-        z += q[2];
-      };
+      Lanes sum{0, 0, 0, 0};
       // Most points have four neighbours: a branch that predicts well.
       if (last - first == 4) {
-        add(first);
-        add(first + 1);
-        add(first + 2);
-        add(first + 3);
+        sum = (from[neighbours[first]] + from[neighbours[first + 1]]) +
+              (from[neighbours[first + 2]] + from[neighbours[first + 3]]);
+        sum *= 0.25f;
       } else {
-        for (uint32_t i = first; i < last; ++i) add(i);
+        for (uint32_t i = first; i < last; ++i) sum += from[neighbours[i]];
+        sum *= 1.0f / static_cast<float>(last - first);
       }
-      const double inverse = 1.0 / (last - first);
-      const Vec3& at = from[p];
-      const Vec3& box = boxes[p];
-      to[p][0] = std::clamp(at[0] + factor * (x * inverse - at[0]), box[0] - half_box[0],
-                            box[0] + half_box[0]);
-      to[p][1] = std::clamp(at[1] + factor * (y * inverse - at[1]), box[1] - half_box[1],
-                            box[1] + half_box[1]);
-      to[p][2] = std::clamp(at[2] + factor * (z * inverse - at[2]), box[2] - half_box[2],
-                            box[2] + half_box[2]);
+      const Lanes at = from[p];
+      Lanes moved = at + factor * (sum - at);
+      const Lanes lo = box[p] - half, hi = box[p] + half;
+      moved = moved < lo ? lo : moved;
+      to[p] = hi < moved ? hi : moved;
     }
   };
   const int steps = 2 * params.smoothing_rounds;
   if (n < kThreadedSmoothingPoints) {
     for (int s = 0; s < steps; ++s) step_range(s, 0, n);
-    return;
+  } else {
+    // Each point's next place reads only the current places: two threads
+    // share the points for the whole run and meet after every step, with
+    // the same result as one.
+    std::barrier<> stepped(2);
+    const auto run_half = [&](size_t begin, size_t end) {
+      for (int s = 0; s < steps; ++s) {
+        step_range(s, begin, end);
+        stepped.arrive_and_wait();
+      }
+    };
+    side_by_side([&] { run_half(n / 2, n); }, [&] { run_half(0, n / 2); });
   }
-  // Each point's next place reads only the current places: two threads
-  // share the points for the whole run and meet after every step, with
-  // the same result as one.
-  std::barrier<> stepped(2);
-  const auto run_half = [&](size_t begin, size_t end) {
-    for (int s = 0; s < steps; ++s) {
-      step_range(s, begin, end);
-      stepped.arrive_and_wait();
-    }
-  };
-  side_by_side([&] { run_half(n / 2, n); }, [&] { run_half(0, n / 2); });
+  for (size_t p = 0; p < n; ++p) points[p] = {now[p][0], now[p][1], now[p][2]};
 }
 
 // Each quad's two sides as slots into one sorted list of the net's labels,
@@ -448,14 +464,17 @@ void restore_volumes(const Net& net, const std::vector<Vec3>& centre, const Vec3
   const bool has_outside = outside < slots.labels.size() && slots.labels[outside] == kOutside;
   const auto target = label_volumes(net, slots, centre);
   constexpr uint32_t kUnowned = UINT32_MAX, kShared = UINT32_MAX - 1;
+  // Per point: the one label (slot) it bounds against the outside, or
+  // kShared when it touches another label too; and its area-weighted
+  // outward normal.
+  std::vector<uint32_t> owner(points.size());
+  std::vector<Vec3> normal(points.size());
+  std::vector<double> area(slots.labels.size());
   for (int round = 0; round < 3; ++round) {
     const auto now = label_volumes(net, slots, points);
-    // Per point: the one label (slot) it bounds against the outside, or
-    // kShared when it touches another label too; and its area-weighted
-    // outward normal.
-    std::vector<uint32_t> owner(points.size(), kUnowned);
-    std::vector<Vec3> normal(points.size(), Vec3{0, 0, 0});
-    std::vector<double> area(slots.labels.size(), 0);
+    std::fill(owner.begin(), owner.end(), kUnowned);
+    std::fill(normal.begin(), normal.end(), Vec3{0, 0, 0});
+    std::fill(area.begin(), area.end(), 0.0);
     for (size_t q = 0; q < net.quads.size(); ++q) {
       const auto& c = net.quads[q];
       const auto& sides = slots.sides[q];
