@@ -10,6 +10,8 @@
 //              labels each pipeline keeps within the voxel tolerance.
 //   shares     the phantoms' axis-aligned area share beside the true shape's;
 // Usage: labelmesh_surface_bench [phantoms|shares|volumes|all] [ROUNDS] [FILE ...]
+#include <malloc.h>
+
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -38,7 +40,13 @@ using labelmesh::testing::AnalyticShape;
 
 namespace {
 
+// Each timed run starts with the heap's free pages handed back to the
+// system, as in a fresh process: otherwise a run is faster or slower by the
+// pages the run before it left behind (a fresh page costs microseconds).
 double seconds_of(const std::function<void()>& f) {
+#ifdef __GLIBC__
+  malloc_trim(0);
+#endif
   const auto start = std::chrono::steady_clock::now();
   f();
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
