@@ -257,10 +257,10 @@ void add_quads(const PaddedLabels& labels, const std::vector<VoxelPair>& pairs, 
                Net& net) {
   const std::array<uint64_t, 3> stride{1, static_cast<uint64_t>(labels.dims[0]),
                                        static_cast<uint64_t>(labels.dims[0] * labels.dims[1])};
-  net.quads.reserve(pairs.size());
-  net.quad_sides.reserve(pairs.size());
-  net.quad_axis.reserve(pairs.size());
-  net.quad_voxels.reserve(pairs.size());
+  net.quads.clear();
+  net.quad_sides.clear();
+  net.quad_axis.clear();
+  net.quad_voxels.clear();
   for (const auto& pair : pairs) {
     const auto voxel = pair.voxel();
     const auto axis = static_cast<int>(pair.axis);
@@ -359,6 +359,9 @@ void smooth(const Stencil& stencil, const std::vector<Vec3>& centre, const Vec3&
     now[p] = to_lanes(points[p]);
     boxes[p] = to_lanes(centre[p]);
   }
+  // The double places are made again at the end, so that the lanes do not
+  // add to the peak memory.
+  std::vector<Vec3>().swap(points);
   const Lanes half = to_lanes(half_box);
   const std::array<Lanes*, 2> places{now.data(), next.data()};
   const auto step_range = [&](int step, size_t begin, size_t end) {
@@ -409,6 +412,9 @@ void smooth(const Stencil& stencil, const std::vector<Vec3>& centre, const Vec3&
     };
     side_by_side([&] { run_half(n / 2, n); }, [&] { run_half(0, n / 2); });
   }
+  std::vector<Lanes>().swap(next);
+  std::vector<Lanes>().swap(boxes);
+  points.resize(n);
   for (size_t p = 0; p < n; ++p) points[p] = {now[p][0], now[p][1], now[p][2]};
 }
 
@@ -601,7 +607,13 @@ InterfaceSurface label_interfaces(const volume::LabelVolume& volume,
   const auto pairs = differing_pairs(padded);
   Net net = net_points(padded, geometry.spacing, pairs, cubes);
   // The quads and the smoothing stencil only read the numbered cubes and
-  // write apart: they are made side by side.
+  // write apart: they are made side by side. The quads' arrays are reserved
+  // here, so that they belong to this thread's heap (glibc keeps one per
+  // thread, and memory freed in another thread's is not reused here).
+  net.quads.reserve(pairs.size());
+  net.quad_sides.reserve(pairs.size());
+  net.quad_axis.reserve(pairs.size());
+  net.quad_voxels.reserve(pairs.size());
   Stencil stencil;
   side_by_side([&] { add_quads(padded, pairs, cubes, net); },
                [&] { stencil = smoothing_stencil(net, padded, cubes, figures); });
