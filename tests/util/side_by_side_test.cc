@@ -1,12 +1,14 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 // Two pieces of work at once: both run, and an exception from either one
-// reaches the caller after both are done.
+// reaches the caller after both are done; a range split in two halves
+// visits every index once.
 #include "core/util/side_by_side.h"
 
 #include <gtest/gtest.h>
 
 #include <atomic>
 #include <stdexcept>
+#include <vector>
 
 namespace labelmesh {
 namespace {
@@ -30,6 +32,19 @@ TEST(SideBySide, AnExceptionHereWaitsForTheOtherThread) {
   EXPECT_THROW(side_by_side([&] { there_finished = true; }, [] { throw std::logic_error("here"); }),
                std::logic_error);
   EXPECT_TRUE(there_finished);
+}
+
+TEST(InTwoHalves, EveryIndexOnceInTwoRanges) {
+  for (const size_t count : {size_t{0}, size_t{1}, size_t{2}, size_t{7}, size_t{1000}}) {
+    std::vector<int> visits(count, 0);
+    std::atomic<int> ranges{0};
+    in_two_halves(count, [&](size_t begin, size_t end) {
+      ++ranges;
+      for (size_t i = begin; i < end; ++i) ++visits[i];
+    });
+    EXPECT_EQ(ranges, 2);
+    for (size_t i = 0; i < count; ++i) EXPECT_EQ(visits[i], 1) << "index " << i << " of " << count;
+  }
 }
 
 }  // namespace
