@@ -102,6 +102,17 @@ std::vector<int32_t> selected_labels(const volume::LabelVolume& volume,
   return out;
 }
 
+// The weights of four slices at -1, 0, 1 and 2 for a place t (0 to 1) between
+// the middle two: a Catmull-Rom cubic, which passes through each slice and
+// bends smoothly from one to the next. Linear weights cut a thin shape's
+// distances down between its slices (rings 9 and 18 mm thick on 4 mm slices
+// fell outside the voxel tolerance); the cubic follows their curve.
+std::array<double, 4> catmull_rom_weights(double t) {
+  const double t2 = t * t, t3 = t2 * t;
+  return {0.5 * (-t3 + 2 * t2 - t), 0.5 * (3 * t3 - 5 * t2 + 2), 0.5 * (-3 * t3 + 4 * t2 + t),
+          0.5 * (t3 - t2)};
+}
+
 // The thinner grid's labels from the thick slices' signed distances, each
 // label's shifted by a bias (mm) that the caller tunes to keep its volume.
 class SliceInterpolator {
@@ -142,24 +153,34 @@ class SliceInterpolator {
     std::array<int64_t, 3> fine_dims = geometry_.dims;
     fine_dims[a_] *= cut_.parts;
     const std::array<int64_t, 3> stride{1, fine_dims[0], fine_dims[0] * fine_dims[1]};
+    // The four slices around each thin one: before, below, above, after.
     int64_t held = -1;
-    std::shared_ptr<const Distances> below, above;
+    std::array<std::shared_ptr<const Distances>, 4> around;
     for (int64_t j = 0; j < fine_dims[a_]; ++j) {
       const double position = std::clamp((j + 0.5) / cut_.parts - 0.5, 0.0, double(na - 1));
       const int64_t i = std::min(static_cast<int64_t>(position), na - 2);
       const double t = position - i;
       if (held != i) {
-        below = held >= 0 && held == i - 1 ? above : distances(i);
-        above = distances(i + 1);
+        const auto slice = [&](int k) {
+          return distances(std::clamp<int64_t>(i - 1 + k, 0, na - 1));
+        };
+        if (held >= 0 && held == i - 1) {
+          std::rotate(around.begin(), around.begin() + 1, around.end());
+          around[3] = slice(3);
+        } else {
+          for (int k = 0; k < 4; ++k) around[k] = slice(k);
+        }
         held = i;
       }
+      const auto weight = catmull_rom_weights(t);
       for (int64_t pv = 0; pv < nv; ++pv) {
         for (int64_t pu = 0; pu < nu; ++pu) {
           const size_t p = static_cast<size_t>(pv * nu + pu);
           size_t best = 0;
           double best_value = -std::numeric_limits<double>::infinity();
           for (size_t l = 0; l < present_.size(); ++l) {
-            const double value = (1 - t) * (*below)[l][p] + t * (*above)[l][p] + bias[l];
+            double value = bias[l];
+            for (int k = 0; k < 4; ++k) value += weight[k] * (*around[k])[l][p];
             if (value > best_value) {
               best_value = value;
               best = l;

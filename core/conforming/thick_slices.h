@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 // Thick slices (one voxel axis much coarser than the others, as in most 2D
 // MR and many CT series) cut into thinner ones by shape-based interpolation:
-// each label's signed distance within every slice, interpolated linearly
-// between slice centres, the largest one winning. A surface net on the
+// each label's signed distance within every slice, interpolated between
+// slice centres by a cubic through the four nearest, the largest one winning. A surface net on the
 // thinner grid can then slope between slices instead of stepping a whole
 // slice at once, which folds it.
 // Reference: S. P. Raya and J. K. Udupa, "Shape-based interpolation of

@@ -121,8 +121,10 @@ TEST(ThickSlices, KeepEachSliceAndEachLabelsVolume) {
   const auto thick_volumes = label_volumes(thick);
   const auto fine_volumes = label_volumes(fine);
   ASSERT_EQ(fine_volumes.size(), 2u);
+  // Within a ring of thin voxels: the inner ball (8,600 thin voxels) gains
+  // or loses them a ring of 60-70 at a time.
   for (int32_t label : {1, 2}) {
-    EXPECT_NEAR(fine_volumes.at(label) / thick_volumes.at(label), 1.0, 0.005) << "label " << label;
+    EXPECT_NEAR(fine_volumes.at(label) / thick_volumes.at(label), 1.0, 0.01) << "label " << label;
   }
 }
 
@@ -158,7 +160,7 @@ TEST(ThickSlices, AnyAxisCanBeThick) {
   const auto thick_volumes = label_volumes(thick);
   const auto fine_volumes = label_volumes(fine);
   for (int32_t label : {1, 2})
-    EXPECT_NEAR(fine_volumes.at(label) / thick_volumes.at(label), 1.0, 0.005);
+    EXPECT_NEAR(fine_volumes.at(label) / thick_volumes.at(label), 1.0, 0.01);
 }
 
 TEST(ThickSlices, GiveAConformingMeshOfFiniteElementQuality) {
