@@ -124,15 +124,16 @@ class SliceInterpolator {
         a_(cut.axis),
         u_((cut.axis + 1) % 3),
         v_((cut.axis + 2) % 3),
-        source_(selected_labels(volume, labels)),
         // Clamped to a slice's thickness: where a label fills a slice or is
         // absent from it, the next slice's shape takes over half way
         // between them, where the voxels say it does.
         band_(static_cast<float>(volume.geometry.spacing[cut.axis])) {
-    present_ = source_;
+    const auto all = selected_labels(volume, labels);
+    present_ = all;
     std::sort(present_.begin(), present_.end());
     present_.erase(std::unique(present_.begin(), present_.end()), present_.end());
-    cache_.resize(static_cast<size_t>(geometry_.dims[a_]));
+    crop_to_labels(all);
+    cache_.resize(static_cast<size_t>(dims_[a_]));
   }
 
   const std::vector<int32_t>& present() const { return present_; }
@@ -141,28 +142,38 @@ class SliceInterpolator {
   std::vector<uint64_t> source_counts() const {
     std::vector<uint64_t> counts(present_.size(), 0);
     for (int32_t label : source_) ++counts[at(label)];
+    add_outside_box(counts, 1);
     return counts;
   }
 
   // Fills `out` (the thinner grid, x fastest) with `bias[l]` added to label
   // l's distances; returns each label's voxels and how many of them touch
   // another label across a face.
+  // `out` outside the labels' box must hold 0 already.
   void fill(const std::vector<double>& bias, int32_t* out, std::vector<uint64_t>& counts,
             std::vector<uint64_t>& boundary) const {
-    const int64_t na = geometry_.dims[a_], nu = geometry_.dims[u_], nv = geometry_.dims[v_];
+    const int64_t na = geometry_.dims[a_], nu = dims_[u_], nv = dims_[v_];
     std::array<int64_t, 3> fine_dims = geometry_.dims;
     fine_dims[a_] *= cut_.parts;
     const std::array<int64_t, 3> stride{1, fine_dims[0], fine_dims[0] * fine_dims[1]};
+    // The box on the thinner grid, and its first voxel's index there.
+    std::array<int64_t, 3> fine_lo = lo_, fine_box = dims_;
+    fine_lo[a_] *= cut_.parts;
+    fine_box[a_] *= cut_.parts;
+    const int64_t corner = fine_lo[0] * stride[0] + fine_lo[1] * stride[1] + fine_lo[2] * stride[2];
     // The four slices around each thin one: before, below, above, after.
+    // Slices beyond the box hold no selected label, as its edge slices do.
     int64_t held = -1;
     std::array<std::shared_ptr<const Distances>, 4> around;
-    for (int64_t j = 0; j < fine_dims[a_]; ++j) {
-      const double position = std::clamp((j + 0.5) / cut_.parts - 0.5, 0.0, double(na - 1));
+    for (int64_t j = 0; j < fine_box[a_]; ++j) {
+      const double position =
+          std::clamp((fine_lo[a_] + j + 0.5) / cut_.parts - 0.5, 0.0, double(na - 1));
       const int64_t i = std::min(static_cast<int64_t>(position), na - 2);
       const double t = position - i;
       if (held != i) {
         const auto slice = [&](int k) {
-          return distances(std::clamp<int64_t>(i - 1 + k, 0, na - 1));
+          return distances(std::clamp<int64_t>(i - 1 + k, lo_[a_], lo_[a_] + dims_[a_] - 1) -
+                           lo_[a_]);
         };
         if (held >= 0 && held == i - 1) {
           std::rotate(around.begin(), around.begin() + 1, around.end());
@@ -186,15 +197,16 @@ class SliceInterpolator {
               best = l;
             }
           }
-          out[j * stride[a_] + pu * stride[u_] + pv * stride[v_]] = present_[best];
+          out[corner + j * stride[a_] + pu * stride[u_] + pv * stride[v_]] = present_[best];
         }
       }
     }
     counts.assign(present_.size(), 0);
     boundary.assign(present_.size(), 0);
-    for (int64_t z = 0; z < fine_dims[2]; ++z) {
-      for (int64_t y = 0; y < fine_dims[1]; ++y) {
-        for (int64_t x = 0; x < fine_dims[0]; ++x) {
+    add_outside_box(counts, cut_.parts);
+    for (int64_t z = fine_lo[2]; z < fine_lo[2] + fine_box[2]; ++z) {
+      for (int64_t y = fine_lo[1]; y < fine_lo[1] + fine_box[1]; ++y) {
+        for (int64_t x = fine_lo[0]; x < fine_lo[0] + fine_box[0]; ++x) {
           const int64_t i = x + y * stride[1] + z * stride[2];
           const size_t l = at(out[i]);
           ++counts[l];
@@ -216,8 +228,53 @@ class SliceInterpolator {
                                present_.begin());
   }
 
+  // The selected labels' box with a margin the interpolation cannot cross:
+  // two slices along the thick axis (the cubic reads two on either side),
+  // and in the slices twice a slice's thickness (the most a label's bias
+  // and the cubic's overshoot can grow it) and two voxels. Outside it every
+  // thinner voxel is 0, as it would be from the whole volume.
+  void crop_to_labels(const std::vector<int32_t>& all) {
+    const auto& dims = geometry_.dims;
+    std::array<int64_t, 3> first{dims[0], dims[1], dims[2]}, last{-1, -1, -1};
+    size_t i = 0;
+    for (int64_t z = 0; z < dims[2]; ++z)
+      for (int64_t y = 0; y < dims[1]; ++y)
+        for (int64_t x = 0; x < dims[0]; ++x, ++i) {
+          if (all[i] == 0) continue;
+          const std::array<int64_t, 3> p{x, y, z};
+          for (int k = 0; k < 3; ++k) {
+            first[k] = std::min(first[k], p[k]);
+            last[k] = std::max(last[k], p[k]);
+          }
+        }
+    if (last[0] < 0) first = last = {0, 0, 0};
+    for (int k = 0; k < 3; ++k) {
+      const auto margin =
+          k == a_ ? int64_t{2}
+                  : static_cast<int64_t>(std::ceil(2 * band_ / geometry_.spacing[k])) + 2;
+      lo_[k] = std::max<int64_t>(0, first[k] - margin);
+      dims_[k] = std::min(dims[k] - 1, last[k] + margin) - lo_[k] + 1;
+    }
+    source_.resize(static_cast<size_t>(dims_[0] * dims_[1] * dims_[2]));
+    size_t o = 0;
+    for (int64_t z = lo_[2]; z < lo_[2] + dims_[2]; ++z)
+      for (int64_t y = lo_[1]; y < lo_[1] + dims_[1]; ++y)
+        for (int64_t x = lo_[0]; x < lo_[0] + dims_[0]; ++x)
+          source_[o++] = all[static_cast<size_t>((z * dims[1] + y) * dims[0] + x)];
+  }
+
+  // Adds the voxels outside the box, `parts` per thick one, to label 0's
+  // count (where 0 is present).
+  void add_outside_box(std::vector<uint64_t>& counts, int parts) const {
+    const auto outside = static_cast<uint64_t>(
+        geometry_.dims[0] * geometry_.dims[1] * geometry_.dims[2] - dims_[0] * dims_[1] * dims_[2]);
+    const size_t zero = at(0);
+    if (outside > 0 && zero < present_.size() && present_[zero] == 0)
+      counts[zero] += outside * static_cast<uint64_t>(parts);
+  }
+
   size_t index(int64_t i, int64_t pu, int64_t pv) const {
-    const int64_t sx = 1, sy = geometry_.dims[0], sz = geometry_.dims[0] * geometry_.dims[1];
+    const int64_t sx = 1, sy = dims_[0], sz = dims_[0] * dims_[1];
     const std::array<int64_t, 3> stride{sx, sy, sz};
     return static_cast<size_t>(i * stride[a_] + pu * stride[u_] + pv * stride[v_]);
   }
@@ -235,12 +292,12 @@ class SliceInterpolator {
     return computed;
   }
 
-  size_t slice_size() const { return static_cast<size_t>(geometry_.dims[u_] * geometry_.dims[v_]); }
+  size_t slice_size() const { return static_cast<size_t>(dims_[u_] * dims_[v_]); }
 
   // Signed distance (mm, positive inside, within +-band) of each present
   // label in slice i.
   Distances slice_distances(int64_t i) const {
-    const int64_t nu = geometry_.dims[u_], nv = geometry_.dims[v_];
+    const int64_t nu = dims_[u_], nv = dims_[v_];
     const double su = geometry_.spacing[u_], sv = geometry_.spacing[v_];
     std::vector<std::vector<float>> distances;
     std::vector<uint8_t> inside(static_cast<size_t>(nu * nv)), outside(inside.size());
@@ -272,8 +329,10 @@ class SliceInterpolator {
   const volume::ImageGeometry& geometry_;
   const ThickSlices cut_;
   const int a_, u_, v_;
-  const std::vector<int32_t> source_;
   const float band_;
+  // The selected labels' box (crop_to_labels) and its labels.
+  std::array<int64_t, 3> lo_{0, 0, 0}, dims_{0, 0, 0};
+  std::vector<int32_t> source_;
   std::vector<int32_t> present_;
   mutable std::vector<std::shared_ptr<const Distances>> cache_;
   mutable size_t cached_floats_ = 0;
@@ -331,6 +390,7 @@ absl::StatusOr<volume::LabelVolume> interpolate_thick_slices(const volume::Label
   // vanished, which has none), at most half a band a round and a band in
   // all, until every label has its voxels' volume to within a tenth of a
   // percent or the rounds run out; the best round's biases are kept.
+  std::fill(out, out + fine.geometry.voxel_count(), 0);
   const SliceInterpolator interpolator(volume, labels, cut);
   const auto& present = interpolator.present();
   std::vector<uint64_t> target = interpolator.source_counts();
