@@ -103,10 +103,11 @@ std::vector<int32_t> selected_labels(const volume::LabelVolume& volume,
 }
 
 // The weights of four slices at -1, 0, 1 and 2 for a place t (0 to 1) between
-// the middle two: a Catmull-Rom cubic, which passes through each slice and
-// bends smoothly from one to the next. Linear weights cut a thin shape's
-// distances down between its slices (rings 9 and 18 mm thick on 4 mm slices
-// fell outside the voxel tolerance); the cubic follows their curve.
+// the middle two: a Catmull-Rom cubic (Catmull and Rom, "A class of local
+// interpolating splines", 1974), which passes through each slice and bends
+// smoothly from one to the next. Linear weights cut a thin shape's distances
+// down between its slices, as a chord lies below its curve, and so thin
+// rings on thick slices; the cubic follows the curve.
 std::array<double, 4> catmull_rom_weights(double t) {
   const double t2 = t * t, t3 = t2 * t;
   return {0.5 * (-t3 + 2 * t2 - t), 0.5 * (3 * t3 - 5 * t2 + 2), 0.5 * (-3 * t3 + 4 * t2 + t),
@@ -172,14 +173,18 @@ class SliceInterpolator {
       const double t = position - i;
       if (held != i) {
         const auto slice = [&](int k) {
-          return distances(std::clamp<int64_t>(i - 1 + k, lo_[a_], lo_[a_] + dims_[a_] - 1) -
-                           lo_[a_]);
+          return std::clamp<int64_t>(i - 1 + k, lo_[a_], lo_[a_] + dims_[a_] - 1) - lo_[a_];
+        };
+        // At the box's ends a slice stands in for its missing neighbour:
+        // the same distances, computed once even when the cache is full.
+        const auto take = [&](int k) {
+          around[k] = k > 0 && slice(k) == slice(k - 1) ? around[k - 1] : distances(slice(k));
         };
         if (held >= 0 && held == i - 1) {
           std::rotate(around.begin(), around.begin() + 1, around.end());
-          around[3] = slice(3);
+          take(3);
         } else {
-          for (int k = 0; k < 4; ++k) around[k] = slice(k);
+          for (int k = 0; k < 4; ++k) take(k);
         }
         held = i;
       }

@@ -2,9 +2,9 @@
 // Thick slices (one voxel axis much coarser than the others, as in most 2D
 // MR and many CT series) cut into thinner ones by shape-based interpolation:
 // each label's signed distance within every slice, interpolated between
-// slice centres by a cubic through the four nearest, the largest one winning. A surface net on the
-// thinner grid can then slope between slices instead of stepping a whole
-// slice at once, which folds it.
+// slice centres by a cubic through the four nearest, the largest one
+// winning. A surface net on the thinner grid can then slope between slices
+// instead of stepping a whole slice at once, which folds it.
 // Reference: S. P. Raya and J. K. Udupa, "Shape-based interpolation of
 // multidimensional objects", IEEE Trans. Medical Imaging 9(1), 1990.
 #pragma once

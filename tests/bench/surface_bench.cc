@@ -10,7 +10,9 @@
 //              labels each pipeline keeps within the voxel tolerance.
 //   shares     the phantoms' axis-aligned area share beside the true shape's;
 // Usage: labelmesh_surface_bench [phantoms|shares|volumes|all] [ROUNDS] [FILE ...]
+#if __has_include(<malloc.h>)
 #include <malloc.h>
+#endif
 
 #include <algorithm>
 #include <atomic>

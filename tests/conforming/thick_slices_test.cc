@@ -121,11 +121,10 @@ TEST(ThickSlices, KeepEachSliceAndEachLabelsVolume) {
   const auto thick_volumes = label_volumes(thick);
   const auto fine_volumes = label_volumes(fine);
   ASSERT_EQ(fine_volumes.size(), 2u);
-  // Within a ring of thin voxels: the inner ball (8,600 thin voxels) gains
-  // or loses them a ring of 60-70 at a time.
-  for (int32_t label : {1, 2}) {
-    EXPECT_NEAR(fine_volumes.at(label) / thick_volumes.at(label), 1.0, 0.01) << "label " << label;
-  }
+  // The shell within 0.5 %; the inner ball (8,600 thin voxels) within a ring
+  // of thin voxels, as it gains or loses them 60-70 at a time.
+  EXPECT_NEAR(fine_volumes.at(1) / thick_volumes.at(1), 1.0, 0.01);
+  EXPECT_NEAR(fine_volumes.at(2) / thick_volumes.at(2), 1.0, 0.005);
 }
 
 TEST(ThickSlices, FollowTheShapeBetweenSlicesBetterThanTheSlicesDo) {
@@ -159,8 +158,8 @@ TEST(ThickSlices, AnyAxisCanBeThick) {
   const auto fine = interpolated(thick, cut);
   const auto thick_volumes = label_volumes(thick);
   const auto fine_volumes = label_volumes(fine);
-  for (int32_t label : {1, 2})
-    EXPECT_NEAR(fine_volumes.at(label) / thick_volumes.at(label), 1.0, 0.01);
+  EXPECT_NEAR(fine_volumes.at(1) / thick_volumes.at(1), 1.0, 0.01);
+  EXPECT_NEAR(fine_volumes.at(2) / thick_volumes.at(2), 1.0, 0.005);
 }
 
 TEST(ThickSlices, GiveAConformingMeshOfFiniteElementQuality) {
