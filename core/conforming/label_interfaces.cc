@@ -354,7 +354,7 @@ void smooth(const Stencil& stencil, const std::vector<Vec3>& centre, const Vec3&
   const size_t n = points.size();
   // Step s reads places[s % 2] and writes places[(s + 1) % 2]; an even
   // number of steps ends in the first.
-  std::vector<Lanes> now(n), boxes(n);
+  std::vector<Lanes> now(n), next(n), boxes(n);
   // Points without neighbours do not move: they keep their places exactly.
   std::vector<std::pair<uint32_t, Vec3>> fixed;
   for (size_t p = 0; p < n; ++p) {
@@ -366,7 +366,6 @@ void smooth(const Stencil& stencil, const std::vector<Vec3>& centre, const Vec3&
   // The double places are made again at the end, so that the lanes do not
   // add to the peak memory.
   std::vector<Vec3>().swap(points);
-  std::vector<Lanes> next(n);
   const Lanes half = to_lanes(half_box);
   const std::array<Lanes*, 2> places{now.data(), next.data()};
   const auto step_range = [&](int step, size_t begin, size_t end) {
