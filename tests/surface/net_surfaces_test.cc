@@ -3,6 +3,10 @@
 // manifold each, sharing their interfaces, judged against the voxels; and
 // the voxel figures the guard judges them by.
 #include <gtest/gtest.h>
+#include <vtkImageData.h>
+#include <vtkPointData.h>
+#include <vtkShortArray.h>
+#include <vtkSmartPointer.h>
 
 #include <algorithm>
 #include <cmath>
@@ -170,6 +174,46 @@ BothSurfaces both_surfaces(const volume::LabelVolume& v) {
   both.slicer = testing::slicer_like_surfaces(v, volume::compute_label_statistics(v), {1});
   both.result = run_pipeline_on_volume(v, MeshParams{}, {});
   return both;
+}
+
+// A rod three voxels across shrinks under smoothing; the volume step gives
+// its volume back whatever the label's value, negative ones included.
+TEST(NetSurfaces, ThinRodsKeepTheirVolumeWhateverTheLabelValue) {
+  const auto rod = [](int16_t value) {
+    volume::LabelVolume v;
+    v.geometry.dims = {36, 9, 9};
+    auto labels = vtkSmartPointer<vtkShortArray>::New();
+    labels->SetNumberOfTuples(36 * 9 * 9);
+    int64_t n = 0;
+    for (int k = 0; k < 9; ++k)
+      for (int j = 0; j < 9; ++j)
+        for (int i = 0; i < 36; ++i) {
+          const bool in = i >= 3 && i < 33 && j >= 3 && j < 6 && k >= 3 && k < 6;
+          labels->SetValue(n++, in ? value : int16_t{0});
+        }
+    v.voxels = vtkSmartPointer<vtkImageData>::New();
+    v.voxels->SetDimensions(36, 9, 9);
+    v.voxels->GetPointData()->SetScalars(labels);
+    return v;
+  };
+  std::vector<double> volumes;
+  for (const int16_t value : {int16_t{5}, int16_t{-5}}) {
+    const auto volume = rod(value);
+    const auto cut = conforming::net_label_surface(smoothed_net(volume), value, volume.geometry);
+    ASSERT_FALSE(cut.mesh.triangles.empty()) << value;
+    volumes.push_back(surface::signed_volume(cut.mesh));
+  }
+  // 30 x 3 x 3 voxels of 1 mm.
+  EXPECT_NEAR(volumes[0] / 270, 1, 0.03);
+  EXPECT_DOUBLE_EQ(volumes[1], volumes[0]);
+  // Without the volume step the rod is smaller by more than that.
+  auto params = net_interface_params(NetOptions{});
+  params.restore_volumes = false;
+  conforming::InterfaceFigures figures;
+  const auto volume = rod(-5);
+  const auto shrunk = conforming::net_label_surface(
+      conforming::label_interfaces(volume, {}, params, figures), -5, volume.geometry);
+  EXPECT_LT(surface::signed_volume(shrunk.mesh), 0.97 * 270);
 }
 
 TEST(NetSurfaces, NestedLabelsShareTheirInterfacesWithoutOverlap) {
