@@ -37,24 +37,9 @@ struct PaddedLabels {
 PaddedLabels padded_labels(const volume::LabelVolume& volume, std::vector<int32_t> selected) {
   std::sort(selected.begin(), selected.end());
   const auto& dims = volume.geometry.dims;
-  // Asked for every voxel: a table over the selected labels' range where it
-  // is small (as label values are), else a search.
-  constexpr int64_t kLargestTable = int64_t{1} << 20;
-  const int32_t least = selected.empty() ? 0 : selected.front();
-  const int64_t range = selected.empty() ? 0 : int64_t{selected.back()} - least + 1;
-  std::vector<uint8_t> table;
-  if (range <= kLargestTable) {
-    table.assign(static_cast<size_t>(range), 0);
-    for (int32_t label : selected) table[static_cast<size_t>(label - least)] = 1;
-  }
   const auto chosen = [&](int32_t label) {
-    if (label == kOutside) return false;
-    if (selected.empty()) return true;
-    if (!table.empty()) {
-      const int64_t slot = int64_t{label} - least;
-      return slot >= 0 && slot < range && table[static_cast<size_t>(slot)] != 0;
-    }
-    return std::binary_search(selected.begin(), selected.end(), label);
+    return label != kOutside &&
+           (selected.empty() || std::binary_search(selected.begin(), selected.end(), label));
   };
   // The selected voxels' box, in volume indices.
   std::array<int64_t, 3> lo{dims[0], dims[1], dims[2]}, hi{-1, -1, -1};
@@ -256,10 +241,6 @@ void add_quads(const PaddedLabels& labels, const std::vector<VoxelPair>& pairs, 
                Net& net) {
   const std::array<uint64_t, 3> stride{1, static_cast<uint64_t>(labels.dims[0]),
                                        static_cast<uint64_t>(labels.dims[0] * labels.dims[1])};
-  net.quads.clear();
-  net.quad_sides.clear();
-  net.quad_axis.clear();
-  net.quad_voxels.clear();
   for (const auto& pair : pairs) {
     const auto voxel = pair.voxel();
     const auto axis = static_cast<int>(pair.axis);
@@ -363,8 +344,8 @@ void smooth(const Stencil& stencil, const std::vector<Vec3>& centre, const Vec3&
     if (stencil.start[p] == stencil.start[p + 1])
       fixed.emplace_back(static_cast<uint32_t>(p), points[p]);
   }
-  // The double places are made again at the end, so that the lanes do not
-  // add to the peak memory.
+  // The double places are let go while the lanes are in use and made again
+  // at the end.
   std::vector<Vec3>().swap(points);
   const Lanes half = to_lanes(half_box);
   const std::array<Lanes*, 2> places{now.data(), next.data()};

@@ -37,10 +37,6 @@ double smallest_angle_cosine(const Edge& pq, const Edge& qr, const Edge& pr) {
                    corner_cosine(reversed(pr), reversed(qr))});
 }
 
-double smallest_angle_cosine(const Vec3& p, const Vec3& q, const Vec3& r) {
-  return smallest_angle_cosine(edge(p, q), edge(q, r), edge(p, r));
-}
-
 // The quads around each point, as offsets into one list.
 struct QuadsAround {
   std::vector<uint32_t> start;
@@ -77,12 +73,8 @@ void resplit_quad(InterfaceSurface& surface, uint32_t t) {
   uint32_t y = second[0];
   for (const uint32_t corner : second)
     if (corner != u && corner != v) y = corner;
-  const auto& at = surface.points;
-  const double now = std::max(smallest_angle_cosine(at[u], at[v], at[x]),
-                              smallest_angle_cosine(at[v], at[u], at[y]));
-  const double other = std::max(smallest_angle_cosine(at[u], at[y], at[x]),
-                                smallest_angle_cosine(at[y], at[v], at[x]));
-  if (other >= now) return;
+  // Split along u-v, the quad's 0-2 diagonal, as now; else along y-x.
+  if (best_quad_split({u, y, v, x}, surface.points).along_02) return;
   first = {u, y, x};
   second = {y, v, x};
 }
