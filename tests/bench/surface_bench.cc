@@ -204,25 +204,39 @@ struct VolumeFigures {
   int ours_poisson = 0;
 };
 
+// A volume file read, with its labels (every one, in statistics order).
+struct ReadVolume {
+  volume::LabelVolume volume;
+  volume::VolumeStatistics statistics;
+  std::vector<int32_t> labels;
+};
+
+std::optional<ReadVolume> read_volume(const std::string& path) {
+  auto volume = volume::read_label_volume(path, {}, RunContext{});
+  if (!volume.ok()) return std::nullopt;
+  ReadVolume read{std::move(*volume), {}, {}};
+  read.statistics = volume::compute_label_statistics(read.volume);
+  for (const auto& l : read.statistics.labels) read.labels.push_back(l.label);
+  return read;
+}
+
 // Our surfaces without the guard's checks: the file read, the shared net
 // built and smoothed as the pipeline does by default, and every label cut
 // out of it, on two threads as the pipeline's are.
 // On the volume's own grid: where the pipeline first cuts thick slices
 // thinner, this leaves that step out.
 void our_surfaces_alone(const std::string& path) {
-  auto volume = volume::read_label_volume(path, {}, RunContext{});
-  if (!volume.ok()) return;
-  const auto statistics = volume::compute_label_statistics(*volume);
-  std::vector<int32_t> labels;
-  for (const auto& l : statistics.labels) labels.push_back(l.label);
+  const auto read = read_volume(path);
+  if (!read) return;
+  const auto& labels = read->labels;
   conforming::InterfaceFigures figures;
-  const auto net = conforming::label_interfaces(*volume, labels,
+  const auto net = conforming::label_interfaces(read->volume, labels,
                                                 net_interface_params(our_params().net), figures);
   // Each thread takes the next label in turn, as the pipeline's do.
   std::atomic<size_t> next{0};
   const auto cut = [&] {
     for (size_t i = next++; i < labels.size(); i = next++)
-      (void)conforming::net_label_surface(net, labels[i], volume->geometry);
+      (void)conforming::net_label_surface(net, labels[i], read->volume.geometry);
   };
   side_by_side(cut, cut);
 }
@@ -238,12 +252,9 @@ int bench_volume(const std::string& path, int rounds) {
     ours_s.push_back(seconds_of([&] { result = run_pipeline(path, our_params(), RunContext{}); }));
     alone_s.push_back(seconds_of([&] { our_surfaces_alone(path); }));
     slicer_s.push_back(seconds_of([&] {
-      auto volume = volume::read_label_volume(path, {}, RunContext{});
-      if (!volume.ok()) return;
-      const auto statistics = volume::compute_label_statistics(*volume);
-      std::vector<int32_t> labels;
-      for (const auto& l : statistics.labels) labels.push_back(l.label);
-      slicer = testing::slicer_like_surfaces(*volume, statistics, labels);
+      const auto read = read_volume(path);
+      if (read)
+        slicer = testing::slicer_like_surfaces(read->volume, read->statistics, read->labels);
     }));
   }
   if (!result.ok()) {
@@ -273,16 +284,16 @@ int bench_volume(const std::string& path, int rounds) {
   std::printf("\n");
 
   // The Slicer-like surfaces measured as ours are, against the voxels.
-  auto volume = volume::read_label_volume(path, {}, RunContext{});
-  if (!volume.ok()) return 1;
-  const auto statistics = volume::compute_label_statistics(*volume);
+  const auto read = read_volume(path);
+  if (!read) return 1;
+  const auto& volume = read->volume;
+  const auto& statistics = read->statistics;
+  const auto& labels = read->labels;
   conforming::InterfaceParams flat;
   flat.smoothing_rounds = 0;
   flat.subdivide_thick_quads = false;
   conforming::InterfaceFigures figures;
-  std::vector<int32_t> labels;
-  for (const auto& l : statistics.labels) labels.push_back(l.label);
-  const auto staircase = conforming::label_interfaces(*volume, labels, flat, figures);
+  const auto staircase = conforming::label_interfaces(volume, labels, flat, figures);
   VolumeFigures f;
   for (size_t i = 0; i < labels.size() && i < slicer.size(); ++i) {
     const auto* label = statistics.find(labels[i]);
@@ -305,11 +316,11 @@ int bench_volume(const std::string& path, int rounds) {
                                    surface::SurfaceFormat::kStl);
       (void)surface::write_surface(ours->mesh, stem + "-ours.stl", surface::SurfaceFormat::kStl);
     }
-    auto slicer_voxels = surface::measure_voxel_fidelity(slicer[i].mesh, *volume, *label, {});
+    auto slicer_voxels = surface::measure_voxel_fidelity(slicer[i].mesh, volume, *label, {});
     if (!slicer_voxels.ok()) continue;
-    const auto cut = conforming::net_label_surface(staircase, labels[i], volume->geometry);
+    const auto cut = conforming::net_label_surface(staircase, labels[i], volume.geometry);
     slicer_voxels->hausdorff_voxels = surface::sampled_hausdorff_voxels(
-        slicer[i].mesh, cut.staircase, volume->geometry, RunContext{});
+        slicer[i].mesh, cut.staircase, volume.geometry, RunContext{});
     f.slicer_misclassified.push_back(100 * slicer_voxels->misclassified_fraction());
     f.slicer_hausdorff.push_back(slicer_voxels->hausdorff_voxels);
     f.slicer_volume.push_back(100 * std::abs(slicer_voxels->volume_change));
