@@ -2,24 +2,23 @@
 #include "core/conforming/label_interfaces.h"
 
 #include <algorithm>
-#include <barrier>
-#include <bit>
 #include <chrono>
 #include <cmath>
 #include <unordered_map>
 #include <utility>
 
+#include "core/conforming/constrained_smoothing.h"
+#include "core/conforming/marked_cubes.h"
 #include "core/conforming/widen_small_angles.h"
 #include "core/util/side_by_side.h"
 #include "core/util/vec3.h"
 #include "core/volume/voxel_access.h"
+#include "core/volume/voxel_box.h"
 
 namespace labelmesh::conforming {
 namespace {
 
 using geometry::Vec3;
-
-constexpr uint32_t kNoPoint = UINT32_MAX;
 
 // The selected labels' box of the volume with a ring of outside voxels
 // around it, so every surface closes.
@@ -41,31 +40,25 @@ PaddedLabels padded_labels(const volume::LabelVolume& volume, std::vector<int32_
     return label != kOutside &&
            (selected.empty() || std::binary_search(selected.begin(), selected.end(), label));
   };
-  // The selected voxels' box, in volume indices.
-  std::array<int64_t, 3> lo{dims[0], dims[1], dims[2]}, hi{-1, -1, -1};
+  volume::VoxelBox box;
   volume::visit_voxels(volume.voxels, [&](const auto* voxels, size_t count) {
     if (count != static_cast<size_t>(dims[0] * dims[1] * dims[2])) return;
-    size_t i = 0;
-    for (int64_t z = 0; z < dims[2]; ++z)
-      for (int64_t y = 0; y < dims[1]; ++y)
-        for (int64_t x = 0; x < dims[0]; ++x, ++i) {
-          if (!chosen(static_cast<int32_t>(voxels[i]))) continue;
-          const std::array<int64_t, 3> p{x, y, z};
-          for (int a = 0; a < 3; ++a) {
-            lo[a] = std::min(lo[a], p[a]);
-            hi[a] = std::max(hi[a], p[a]);
-          }
-        }
+    box = volume::voxel_box(voxels, dims,
+                            [&](auto label) { return chosen(static_cast<int32_t>(label)); });
   });
   PaddedLabels padded;
-  if (hi[0] < 0) lo = hi = {0, 0, 0};
+  // With no selected voxel, a ring around one outside voxel.
+  const bool none = box.empty();
+  if (none) box.last = box.first;
+  const auto& lo = box.first;
+  const auto& hi = box.last;
   for (int a = 0; a < 3; ++a) {
     padded.first[a] = lo[a] - 1;
     padded.dims[a] = hi[a] - lo[a] + 3;
   }
   padded.labels.assign(static_cast<size_t>(padded.dims[0] * padded.dims[1] * padded.dims[2]),
                        kOutside);
-  if (hi[0] < 0) return padded;
+  if (none) return padded;
   volume::visit_voxels(volume.voxels, [&](const auto* voxels, size_t count) {
     if (count != static_cast<size_t>(dims[0] * dims[1] * dims[2])) return;
     for (int64_t z = lo[2]; z <= hi[2]; ++z) {
@@ -82,61 +75,6 @@ PaddedLabels padded_labels(const volume::LabelVolume& volume, std::vector<int32_
   });
   return padded;
 }
-
-// The cubes between voxel centres: cube (a, b, c) has the padded voxels
-// (a..a+1, b..b+1, c..c+1) as corners. The cubes with a point are marked
-// and their points numbered in cube index order, so a cube's point is the
-// count of marked cubes before it: one bit per cube and a running count per
-// 64 cubes, a twentieth of the memory of a point number per cube.
-class Cubes {
- public:
-  explicit Cubes(const std::array<int64_t, 3>& dims)
-      : dims_(dims), marked_((static_cast<size_t>(dims[0] * dims[1] * dims[2]) + 63) / 64, 0) {}
-
-  const std::array<int64_t, 3>& dims() const { return dims_; }
-  size_t index(int64_t a, int64_t b, int64_t c) const {
-    return static_cast<size_t>((c * dims_[1] + b) * dims_[0] + a);
-  }
-  std::array<int64_t, 3> cube(size_t index) const {
-    const auto i = static_cast<int64_t>(index);
-    return {i % dims_[0], (i / dims_[0]) % dims_[1], i / (dims_[0] * dims_[1])};
-  }
-
-  void mark(size_t index) { marked_[index / 64] |= uint64_t{1} << (index % 64); }
-  // Numbers the marked cubes; after this `point` answers.
-  void number() {
-    before_.resize(marked_.size());
-    uint32_t count = 0;
-    for (size_t w = 0; w < marked_.size(); ++w) {
-      before_[w] = count;
-      count += static_cast<uint32_t>(std::popcount(marked_[w]));
-    }
-    points_ = count;
-  }
-  size_t points() const { return points_; }
-  // The cube's point, or kNoPoint.
-  uint32_t point(size_t index) const {
-    const uint64_t word = marked_[index / 64];
-    const uint64_t bit = uint64_t{1} << (index % 64);
-    if ((word & bit) == 0) return kNoPoint;
-    return before_[index / 64] + static_cast<uint32_t>(std::popcount(word & (bit - 1)));
-  }
-  // visit(cube index, point) for every marked cube, in index order.
-  template <typename Visit>
-  void for_each_point(Visit&& visit) const {
-    for (size_t w = 0; w < marked_.size(); ++w) {
-      uint32_t p = before_[w];
-      for (uint64_t word = marked_[w]; word != 0; word &= word - 1, ++p)
-        visit(64 * w + static_cast<size_t>(std::countr_zero(word)), p);
-    }
-  }
-
- private:
-  std::array<int64_t, 3> dims_;
-  std::vector<uint64_t> marked_;  // bit i % 64 of word i / 64: cube i has a point
-  std::vector<uint32_t> before_;  // marked cubes in the words before
-  size_t points_ = 0;
-};
 
 struct Net {
   // Positions in scaled voxel space: index times spacing, mm along each axis.
@@ -207,7 +145,7 @@ constexpr std::array<std::array<int, 2>, 4> kQuadOffsets{{{1, 1}, {0, 1}, {0, 0}
 // The net's points, one per cube whose corners hold more than one label,
 // numbered in cube index order.
 Net net_points(const PaddedLabels& labels, const std::array<double, 3>& spacing,
-               const std::vector<VoxelPair>& pairs, Cubes& cubes) {
+               const std::vector<VoxelPair>& pairs, MarkedCubes& cubes) {
   // A cube's corners hold more than one label exactly when one of its edges
   // joins two different labels, and every such edge's quad uses the four
   // cubes around it: mark those, then number them in index order.
@@ -237,8 +175,8 @@ Net net_points(const PaddedLabels& labels, const std::array<double, 3>& spacing,
 // One quad per pair of face neighbours with different labels, wound so its
 // normal points from the first voxel to the second: the four cubes around
 // their common axis, counter-clockwise seen from the second voxel.
-void add_quads(const PaddedLabels& labels, const std::vector<VoxelPair>& pairs, const Cubes& cubes,
-               Net& net) {
+void add_quads(const PaddedLabels& labels, const std::vector<VoxelPair>& pairs,
+               const MarkedCubes& cubes, Net& net) {
   const std::array<uint64_t, 3> stride{1, static_cast<uint64_t>(labels.dims[0]),
                                        static_cast<uint64_t>(labels.dims[0] * labels.dims[1])};
   for (const auto& pair : pairs) {
@@ -258,19 +196,11 @@ void add_quads(const PaddedLabels& labels, const std::vector<VoxelPair>& pairs, 
   }
 }
 
-// Neighbours each point averages over: every neighbour on a patch between
-// two labels; on a junction curve, only its two neighbours on the curve.
-// Points where curves meet or end have none and stay fixed.
-struct Stencil {
-  std::vector<uint32_t> start;  // CSR offsets, one past the last point
-  std::vector<uint32_t> neighbours;
-};
-
 // Two points are neighbours when their cubes share a face whose four voxels
 // do not all hold one label: a quad then has both as consecutive corners.
 // The six directions in this order give each point's neighbours in
 // increasing index, as the points are numbered in cube index order.
-Stencil smoothing_stencil(const Net& net, const PaddedLabels& labels, const Cubes& cubes,
+Stencil smoothing_stencil(const Net& net, const PaddedLabels& labels, const MarkedCubes& cubes,
                           InterfaceFigures& figures) {
   constexpr std::array<std::array<int, 2>, 6> kDirections{
       {{2, -1}, {1, -1}, {0, -1}, {0, 1}, {1, 1}, {2, 1}}};  // axis, sign
@@ -314,99 +244,6 @@ Stencil smoothing_stencil(const Net& net, const PaddedLabels& labels, const Cube
   });
   stencil.start[n] = static_cast<uint32_t>(stencil.neighbours.size());
   return stencil;
-}
-
-// Below this many points one thread smooths faster than two start.
-constexpr size_t kThreadedSmoothingPoints = 20'000;
-
-// A point's three coordinates and a spare in single precision: one step's
-// sums and clamps are a few vector operations, on two thirds of the memory.
-// Single precision holds a place 500 mm from the origin to 0.00003 mm; after
-// all the rounds the points lie within 0.001 mm of the double-precision
-// ones on the DICOM slab.
-using Lanes = float __attribute__((vector_size(16)));
-
-Lanes to_lanes(const Vec3& v) {
-  return Lanes{static_cast<float>(v[0]), static_cast<float>(v[1]), static_cast<float>(v[2]), 0};
-}
-
-void smooth(const Stencil& stencil, const std::vector<Vec3>& centre, const Vec3& half_box,
-            const InterfaceParams& params, std::vector<Vec3>& points) {
-  const size_t n = points.size();
-  // Step s reads places[s % 2] and writes places[(s + 1) % 2]; an even
-  // number of steps ends in the first.
-  std::vector<Lanes> now(n), next(n), boxes(n);
-  // Points without neighbours do not move: they keep their places exactly.
-  std::vector<std::pair<uint32_t, Vec3>> fixed;
-  for (size_t p = 0; p < n; ++p) {
-    now[p] = to_lanes(points[p]);
-    boxes[p] = to_lanes(centre[p]);
-    if (stencil.start[p] == stencil.start[p + 1])
-      fixed.emplace_back(static_cast<uint32_t>(p), points[p]);
-  }
-  // The double places are let go while the lanes are in use and made again
-  // at the end.
-  std::vector<Vec3>().swap(points);
-  const Lanes half = to_lanes(half_box);
-  const std::array<Lanes*, 2> places{now.data(), next.data()};
-  const auto step_range = [&](int step, size_t begin, size_t end) {
-    const auto factor =
-        static_cast<float>(step % 2 == 0 ? params.shrink_step : params.inflate_step);
-    const uint32_t* __restrict start = stencil.start.data();
-    const uint32_t* __restrict neighbours = stencil.neighbours.data();
-    const Lanes* __restrict box = boxes.data();
-    const Lanes* __restrict from = places[step % 2];
-    Lanes* __restrict to = places[(step + 1) % 2];
-    for (size_t p = begin; p < end; ++p) {
-      const uint32_t first = start[p];
-      const uint32_t last = start[p + 1];
-      if (first == last) {
-        to[p] = from[p];
-        continue;
-      }
-      Lanes sum{0, 0, 0, 0};
-      // Most points have four neighbours: a branch that predicts well.
-      if (last - first == 4) {
-        sum = (from[neighbours[first]] + from[neighbours[first + 1]]) +
-              (from[neighbours[first + 2]] + from[neighbours[first + 3]]);
-        sum *= 0.25f;
-      } else {
-        for (uint32_t i = first; i < last; ++i) sum += from[neighbours[i]];
-        sum *= 1.0f / static_cast<float>(last - first);
-      }
-      const Lanes at = from[p];
-      Lanes moved = at + factor * (sum - at);
-      const Lanes lo = box[p] - half, hi = box[p] + half;
-      moved = moved < lo ? lo : moved;
-      to[p] = hi < moved ? hi : moved;
-    }
-  };
-  const int steps = 2 * params.smoothing_rounds;
-  if (n < kThreadedSmoothingPoints) {
-    for (int s = 0; s < steps; ++s) step_range(s, 0, n);
-  } else {
-    // Each point's next place reads only the current places: two threads
-    // share the points for the whole run and meet after every step, with
-    // the same result as one.
-    std::barrier<> stepped(2);
-    const auto run_half = [&](size_t begin, size_t end) {
-      for (int s = 0; s < steps; ++s) {
-        step_range(s, begin, end);
-        stepped.arrive_and_wait();
-      }
-    };
-    side_by_side([&] { run_half(n / 2, n); }, [&] { run_half(0, n / 2); });
-  }
-  std::vector<Lanes>().swap(next);
-  std::vector<Lanes>().swap(boxes);
-  // Back in double precision, held in the boxes as the double sums would be
-  // (a single-precision clamp can leave a point a rounding outside).
-  points.resize(n);
-  for (size_t p = 0; p < n; ++p)
-    for (int k = 0; k < 3; ++k)
-      points[p][k] = std::clamp(static_cast<double>(now[p][k]), centre[p][k] - half_box[k],
-                                centre[p][k] + half_box[k]);
-  for (const auto& [p, place] : fixed) points[p] = place;
 }
 
 // Each quad's two sides as slots into one sorted list of the net's labels,
@@ -594,7 +431,7 @@ InterfaceSurface label_interfaces(const volume::LabelVolume& volume,
   figures = InterfaceFigures{};
   const auto& geometry = volume.geometry;
   PaddedLabels padded = padded_labels(volume, labels);
-  Cubes cubes({padded.dims[0] - 1, padded.dims[1] - 1, padded.dims[2] - 1});
+  MarkedCubes cubes({padded.dims[0] - 1, padded.dims[1] - 1, padded.dims[2] - 1});
   Net net;
   Stencil stencil;
   {
@@ -619,7 +456,7 @@ InterfaceSurface label_interfaces(const volume::LabelVolume& volume,
                       half * geometry.spacing[1] * params.box_scale[1],
                       half * geometry.spacing[2] * params.box_scale[2]};
   std::vector<Vec3> points = net.centre;
-  smooth(stencil, net.centre, half_box, params, points);
+  smooth_in_boxes(stencil, net.centre, half_box, params, points);
   if (params.restore_volumes) restore_volumes(net, net.centre, half_box, points);
   std::vector<Vec3> before_widening;
   // Widened nets keep two triangles per quad (the take-back splits quads

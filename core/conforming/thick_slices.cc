@@ -13,6 +13,7 @@
 #include "core/util/status_macros.h"
 #include "core/util/text.h"
 #include "core/volume/voxel_access.h"
+#include "core/volume/voxel_box.h"
 
 namespace labelmesh::conforming {
 namespace {
@@ -240,19 +241,11 @@ class SliceInterpolator {
   // thinner voxel is 0, as it would be from the whole volume.
   void crop_to_labels(const std::vector<int32_t>& all) {
     const auto& dims = geometry_.dims;
-    std::array<int64_t, 3> first{dims[0], dims[1], dims[2]}, last{-1, -1, -1};
-    size_t i = 0;
-    for (int64_t z = 0; z < dims[2]; ++z)
-      for (int64_t y = 0; y < dims[1]; ++y)
-        for (int64_t x = 0; x < dims[0]; ++x, ++i) {
-          if (all[i] == 0) continue;
-          const std::array<int64_t, 3> p{x, y, z};
-          for (int k = 0; k < 3; ++k) {
-            first[k] = std::min(first[k], p[k]);
-            last[k] = std::max(last[k], p[k]);
-          }
-        }
-    if (last[0] < 0) first = last = {0, 0, 0};
+    auto box = volume::voxel_box(all.data(), dims, [](int32_t label) { return label != 0; });
+    // With no label, a voxel's box: margins as around one.
+    if (box.empty()) box.last = box.first;
+    const auto& first = box.first;
+    const auto& last = box.last;
     for (int k = 0; k < 3; ++k) {
       const auto margin =
           k == a_ ? int64_t{2}

@@ -1,0 +1,32 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// Taubin smoothing of the surface net's points, each step holding every
+// point in a box around its staircase position (Frisken's constrained
+// smoothing).
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "core/conforming/label_interfaces.h"
+#include "core/util/vec3.h"
+
+namespace labelmesh::conforming {
+
+// Neighbours each point averages over: every neighbour on a patch between
+// two labels; on a junction curve, only its two neighbours on the curve.
+// Points where curves meet or end have none and stay fixed.
+struct Stencil {
+  std::vector<uint32_t> start;  // CSR offsets, one past the last point
+  std::vector<uint32_t> neighbours;
+};
+
+// params.smoothing_rounds rounds of a shrink_step and an inflate_step, each
+// point moving towards the mean of its stencil neighbours and held within
+// centre[p] +- half_box along each axis. Points without neighbours stay
+// exactly where they are. Two threads share large nets; the result is the
+// same as one thread's.
+void smooth_in_boxes(const Stencil& stencil, const std::vector<geometry::Vec3>& centre,
+                     const geometry::Vec3& half_box, const InterfaceParams& params,
+                     std::vector<geometry::Vec3>& points);
+
+}  // namespace labelmesh::conforming
