@@ -29,8 +29,10 @@ Lanes to_lanes(const Vec3& v) {
 
 }  // namespace
 
-void smooth_in_boxes(const Stencil& stencil, const std::vector<Vec3>& centre, const Vec3& half_box,
-                     const InterfaceParams& params, std::vector<Vec3>& points) {
+void smooth_in_boxes(const Stencil& stencil, const std::vector<Vec3>& centre,
+                     const PointBoxes& point_boxes, const InterfaceParams& params,
+                     std::vector<Vec3>& points) {
+  const Vec3& half_box = point_boxes.half;
   const size_t n = points.size();
   // Step s reads places[s % 2] and writes places[(s + 1) % 2]; an even
   // number of steps ends in the first.
@@ -47,6 +49,10 @@ void smooth_in_boxes(const Stencil& stencil, const std::vector<Vec3>& centre, co
   // at the end.
   std::vector<Vec3>().swap(points);
   const Lanes half = to_lanes(half_box);
+  const int drawn = point_boxes.drawn_axis;
+  const auto drawn_first = static_cast<float>(point_boxes.drawn_first);
+  const auto drawn_spacing = static_cast<float>(point_boxes.drawn_spacing);
+  const Lanes widening = to_lanes(point_boxes.widening);
   const std::array<Lanes*, 2> places{now.data(), next.data()};
   const auto step_range = [&](int step, size_t begin, size_t end) {
     const auto factor =
@@ -75,7 +81,14 @@ void smooth_in_boxes(const Stencil& stencil, const std::vector<Vec3>& centre, co
       }
       const Lanes at = from[p];
       Lanes moved = at + factor * (sum - at);
-      const Lanes lo = box[p] - half, hi = box[p] + half;
+      Lanes width = half;
+      if (drawn >= 0) {
+        // Along the drawn axis first: the width across follows from there.
+        const float along =
+            std::clamp(moved[drawn], box[p][drawn] - half[drawn], box[p][drawn] + half[drawn]);
+        width += between_drawn(along, drawn_first, drawn_spacing) * widening;
+      }
+      const Lanes lo = box[p] - width, hi = box[p] + width;
       moved = moved < lo ? lo : moved;
       to[p] = hi < moved ? hi : moved;
     }
@@ -102,9 +115,9 @@ void smooth_in_boxes(const Stencil& stencil, const std::vector<Vec3>& centre, co
   // (a single-precision clamp can leave a point a rounding outside).
   points.resize(n);
   for (size_t p = 0; p < n; ++p)
-    for (int k = 0; k < 3; ++k)
-      points[p][k] = std::clamp(static_cast<double>(now[p][k]), centre[p][k] - half_box[k],
-                                centre[p][k] + half_box[k]);
+    points[p] =
+        point_boxes.hold(centre[p], {static_cast<double>(now[p][0]), static_cast<double>(now[p][1]),
+                                     static_cast<double>(now[p][2])});
   for (const auto& [p, place] : fixed) points[p] = place;
 }
 

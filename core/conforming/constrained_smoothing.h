@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "core/conforming/label_interfaces.h"
+#include "core/conforming/point_boxes.h"
 #include "core/util/vec3.h"
 
 namespace labelmesh::conforming {
@@ -21,12 +22,11 @@ struct Stencil {
 };
 
 // params.smoothing_rounds rounds of a shrink_step and an inflate_step, each
-// point moving towards the mean of its stencil neighbours and held within
-// centre[p] +- half_box along each axis. Points without neighbours stay
-// exactly where they are. Two threads share large nets; the result is the
-// same as one thread's.
+// point moving towards the mean of its stencil neighbours and held in its
+// box around centre[p]. Points without neighbours stay exactly where they
+// are. Two threads share large nets; the result is the same as one thread's.
 void smooth_in_boxes(const Stencil& stencil, const std::vector<geometry::Vec3>& centre,
-                     const geometry::Vec3& half_box, const InterfaceParams& params,
+                     const PointBoxes& boxes, const InterfaceParams& params,
                      std::vector<geometry::Vec3>& points);
 
 }  // namespace labelmesh::conforming

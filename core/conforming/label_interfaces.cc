@@ -285,12 +285,31 @@ std::vector<double> label_volumes(const Net& net, const SideSlots& slots,
   return volume;
 }
 
+// Each point's box: cube_fraction of half a voxel along each axis (scaled
+// by box_scale), wider between drawn slices on a grid cut into thinner ones.
+PointBoxes point_boxes(const volume::ImageGeometry& geometry, const InterfaceParams& params) {
+  const auto& spacing = geometry.spacing;
+  PointBoxes boxes;
+  for (int k = 0; k < 3; ++k)
+    boxes.half[k] = 0.5 * params.cube_fraction * spacing[k] * params.box_scale[k];
+  const int a = params.drawn_axis;
+  if (a < 0 || params.between_drawn_widening <= 0) return boxes;
+  boxes.drawn_axis = a;
+  boxes.drawn_spacing = spacing[a] * params.drawn_parts;
+  // Thin slice j's centre lies at j times its spacing; drawn slice k's at
+  // thin slice (k + 1/2) parts - 1/2.
+  boxes.drawn_first = 0.5 * (boxes.drawn_spacing - spacing[a]);
+  for (int k = 0; k < 3; ++k)
+    if (k != a) boxes.widening[k] = params.between_drawn_widening * spacing[k];
+  return boxes;
+}
+
 // Moves the points where only one label meets the outside along their
 // normal, by the label's lost volume over its area there, so each label
 // keeps its voxels' volume where smoothing shrank it (thin labels most):
 // interfaces between labels stay where smoothing put them. Points stay in
 // their boxes.
-void restore_volumes(const Net& net, const std::vector<Vec3>& centre, const Vec3& half_box,
+void restore_volumes(const Net& net, const std::vector<Vec3>& centre, const PointBoxes& boxes,
                      std::vector<Vec3>& points) {
   const SideSlots slots = side_slots(net);
   const auto outside = static_cast<uint32_t>(
@@ -337,9 +356,7 @@ void restore_volumes(const Net& net, const std::vector<Vec3>& centre, const Vec3
       const double length = geometry::norm(normal[p]);
       if (length == 0 || area[label] == 0) continue;
       const Vec3 step = geometry::scale(normal[p], lost / area[label] / length);
-      for (int k = 0; k < 3; ++k)
-        points[p][k] = std::clamp(points[p][k] + step[k], centre[p][k] - half_box[k],
-                                  centre[p][k] + half_box[k]);
+      points[p] = boxes.hold(centre[p], geometry::add(points[p], step));
     }
   }
 }
@@ -452,12 +469,10 @@ InterfaceSurface label_interfaces(const volume::LabelVolume& volume,
   std::vector<int32_t>().swap(padded.labels);
 
   const double half = 0.5 * params.cube_fraction;
-  const Vec3 half_box{half * geometry.spacing[0] * params.box_scale[0],
-                      half * geometry.spacing[1] * params.box_scale[1],
-                      half * geometry.spacing[2] * params.box_scale[2]};
+  const PointBoxes boxes = point_boxes(geometry, params);
   std::vector<Vec3> points = net.centre;
-  smooth_in_boxes(stencil, net.centre, half_box, params, points);
-  if (params.restore_volumes) restore_volumes(net, net.centre, half_box, points);
+  smooth_in_boxes(stencil, net.centre, boxes, params, points);
+  if (params.restore_volumes) restore_volumes(net, net.centre, boxes, points);
   std::vector<Vec3> before_widening;
   // Widened nets keep two triangles per quad (the take-back splits quads
   // again), so a net cut into smaller quads is not widened.
@@ -478,7 +493,7 @@ InterfaceSurface label_interfaces(const volume::LabelVolume& volume,
     // Across the surface by a quarter of the grid's own voxel.
     const Vec3 across{0.5 * half * geometry.spacing[0], 0.5 * half * geometry.spacing[1],
                       0.5 * half * geometry.spacing[2]};
-    const auto widened = widen_small_angles(net.quads, net.quad_sides, slides, net.centre, half_box,
+    const auto widened = widen_small_angles(net.quads, net.quad_sides, slides, net.centre, boxes,
                                             across, params.widen_angles_below_deg, points);
     figures.widened_points = widened.points_moved;
   }

@@ -39,6 +39,16 @@ struct InterfaceParams {
   // The box along each axis is this many times cube_fraction's (a grid cut
   // into thinner slices may let its points move as far as the thick ones').
   std::array<double, 3> box_scale{1, 1, 1};
+  // On a grid cut into thinner slices (thick_slices.h): the axis cut, -1 for
+  // none, and into how many parts. Between two drawn slices the thinner
+  // slices' pixels are interpolated, not drawn: a point may move beyond its
+  // box across the axis by up to this fraction of the voxel, more the
+  // farther it lies from the nearest drawn slice (none on or near one, all
+  // of it midway; point_boxes.h), so the interpolation's pixel steps do not
+  // stay as ridges.
+  int drawn_axis = -1;
+  int drawn_parts = 1;
+  double between_drawn_widening = 0;
   // After smoothing, move the points of quads whose triangles have an angle
   // below this many degrees inside their boxes where that widens the angle
   // (widen_small_angles.h); 0: leave them. Not with subdivide_thick_quads.

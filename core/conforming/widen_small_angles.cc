@@ -95,7 +95,7 @@ QuadSplit best_quad_split(const std::array<uint32_t, 4>& quad, const std::vector
 WidenedAngles widen_small_angles(const std::vector<std::array<uint32_t, 4>>& quads,
                                  const std::vector<std::array<int32_t, 2>>& quad_sides,
                                  const std::vector<Slide>& slides, const std::vector<Vec3>& centre,
-                                 const Vec3& half_box, const Vec3& across, double below_deg,
+                                 const PointBoxes& boxes, const Vec3& across, double below_deg,
                                  std::vector<Vec3>& points) {
   WidenedAngles result;
   const double limit = std::cos(below_deg * M_PI / 180);
@@ -160,9 +160,7 @@ WidenedAngles widen_small_angles(const std::vector<std::array<uint32_t, 4>>& qua
     Vec3 best_place = from;
     const auto try_moves = [&](const std::vector<Vec3>& moves) {
       for (const Vec3& move : moves) {
-        for (int k = 0; k < 3; ++k)
-          points[p][k] =
-              std::clamp(from[k] + move[k], centre[p][k] - half_box[k], centre[p][k] + half_box[k]);
+        points[p] = boxes.hold(centre[p], geometry::add(from, move));
         const double worst = worst_around(p);
         if (worst < best) {
           best = worst;

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "core/conforming/interface_surface.h"
+#include "core/conforming/point_boxes.h"
 #include "core/surface/crossing_triangles.h"
 #include "core/util/vec3.h"
 
@@ -43,7 +44,7 @@ struct WidenedAngles {
 };
 
 // Moves the points of quads whose best split has an angle below
-// `below_deg`, each within `half_box` of its `centre` along every axis:
+// `below_deg`, each held in its box around its `centre`:
 // along the surface first, and where that is not enough, by `across` along
 // a voxel axis. Positions, boxes and moves are in mm along the voxel axes.
 // `quad_sides` orient the quads (a quad's normal points from its lower side
@@ -53,9 +54,9 @@ struct WidenedAngles {
 WidenedAngles widen_small_angles(const std::vector<std::array<uint32_t, 4>>& quads,
                                  const std::vector<std::array<int32_t, 2>>& quad_sides,
                                  const std::vector<Slide>& slides,
-                                 const std::vector<geometry::Vec3>& centre,
-                                 const geometry::Vec3& half_box, const geometry::Vec3& across,
-                                 double below_deg, std::vector<geometry::Vec3>& points);
+                                 const std::vector<geometry::Vec3>& centre, const PointBoxes& boxes,
+                                 const geometry::Vec3& across, double below_deg,
+                                 std::vector<geometry::Vec3>& points);
 
 // Puts the slid points of the `crossing` triangle pairs back where smoothing
 // left them (the surface's `widened` list), and splits each of their quads

@@ -48,6 +48,11 @@ struct NetOptions {
   // of stepping a whole slice at once. 0 turns it off.
   double thick_ratio = 2.5;
   double thin_ratio = 1;
+  // Between two drawn slices a point of the thinner grid may move across
+  // the cut axis up to this fraction of a voxel beyond its box, more the
+  // farther it lies from the nearest drawn slice: the interpolated slices'
+  // pixel steps would otherwise stay as ridges. At most 0.5.
+  double between_drawn_widening = 0.5;
   // At most this many voxels on the thinner grid (fewer parts otherwise).
   int64_t max_thin_voxels = 48'000'000;
   // Poisson is tried first on labels touching no other selected label, at

@@ -51,6 +51,11 @@ absl::Status check_net_options(const NetOptions& options) {
   if (!(options.cube_fraction > 0 && options.cube_fraction < 1))
     return absl::InvalidArgumentError(
         cat("net cube fraction: ", options.cube_fraction, " is outside (0, 1)"));
+  // Half a voxel wider at most: with cube_fraction below 1 a point then
+  // stays within a voxel of its staircase place.
+  if (!(options.between_drawn_widening >= 0 && options.between_drawn_widening <= 0.5))
+    return absl::InvalidArgumentError(cat("net widening between drawn slices: ",
+                                          options.between_drawn_widening, " is outside [0, 0.5]"));
   return absl::OkStatus();
 }
 
@@ -114,6 +119,9 @@ absl::StatusOr<LayerNet> layer_net(const volume::LabelVolume& layer,
   // Points of the thinner grid may move as far as the thick slices'.
   auto thin_params = interface_params(options);
   thin_params.box_scale[cut.axis] = cut.parts;
+  thin_params.drawn_axis = cut.axis;
+  thin_params.drawn_parts = cut.parts;
+  thin_params.between_drawn_widening = options.between_drawn_widening;
   made.net = conforming::label_interfaces(*thin, here, thin_params, figures);
   if (!with_staircase) return made;
   conforming::InterfaceParams flat = interface_params(options);

@@ -34,6 +34,7 @@
 #include "core/util/side_by_side.h"
 #include "core/volume/label_statistics.h"
 #include "core/volume/read_label_volume.h"
+#include "core/volume/write_label_volume.h"
 #include "support/analytic_shapes.h"
 #include "support/slicer_like.h"
 
@@ -61,8 +62,8 @@ double median(std::vector<double> v) {
   return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
-// Default options, or the net's from LABELMESH_NET_ROUNDS, _INFLATE, _CUBE
-// and _THICK, and with LABELMESH_NET_ONLY the net alone (for tuning).
+// Default options, or the net's from LABELMESH_NET_ROUNDS, _INFLATE, _CUBE,
+// _THICK and _WIDEN, and with LABELMESH_NET_ONLY the net alone (for tuning).
 MeshParams our_params() {
   MeshParams params;
   if (const char* v = std::getenv("LABELMESH_NET_ROUNDS"))
@@ -75,6 +76,8 @@ MeshParams our_params() {
   if (std::getenv("LABELMESH_NET_NO_RESTORE")) params.net.restore_volumes = false;
   if (const char* v = std::getenv("LABELMESH_NET_CUBE")) params.net.cube_fraction = std::atof(v);
   if (const char* v = std::getenv("LABELMESH_NET_THICK")) params.net.thick_ratio = std::atof(v);
+  if (const char* v = std::getenv("LABELMESH_NET_WIDEN"))
+    params.net.between_drawn_widening = std::atof(v);
   return params;
 }
 
@@ -141,7 +144,8 @@ int bench_phantoms() {
         ++failures;
         continue;
       }
-      // LABELMESH_BENCH_OUT=DIR keeps the three surfaces as STL, to look at.
+      // LABELMESH_BENCH_OUT=DIR keeps the three surfaces as STL, to look at,
+      // and the phantom's volume, to mesh again.
       if (const char* out = std::getenv("LABELMESH_BENCH_OUT")) {
         std::string stem = std::string(out) + "/" + shape.name + "-" + grid.name;
         std::replace(stem.begin() + static_cast<long>(std::strlen(out)), stem.end(), ' ', '_');
@@ -150,6 +154,7 @@ int bench_phantoms() {
         (void)surface::write_surface(made->slicer, stem + "-slicer.stl",
                                      surface::SurfaceFormat::kStl);
         (void)surface::write_surface(made->ours, stem + "-ours.stl", surface::SurfaceFormat::kStl);
+        (void)volume::write_label_volume(made->volume, stem + ".nii.gz");
       }
       const auto e_mc = testing::shape_error(made->marching_cubes, shape);
       const auto e_slicer = testing::shape_error(made->slicer, shape);

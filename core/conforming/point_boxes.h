@@ -1,0 +1,46 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// The boxes the surface net's points are held in while they are smoothed
+// and moved: around each point's staircase position, wider between drawn
+// slices on a grid cut into thinner ones.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/util/vec3.h"
+
+namespace labelmesh::conforming {
+
+// Where each point may lie: within `half` of its centre along each axis,
+// and across a drawn axis up to `widening` more, growing with the point's
+// distance from the nearest drawn slice (between_drawn below;
+// InterfaceParams::between_drawn_widening).
+struct PointBoxes {
+  geometry::Vec3 half{0, 0, 0};
+  int drawn_axis = -1;               // -1: every box is fixed
+  double drawn_spacing = 0;          // mm between drawn slices
+  double drawn_first = 0;            // a drawn slice's place along the axis, mm
+  geometry::Vec3 widening{0, 0, 0};  // mm midway between drawn slices; 0 along the axis
+
+  // p held in the box around `centre`.
+  geometry::Vec3 hold(const geometry::Vec3& centre, geometry::Vec3 p) const;
+};
+
+// Within this fraction of the way from a drawn slice to the middle between
+// two, boxes stay as narrow as on the drawn slice: a triangle reaching the
+// drawn slice from a point just off it would otherwise cross the drawn
+// voxel centres there.
+inline constexpr double kNarrowNearDrawn = 0.2;
+
+// How far between two drawn slices `place` lies along their axis, for the
+// widening: 0 on or near one (kNarrowNearDrawn), 1 midway.
+template <typename Real>
+Real between_drawn(Real place, Real first, Real spacing) {
+  const Real offset = place - first;
+  const Real into = offset - std::floor(offset / spacing) * spacing;
+  const Real between = std::min(into, spacing - into) / (Real{0.5} * spacing);
+  const auto narrow = static_cast<Real>(kNarrowNearDrawn);
+  return std::clamp((between - narrow) / (Real{1} - narrow), Real{0}, Real{1});
+}
+
+}  // namespace labelmesh::conforming

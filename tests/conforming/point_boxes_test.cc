@@ -1,0 +1,63 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// The net's point boxes: fixed on an ordinary grid; on a grid cut into
+// thinner slices as narrow as ever on and near a drawn slice, and wider
+// across the cut axis midway between two.
+#include "core/conforming/point_boxes.h"
+
+#include <gtest/gtest.h>
+
+namespace labelmesh::conforming {
+namespace {
+
+using geometry::Vec3;
+
+// A grid of 1 mm pixels whose 3 mm slices (along z) were cut into thirds:
+// drawn slices at z = 1 + 3 k, boxes 0.475 mm across and a slice along z,
+// half a pixel wider midway between drawn slices.
+PointBoxes thirds() {
+  PointBoxes boxes;
+  boxes.half = {0.475, 0.475, 1.425};
+  boxes.drawn_axis = 2;
+  boxes.drawn_spacing = 3;
+  boxes.drawn_first = 1;
+  boxes.widening = {0.5, 0.5, 0};
+  return boxes;
+}
+
+TEST(PointBoxes, WithoutDrawnSlicesAPointIsClampedAlongEachAxis) {
+  const PointBoxes boxes{{0.5, 0.25, 1}};
+  const Vec3 held = boxes.hold({10, 20, 30}, {11, 19, 30.5});
+  EXPECT_EQ(held, (Vec3{10.5, 19.75, 30.5}));
+}
+
+TEST(PointBoxes, OnAndNearADrawnSliceTheBoxStaysNarrow) {
+  const auto boxes = thirds();
+  // On the drawn slice z = 4, and a tenth of the way to the middle.
+  for (const double z : {4.0, 4.15, 3.85}) {
+    const Vec3 held = boxes.hold({5, 5, z}, {7, 3, z});
+    EXPECT_DOUBLE_EQ(held[0], 5.475) << z;
+    EXPECT_DOUBLE_EQ(held[1], 4.525) << z;
+    EXPECT_DOUBLE_EQ(held[2], z) << z;
+  }
+}
+
+TEST(PointBoxes, MidwayBetweenDrawnSlicesTheBoxIsWiderAcrossOnly) {
+  const auto boxes = thirds();
+  // z = 5.5 is midway between the drawn slices 4 and 7.
+  const Vec3 midway = boxes.hold({5, 5, 5.5}, {7, 3, 5.5});
+  EXPECT_DOUBLE_EQ(midway[0], 5.975);
+  EXPECT_DOUBLE_EQ(midway[1], 4.025);
+  // 0.9 mm from the drawn slice at z = 4 is 0.6 of the way to the middle:
+  // (0.6 - 0.2) / 0.8, half the widening.
+  const Vec3 partway = boxes.hold({5, 5, 5.5}, {7, 5, 4.9});
+  EXPECT_NEAR(partway[0], 5.725, 1e-12);
+  // Along the cut axis the box is never wider, and the width across is
+  // taken where the point is held along it: z = 9 would be well between
+  // drawn slices, but the point is held at 6.925, near the one at 7.
+  const Vec3 far_along = boxes.hold({5, 5, 5.5}, {7, 5, 9});
+  EXPECT_DOUBLE_EQ(far_along[2], 6.925);
+  EXPECT_DOUBLE_EQ(far_along[0], 5.475);
+}
+
+}  // namespace
+}  // namespace labelmesh::conforming
