@@ -30,9 +30,14 @@ struct InterfaceSurface {
   std::array<int64_t, 3> padded_dims{0, 0, 0};
   std::array<int64_t, 3> padded_first{-1, -1, -1};
   // The points moved to widen small angles, each with the place smoothing
-  // left it (LPS mm): a move that makes triangles cross is taken back
-  // (widen_small_angles.h).
-  std::vector<std::pair<uint32_t, std::array<double, 3>>> widened;
+  // left it (LPS mm): a move that makes triangles cross is taken back by
+  // halves, then wholly (widen_small_angles.h).
+  struct Slid {
+    uint32_t point = 0;
+    std::array<double, 3> before{0, 0, 0};
+    int halvings = 0;  // times half of what was left of the move went back
+  };
+  std::vector<Slid> widened;
 };
 
 }  // namespace labelmesh::conforming

@@ -564,7 +564,7 @@ void restore_staircase(InterfaceSurface& surface, const std::vector<uint32_t>& p
   }
   auto& widened = surface.widened;
   widened.erase(std::remove_if(widened.begin(), widened.end(),
-                               [&](const auto& slid) { return restored[slid.first]; }),
+                               [&](const auto& slid) { return restored[slid.point]; }),
                 widened.end());
 }
 

@@ -215,14 +215,23 @@ std::vector<uint32_t> take_back_crossing_slides(InterfaceSurface& surface,
     for (const uint32_t triangle : {s, t})
       for (const uint32_t p : surface.triangles[triangle]) in_crossing[p] = true;
   auto& widened = surface.widened;
+  // Points moved now; those back where smoothing left them leave the list.
   std::vector<bool> taken_back(surface.points.size(), false);
-  for (const auto& [point, before] : widened) {
-    if (!in_crossing[point]) continue;
-    surface.points[point] = before;
-    taken_back[point] = true;
+  std::vector<bool> whole(surface.points.size(), false);
+  for (auto& slid : widened) {
+    if (!in_crossing[slid.point]) continue;
+    auto& place = surface.points[slid.point];
+    if (slid.halvings == kHalvings) {
+      place = slid.before;
+      whole[slid.point] = true;
+    } else {
+      place = geometry::scale(geometry::add(place, slid.before), 0.5);
+      ++slid.halvings;
+    }
+    taken_back[slid.point] = true;
   }
   widened.erase(std::remove_if(widened.begin(), widened.end(),
-                               [&](const auto& slid) { return taken_back[slid.first]; }),
+                               [&](const auto& slid) { return whole[slid.point]; }),
                 widened.end());
   for (uint32_t t = 0; t + 1 < surface.triangles.size(); t += 2) {
     const auto& a = surface.triangles[t];

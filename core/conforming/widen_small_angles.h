@@ -58,10 +58,17 @@ WidenedAngles widen_small_angles(const std::vector<std::array<uint32_t, 4>>& qua
                                  const geometry::Vec3& across, double below_deg,
                                  std::vector<geometry::Vec3>& points);
 
-// Puts the slid points of the `crossing` triangle pairs back where smoothing
-// left them (the surface's `widened` list), and splits each of their quads
-// (triangles 2q and 2q + 1) again along the diagonal that gives the larger
-// smallest angle; returns the triangles of those quads.
+// A move in a crossing pair goes back by half of what is left of it this
+// many times, and then wholly: most crossings at the rims of thin sheets
+// clear after a part of the move, which keeps part of its wider angle.
+inline constexpr int kHalvings = 3;
+
+// Takes back half of what is left of the slide of each slid point of the
+// `crossing` triangle pairs (the surface's `widened` list), or all of it
+// after kHalvings halvings, putting the point where smoothing left it;
+// splits each of their quads (triangles 2q and 2q + 1) again along the
+// diagonal that gives the larger smallest angle, and returns the triangles
+// of those quads.
 std::vector<uint32_t> take_back_crossing_slides(InterfaceSurface& surface,
                                                 const surface::TrianglePairs& crossing);
 

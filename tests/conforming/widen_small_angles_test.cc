@@ -82,29 +82,40 @@ TEST(WidenSmallAngles, WideAnglesAreLeftAlone) {
   EXPECT_EQ(net.points, moved_before);
 }
 
-TEST(WidenSmallAngles, MovesInCrossingTrianglesAreTakenBack) {
+// A move in a crossing pair is taken back by halves while the pair still
+// crosses, then wholly.
+TEST(WidenSmallAngles, MovesInCrossingTrianglesAreTakenBackByHalvesThenWhole) {
   InterfaceSurface surface;
   surface.points = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {5, 5, 5}, {6, 5, 5}, {5, 6, 5}};
   surface.triangles = {{0, 1, 2}, {3, 4, 5}};
-  surface.widened = {{1, {0.9, 0, 0}}, {4, {6.1, 5, 5}}};
+  surface.widened = {{1, {0.2, 0, 0}}, {4, {6.1, 5, 5}}};
   // A pair that holds no moved point takes nothing back.
   EXPECT_TRUE(take_back_crossing_slides(surface, {}).empty());
-  EXPECT_EQ(take_back_crossing_slides(surface, {{0, 0}}), (std::vector<uint32_t>{0, 1}));
-  EXPECT_EQ(surface.points[1], (Vec3{0.9, 0, 0}));
+  // The move of point 1 is 0.8 long: 0.4, 0.2 and 0.1 of it are left.
+  for (const double left : {0.4, 0.2, 0.1}) {
+    EXPECT_EQ(take_back_crossing_slides(surface, {{0, 0}}), (std::vector<uint32_t>{0, 1}));
+    EXPECT_NEAR(surface.points[1][0], 0.2 + left, 1e-12);
+    ASSERT_EQ(surface.widened.size(), 2u);
+  }
   EXPECT_EQ(surface.points[4], (Vec3{6, 5, 5}));
+  EXPECT_EQ(surface.widened[0].halvings, kHalvings);
+  EXPECT_EQ(surface.widened[1].halvings, 0);
+  EXPECT_EQ(take_back_crossing_slides(surface, {{0, 0}}), (std::vector<uint32_t>{0, 1}));
+  EXPECT_EQ(surface.points[1], (Vec3{0.2, 0, 0}));
   ASSERT_EQ(surface.widened.size(), 1u);
-  EXPECT_EQ(surface.widened[0].first, 4u);
+  EXPECT_EQ(surface.widened[0].point, 4u);
   EXPECT_TRUE(take_back_crossing_slides(surface, {{0, 0}}).empty());
 }
 
 // A kite split along its long diagonal once its top corner is back where
-// smoothing left it: the short diagonal gives the wider angles.
+// smoothing left it (after its halvings): the short diagonal gives the
+// wider angles.
 TEST(WidenSmallAngles, AQuadTakenBackIsSplitAgain) {
   InterfaceSurface surface;
   // A, B, C and D counter-clockwise; D was moved up from (1, 0.2).
   surface.points = {{0, 0, 0}, {1, -0.2, 0}, {2, 0, 0}, {1, 0.6, 0}};
   surface.triangles = {{0, 2, 3}, {2, 0, 1}};
-  surface.widened = {{3, {1, 0.2, 0}}};
+  surface.widened = {{3, {1, 0.2, 0}, kHalvings}};
   EXPECT_EQ(take_back_crossing_slides(surface, {{0, 1}}), (std::vector<uint32_t>{0, 1}));
   EXPECT_EQ(surface.points[3], (Vec3{1, 0.2, 0}));
   const std::vector<std::array<uint32_t, 3>> split{{0, 1, 3}, {1, 2, 3}};
