@@ -9,7 +9,10 @@
 //              the axis-aligned area share per label (median), and how many
 //              labels each pipeline keeps within the voxel tolerance.
 //   shares     the phantoms' axis-aligned area share beside the true shape's;
-// Usage: labelmesh_surface_bench [phantoms|shares|volumes|all] [ROUNDS] [FILE ...]
+//   slices     five touching labels on three 5 mm slices of 512 x 512 pixels,
+//              as a DICOM SEG of a short series holds them, timed as the
+//              volumes are (the file is written to the temporary directory).
+// Usage: labelmesh_surface_bench [phantoms|shares|volumes|slices|all] [ROUNDS] [FILE ...]
 #if __has_include(<malloc.h>)
 #include <malloc.h>
 #endif
@@ -21,6 +24,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <optional>
 #include <string>
 #include <vector>
@@ -36,6 +40,7 @@
 #include "core/volume/read_label_volume.h"
 #include "core/volume/write_label_volume.h"
 #include "support/analytic_shapes.h"
+#include "support/label_grid.h"
 #include "support/slicer_like.h"
 
 using namespace labelmesh;
@@ -355,6 +360,46 @@ int bench_volume(const std::string& path, int rounds) {
   return 0;
 }
 
+// Five organs cut by three 5 mm slices of 0.78 mm pixels: a large one, two
+// touching it and each other, a round vessel beside them and a small one
+// inside the large one. Each shrinks or grows from slice to slice as organs
+// do across a short series.
+volume::LabelVolume five_labels_on_three_slices() {
+  constexpr int kPixels = 512;
+  auto v = testing::label_grid({kPixels, kPixels, 3}, [](int i, int j, int k) -> uint8_t {
+    const double x = (i - 256) * 0.78, y = (j - 256) * 0.78;
+    const double grow = 1 + 0.12 * (k - 1);
+    const auto inside = [&](double cx, double cy, double rx, double ry) {
+      const double u = (x - cx) / (rx * grow), w = (y - cy) / (ry * grow);
+      return u * u + w * w < 1;
+    };
+    if (inside(-40, 10, 18, 14)) return 5;  // inside the large organ
+    if (inside(-50, 0, 80, 60)) return 1;
+    if (inside(55, -10, 35, 25)) return 2;         // touches 1
+    if (inside(50, 40, 30, 22)) return 3;          // touches 1 and 2
+    if (std::hypot(x - 5, y + 70) < 12) return 4;  // a vessel, the same on every slice
+    return 0;
+  });
+  v.geometry.spacing = {0.78, 0.78, 5};
+  return v;
+}
+
+int bench_three_slices(int rounds) {
+  // LABELMESH_BENCH_OUT=DIR keeps the volume there, to mesh again.
+  const char* out = std::getenv("LABELMESH_BENCH_OUT");
+  const auto path =
+      (out != nullptr ? std::filesystem::path(out) : std::filesystem::temp_directory_path()) /
+      "labelmesh-five-labels-three-slices.nii.gz";
+  if (const auto written = volume::write_label_volume(five_labels_on_three_slices(), path.string());
+      !written.ok()) {
+    std::printf("could not write %s: %s\n", path.c_str(), std::string(written.message()).c_str());
+    return 1;
+  }
+  const int failures = bench_volume(path.string(), rounds);
+  if (out == nullptr) std::filesystem::remove(path);
+  return failures;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -375,5 +420,6 @@ int main(int argc, char** argv) {
   if (what == "shares" || what == "all") failures += bench_shares();
   if (what == "volumes" || what == "all")
     for (const auto& f : files) failures += bench_volume(f, rounds);
+  if (what == "slices" || what == "all") failures += bench_three_slices(rounds);
   return failures == 0 ? 0 : 1;
 }
