@@ -82,7 +82,7 @@ void smooth_in_boxes(const Stencil& stencil, const std::vector<Vec3>& centre,
       const Lanes at = from[p];
       Lanes moved = at + factor * (sum - at);
       Lanes width = half;
-      if (drawn >= 0) {
+      if (drawn >= 0 && point_boxes.widens(p)) {
         // Along the drawn axis first: the width across follows from there.
         const float along =
             std::clamp(moved[drawn], box[p][drawn] - half[drawn], box[p][drawn] + half[drawn]);
@@ -115,9 +115,9 @@ void smooth_in_boxes(const Stencil& stencil, const std::vector<Vec3>& centre,
   // (a single-precision clamp can leave a point a rounding outside).
   points.resize(n);
   for (size_t p = 0; p < n; ++p)
-    points[p] =
-        point_boxes.hold(centre[p], {static_cast<double>(now[p][0]), static_cast<double>(now[p][1]),
-                                     static_cast<double>(now[p][2])});
+    points[p] = point_boxes.hold(p, centre[p],
+                                 {static_cast<double>(now[p][0]), static_cast<double>(now[p][1]),
+                                  static_cast<double>(now[p][2])});
   for (const auto& [p, place] : fixed) points[p] = place;
 }
 

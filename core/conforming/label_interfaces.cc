@@ -356,7 +356,7 @@ void restore_volumes(const Net& net, const std::vector<Vec3>& centre, const Poin
       const double length = geometry::norm(normal[p]);
       if (length == 0 || area[label] == 0) continue;
       const Vec3 step = geometry::scale(normal[p], lost / area[label] / length);
-      points[p] = boxes.hold(centre[p], geometry::add(points[p], step));
+      points[p] = boxes.hold(p, centre[p], geometry::add(points[p], step));
     }
   }
 }
@@ -469,7 +469,11 @@ InterfaceSurface label_interfaces(const volume::LabelVolume& volume,
   std::vector<int32_t>().swap(padded.labels);
 
   const double half = 0.5 * params.cube_fraction;
-  const PointBoxes boxes = point_boxes(geometry, params);
+  PointBoxes boxes = point_boxes(geometry, params);
+  if (boxes.drawn_axis >= 0) {
+    boxes.narrow.resize(net.label_count.size());
+    for (size_t p = 0; p < net.label_count.size(); ++p) boxes.narrow[p] = net.label_count[p] > 2;
+  }
   std::vector<Vec3> points = net.centre;
   smooth_in_boxes(stencil, net.centre, boxes, params, points);
   if (params.restore_volumes) restore_volumes(net, net.centre, boxes, points);

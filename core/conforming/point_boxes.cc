@@ -5,9 +5,9 @@ namespace labelmesh::conforming {
 
 using geometry::Vec3;
 
-Vec3 PointBoxes::hold(const Vec3& centre, Vec3 p) const {
+Vec3 PointBoxes::hold(size_t point, const Vec3& centre, Vec3 p) const {
   Vec3 width = half;
-  if (drawn_axis >= 0) {
+  if (widens(point)) {
     const int a = drawn_axis;
     p[a] = std::clamp(p[a], centre[a] - half[a], centre[a] + half[a]);
     const double between = between_drawn(p[a], drawn_first, drawn_spacing);

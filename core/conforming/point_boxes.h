@@ -6,6 +6,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
+#include <vector>
 
 #include "core/util/vec3.h"
 
@@ -21,9 +23,15 @@ struct PointBoxes {
   double drawn_spacing = 0;          // mm between drawn slices
   double drawn_first = 0;            // a drawn slice's place along the axis, mm
   geometry::Vec3 widening{0, 0, 0};  // mm midway between drawn slices; 0 along the axis
+  // Points whose boxes never widen (where three labels or more meet): a
+  // junction curve held to its pixels keeps its points apart.
+  std::vector<bool> narrow;
 
-  // p held in the box around `centre`.
-  geometry::Vec3 hold(const geometry::Vec3& centre, geometry::Vec3 p) const;
+  bool widens(size_t point) const {
+    return drawn_axis >= 0 && (point >= narrow.size() || !narrow[point]);
+  }
+  // Point `point`, at p, held in its box around `centre`.
+  geometry::Vec3 hold(size_t point, const geometry::Vec3& centre, geometry::Vec3 p) const;
 };
 
 // Within this fraction of the way from a drawn slice to the middle between

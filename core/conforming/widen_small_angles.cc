@@ -160,7 +160,7 @@ WidenedAngles widen_small_angles(const std::vector<std::array<uint32_t, 4>>& qua
     Vec3 best_place = from;
     const auto try_moves = [&](const std::vector<Vec3>& moves) {
       for (const Vec3& move : moves) {
-        points[p] = boxes.hold(centre[p], geometry::add(from, move));
+        points[p] = boxes.hold(p, centre[p], geometry::add(from, move));
         const double worst = worst_around(p);
         if (worst < best) {
           best = worst;

@@ -40,7 +40,7 @@
 #include "core/volume/read_label_volume.h"
 #include "core/volume/write_label_volume.h"
 #include "support/analytic_shapes.h"
-#include "support/label_grid.h"
+#include "support/organs_on_slices.h"
 #include "support/slicer_like.h"
 
 using namespace labelmesh;
@@ -360,37 +360,14 @@ int bench_volume(const std::string& path, int rounds) {
   return 0;
 }
 
-// Five organs cut by three 5 mm slices of 0.78 mm pixels: a large one, two
-// touching it and each other, a round vessel beside them and a small one
-// inside the large one. Each shrinks or grows from slice to slice as organs
-// do across a short series.
-volume::LabelVolume five_labels_on_three_slices() {
-  constexpr int kPixels = 512;
-  auto v = testing::label_grid({kPixels, kPixels, 3}, [](int i, int j, int k) -> uint8_t {
-    const double x = (i - 256) * 0.78, y = (j - 256) * 0.78;
-    const double grow = 1 + 0.12 * (k - 1);
-    const auto inside = [&](double cx, double cy, double rx, double ry) {
-      const double u = (x - cx) / (rx * grow), w = (y - cy) / (ry * grow);
-      return u * u + w * w < 1;
-    };
-    if (inside(-40, 10, 18, 14)) return 5;  // inside the large organ
-    if (inside(-50, 0, 80, 60)) return 1;
-    if (inside(55, -10, 35, 25)) return 2;         // touches 1
-    if (inside(50, 40, 30, 22)) return 3;          // touches 1 and 2
-    if (std::hypot(x - 5, y + 70) < 12) return 4;  // a vessel, the same on every slice
-    return 0;
-  });
-  v.geometry.spacing = {0.78, 0.78, 5};
-  return v;
-}
-
 int bench_three_slices(int rounds) {
   // LABELMESH_BENCH_OUT=DIR keeps the volume there, to mesh again.
   const char* out = std::getenv("LABELMESH_BENCH_OUT");
   const auto path =
       (out != nullptr ? std::filesystem::path(out) : std::filesystem::temp_directory_path()) /
       "labelmesh-five-labels-three-slices.nii.gz";
-  if (const auto written = volume::write_label_volume(five_labels_on_three_slices(), path.string());
+  if (const auto written =
+          volume::write_label_volume(testing::five_organs_on_three_slices(), path.string());
       !written.ok()) {
     std::printf("could not write %s: %s\n", path.c_str(), std::string(written.message()).c_str());
     return 1;

@@ -26,7 +26,7 @@ PointBoxes thirds() {
 
 TEST(PointBoxes, WithoutDrawnSlicesAPointIsClampedAlongEachAxis) {
   const PointBoxes boxes{{0.5, 0.25, 1}};
-  const Vec3 held = boxes.hold({10, 20, 30}, {11, 19, 30.5});
+  const Vec3 held = boxes.hold(0, {10, 20, 30}, {11, 19, 30.5});
   EXPECT_EQ(held, (Vec3{10.5, 19.75, 30.5}));
 }
 
@@ -34,7 +34,7 @@ TEST(PointBoxes, OnAndNearADrawnSliceTheBoxStaysNarrow) {
   const auto boxes = thirds();
   // On the drawn slice z = 4, and a tenth of the way to the middle.
   for (const double z : {4.0, 4.15, 3.85}) {
-    const Vec3 held = boxes.hold({5, 5, z}, {7, 3, z});
+    const Vec3 held = boxes.hold(0, {5, 5, z}, {7, 3, z});
     EXPECT_DOUBLE_EQ(held[0], 5.475) << z;
     EXPECT_DOUBLE_EQ(held[1], 4.525) << z;
     EXPECT_DOUBLE_EQ(held[2], z) << z;
@@ -44,19 +44,28 @@ TEST(PointBoxes, OnAndNearADrawnSliceTheBoxStaysNarrow) {
 TEST(PointBoxes, MidwayBetweenDrawnSlicesTheBoxIsWiderAcrossOnly) {
   const auto boxes = thirds();
   // z = 5.5 is midway between the drawn slices 4 and 7.
-  const Vec3 midway = boxes.hold({5, 5, 5.5}, {7, 3, 5.5});
+  const Vec3 midway = boxes.hold(0, {5, 5, 5.5}, {7, 3, 5.5});
   EXPECT_DOUBLE_EQ(midway[0], 5.975);
   EXPECT_DOUBLE_EQ(midway[1], 4.025);
   // 0.9 mm from the drawn slice at z = 4 is 0.6 of the way to the middle:
   // (0.6 - 0.2) / 0.8, half the widening.
-  const Vec3 partway = boxes.hold({5, 5, 5.5}, {7, 5, 4.9});
+  const Vec3 partway = boxes.hold(0, {5, 5, 5.5}, {7, 5, 4.9});
   EXPECT_NEAR(partway[0], 5.725, 1e-12);
   // Along the cut axis the box is never wider, and the width across is
   // taken where the point is held along it: z = 9 would be well between
   // drawn slices, but the point is held at 6.925, near the one at 7.
-  const Vec3 far_along = boxes.hold({5, 5, 5.5}, {7, 5, 9});
+  const Vec3 far_along = boxes.hold(0, {5, 5, 5.5}, {7, 5, 9});
   EXPECT_DOUBLE_EQ(far_along[2], 6.925);
   EXPECT_DOUBLE_EQ(far_along[0], 5.475);
+}
+
+TEST(PointBoxes, NarrowPointsNeverWiden) {
+  auto boxes = thirds();
+  boxes.narrow = {false, true};
+  EXPECT_DOUBLE_EQ(boxes.hold(0, {5, 5, 5.5}, {7, 3, 5.5})[0], 5.975);
+  EXPECT_DOUBLE_EQ(boxes.hold(1, {5, 5, 5.5}, {7, 3, 5.5})[0], 5.475);
+  // Points past the list widen as any other.
+  EXPECT_DOUBLE_EQ(boxes.hold(2, {5, 5, 5.5}, {7, 3, 5.5})[0], 5.975);
 }
 
 }  // namespace
