@@ -36,12 +36,12 @@ void smooth_in_boxes(const Stencil& stencil, const std::vector<Vec3>& centre,
   const size_t n = points.size();
   // Step s reads places[s % 2] and writes places[(s + 1) % 2]; an even
   // number of steps ends in the first.
-  std::vector<Lanes> now(n), next(n), boxes(n);
+  std::vector<Lanes> now(n), next(n), centres(n);
   // Points without neighbours do not move: they keep their places exactly.
   std::vector<std::pair<uint32_t, Vec3>> fixed;
   for (size_t p = 0; p < n; ++p) {
     now[p] = to_lanes(points[p]);
-    boxes[p] = to_lanes(centre[p]);
+    centres[p] = to_lanes(centre[p]);
     if (stencil.start[p] == stencil.start[p + 1])
       fixed.emplace_back(static_cast<uint32_t>(p), points[p]);
   }
@@ -59,7 +59,7 @@ void smooth_in_boxes(const Stencil& stencil, const std::vector<Vec3>& centre,
         static_cast<float>(step % 2 == 0 ? params.shrink_step : params.inflate_step);
     const uint32_t* __restrict start = stencil.start.data();
     const uint32_t* __restrict neighbours = stencil.neighbours.data();
-    const Lanes* __restrict box = boxes.data();
+    const Lanes* __restrict box = centres.data();
     const Lanes* __restrict from = places[step % 2];
     Lanes* __restrict to = places[(step + 1) % 2];
     for (size_t p = begin; p < end; ++p) {
@@ -110,7 +110,7 @@ void smooth_in_boxes(const Stencil& stencil, const std::vector<Vec3>& centre,
     side_by_side([&] { run_half(n / 2, n); }, [&] { run_half(0, n / 2); });
   }
   std::vector<Lanes>().swap(next);
-  std::vector<Lanes>().swap(boxes);
+  std::vector<Lanes>().swap(centres);
   // Back in double precision, held in the boxes as the double sums would be
   // (a single-precision clamp can leave a point a rounding outside).
   points.resize(n);

@@ -285,25 +285,6 @@ std::vector<double> label_volumes(const Net& net, const SideSlots& slots,
   return volume;
 }
 
-// Each point's box: cube_fraction of half a voxel along each axis (scaled
-// by box_scale), wider between drawn slices on a grid cut into thinner ones.
-PointBoxes point_boxes(const volume::ImageGeometry& geometry, const InterfaceParams& params) {
-  const auto& spacing = geometry.spacing;
-  PointBoxes boxes;
-  for (int k = 0; k < 3; ++k)
-    boxes.half[k] = 0.5 * params.cube_fraction * spacing[k] * params.box_scale[k];
-  const int a = params.drawn_axis;
-  if (a < 0 || params.between_drawn_widening <= 0) return boxes;
-  boxes.drawn_axis = a;
-  boxes.drawn_spacing = spacing[a] * params.drawn_parts;
-  // Thin slice j's centre lies at j times its spacing; drawn slice k's at
-  // thin slice (k + 1/2) parts - 1/2.
-  boxes.drawn_first = 0.5 * (boxes.drawn_spacing - spacing[a]);
-  for (int k = 0; k < 3; ++k)
-    if (k != a) boxes.widening[k] = params.between_drawn_widening * spacing[k];
-  return boxes;
-}
-
 // Moves the points where only one label meets the outside along their
 // normal, by the label's lost volume over its area there, so each label
 // keeps its voxels' volume where smoothing shrank it (thin labels most):

@@ -17,4 +17,21 @@ Vec3 PointBoxes::hold(size_t point, const Vec3& centre, Vec3 p) const {
   return p;
 }
 
+PointBoxes point_boxes(const volume::ImageGeometry& geometry, const InterfaceParams& params) {
+  const auto& spacing = geometry.spacing;
+  PointBoxes boxes;
+  for (int k = 0; k < 3; ++k)
+    boxes.half[k] = 0.5 * params.cube_fraction * spacing[k] * params.box_scale[k];
+  const int a = params.drawn_axis;
+  if (a < 0 || params.drawn_parts < 2 || params.between_drawn_widening <= 0) return boxes;
+  boxes.drawn_axis = a;
+  boxes.drawn_spacing = spacing[a] * params.drawn_parts;
+  // Thin slice j's centre lies at j times its spacing; drawn slice k's at
+  // thin slice (k + 1/2) parts - 1/2.
+  boxes.drawn_first = 0.5 * (boxes.drawn_spacing - spacing[a]);
+  for (int k = 0; k < 3; ++k)
+    if (k != a) boxes.widening[k] = params.between_drawn_widening * spacing[k];
+  return boxes;
+}
+
 }  // namespace labelmesh::conforming

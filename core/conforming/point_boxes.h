@@ -9,7 +9,9 @@
 #include <cstddef>
 #include <vector>
 
+#include "core/conforming/label_interfaces.h"
 #include "core/util/vec3.h"
+#include "core/volume/label_volume.h"
 
 namespace labelmesh::conforming {
 
@@ -33,6 +35,11 @@ struct PointBoxes {
   // Point `point`, at p, held in its box around `centre`.
   geometry::Vec3 hold(size_t point, const geometry::Vec3& centre, geometry::Vec3 p) const;
 };
+
+// Each point's box on `geometry` (cube_fraction of half a voxel along each
+// axis, times box_scale), wider between drawn slices when params name a
+// drawn axis cut into two parts or more. `narrow` is left empty.
+PointBoxes point_boxes(const volume::ImageGeometry& geometry, const InterfaceParams& params);
 
 // Within this fraction of the way from a drawn slice to the middle between
 // two, boxes stay as narrow as on the drawn slice: a triangle reaching the

@@ -217,13 +217,13 @@ std::vector<uint32_t> take_back_crossing_slides(InterfaceSurface& surface,
   auto& widened = surface.widened;
   // Points moved now; those back where smoothing left them leave the list.
   std::vector<bool> taken_back(surface.points.size(), false);
-  std::vector<bool> whole(surface.points.size(), false);
+  std::vector<bool> taken_back_wholly(surface.points.size(), false);
   for (auto& slid : widened) {
     if (!in_crossing[slid.point]) continue;
     auto& place = surface.points[slid.point];
     if (slid.halvings == kHalvings) {
       place = slid.before;
-      whole[slid.point] = true;
+      taken_back_wholly[slid.point] = true;
     } else {
       place = geometry::scale(geometry::add(place, slid.before), 0.5);
       ++slid.halvings;
@@ -231,7 +231,7 @@ std::vector<uint32_t> take_back_crossing_slides(InterfaceSurface& surface,
     taken_back[slid.point] = true;
   }
   widened.erase(std::remove_if(widened.begin(), widened.end(),
-                               [&](const auto& slid) { return whole[slid.point]; }),
+                               [&](const auto& slid) { return taken_back_wholly[slid.point]; }),
                 widened.end());
   for (uint32_t t = 0; t + 1 < surface.triangles.size(); t += 2) {
     const auto& a = surface.triangles[t];
@@ -249,7 +249,8 @@ std::vector<uint32_t> take_back_crossing_slides(InterfaceSurface& surface,
 
 surface::TrianglePairs crossings_after_taking_back_slides(InterfaceSurface& surface) {
   auto pairs = surface::crossing_triangles(surface.points, surface.triangles);
-  // Each round takes back at least one slide, so the rounds end.
+  // Each round halves or takes back at least one slide, and a slide is
+  // halved at most kHalvings times: the rounds end.
   for (;;) {
     const auto among = take_back_crossing_slides(surface, pairs);
     if (among.empty()) break;

@@ -5,7 +5,7 @@
 // its neighbours in the surface's tangent plane (which keeps the shape to
 // first order), or where that is not enough moves a little along a voxel
 // axis (which changes it), whichever widens the smallest angle around it
-// most. It never leaves its box, so every voxel centre stays on its side.
+// most. It never leaves its box (point_boxes.h).
 #pragma once
 
 #include <array>
@@ -65,7 +65,10 @@ inline constexpr int kHalvings = 3;
 
 // Takes back half of what is left of the slide of each slid point of the
 // `crossing` triangle pairs (the surface's `widened` list), or all of it
-// after kHalvings halvings, putting the point where smoothing left it;
+// after kHalvings halvings, putting the point where smoothing left it; a
+// point half way may lie outside a box that widens between drawn slices
+// (point_boxes.h: such boxes are not convex), never farther from its
+// staircase place than the wider of the two ends allows;
 // splits each of their quads (triangles 2q and 2q + 1) again along the
 // diagonal that gives the larger smallest angle, and returns the triangles
 // of those quads.

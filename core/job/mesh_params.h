@@ -37,7 +37,8 @@ struct NetOptions {
   double shrink_step = 0.5;
   double inflate_step = -0.505;
   // How far a point may leave its staircase position along each axis, as a
-  // fraction of half the voxel: below 1, so no voxel centre changes sides.
+  // fraction of half the voxel: below 1, so on the volume's own grid no
+  // voxel centre changes sides (on thinner slices the guard measures it).
   double cube_fraction = 0.95;
   // Give each label back the volume smoothing took from it, where it meets
   // only the outside (thin labels shrink most).

@@ -17,8 +17,8 @@ struct VoxelBox {
   bool empty() const { return last[0] < first[0]; }
 };
 
-// The box of the voxels v (x fastest, `dims` of them) for which
-// accepts(voxels[i]) holds.
+// The box of the voxels (x fastest, `dims` of them) for which
+// accepts(voxel) holds.
 template <typename T, typename Accepts>
 VoxelBox voxel_box(const T* voxels, const std::array<int64_t, 3>& dims, Accepts&& accepts) {
   std::array<int64_t, 3> first{dims[0], dims[1], dims[2]}, last{-1, -1, -1};

@@ -68,5 +68,45 @@ TEST(PointBoxes, NarrowPointsNeverWiden) {
   EXPECT_DOUBLE_EQ(boxes.hold(2, {5, 5, 5.5}, {7, 3, 5.5})[0], 5.975);
 }
 
+// The boxes a grid cut into `parts` thin slices gets: on the thin slices
+// that lie on drawn slices' centres they stay narrow, halfway between two
+// drawn slices they are widest.
+TEST(PointBoxes, DrawnSlicesFallOnTheThinSlicesCutFromThem) {
+  for (const int parts : {3, 6}) {
+    volume::ImageGeometry thin;
+    thin.spacing = {0.8, 0.8, 5.0 / parts};
+    InterfaceParams params;
+    params.cube_fraction = 0.95;
+    params.box_scale = {1, 1, double(parts)};
+    params.drawn_axis = 2;
+    params.drawn_parts = parts;
+    params.between_drawn_widening = 0.5;
+    const auto boxes = point_boxes(thin, params);
+    ASSERT_EQ(boxes.drawn_axis, 2) << parts;
+    EXPECT_DOUBLE_EQ(boxes.drawn_spacing, 5) << parts;
+    EXPECT_DOUBLE_EQ(boxes.half[0], 0.38) << parts;
+    EXPECT_DOUBLE_EQ(boxes.widening[0], 0.4) << parts;
+    EXPECT_EQ(boxes.widening[2], 0) << parts;
+    // Drawn slice k is thin slice (k + 1/2) parts - 1/2, at that index
+    // times the thin spacing.
+    const auto place = [&](double thin_index) { return thin_index * thin.spacing[2]; };
+    for (const int k : {0, 1, 4}) {
+      const double z = place((k + 0.5) * parts - 0.5);
+      EXPECT_DOUBLE_EQ(boxes.hold(0, {10, 10, z}, {20, 10, z})[0], 10.38) << parts << " " << k;
+      const double midway = z + 2.5;
+      EXPECT_NEAR(boxes.hold(0, {10, 10, midway}, {20, 10, midway})[0], 10.78, 1e-9)
+          << parts << " " << k;
+    }
+  }
+  // One part is no cut: the boxes stay fixed.
+  InterfaceParams uncut;
+  uncut.drawn_axis = 2;
+  uncut.drawn_parts = 1;
+  uncut.between_drawn_widening = 0.5;
+  volume::ImageGeometry grid;
+  grid.spacing = {1, 1, 3};
+  EXPECT_EQ(point_boxes(grid, uncut).drawn_axis, -1);
+}
+
 }  // namespace
 }  // namespace labelmesh::conforming

@@ -377,9 +377,9 @@ TEST(NetSurfaces, WiderBoxesBetweenDrawnSlicesSmoothTheInterpolatedSteps) {
 
 // Five organs on three 5 mm slices, touching along junction curves. Boxes
 // that widen between drawn slices would let a junction curve's points
-// crowd together (a 2.7 degree triangle, and a point on top of another),
-// so junction points keep narrow boxes: every net surface stays closed,
-// manifold, without crossings and without thin triangles.
+// crowd together into needles and crossings, so junction points keep narrow
+// boxes: every net surface stays closed, manifold, without crossings and
+// without triangles below 15 degrees.
 TEST(NetSurfaces, OrgansOnThreeThickSlicesKeepTheirAngles) {
   const auto result =
       run_pipeline_on_volume(testing::five_organs_on_three_slices(), MeshParams{}, {});
@@ -395,9 +395,9 @@ TEST(NetSurfaces, OrgansOnThreeThickSlicesKeepTheirAngles) {
     EXPECT_GE(s.statistics.min_angle_deg, 15) << s.label;
   }
   EXPECT_GE(nets, 4u);
-  // The two organs that grow 4 mm from slice to slice stray 1.4 voxels from
-  // their staircase between slices, outside the tolerance; the other three
-  // are within it.
+  // Where two organs meet the large one between slices the interpolation
+  // gives one of them thin voxels none of whose thick neighbours hold it,
+  // outside the Hausdorff tolerance; the other nets are within it.
   EXPECT_GE(within, 3u);
 }
 
@@ -518,7 +518,7 @@ TEST(NetSurfacesRealData, CrossingMovesAreTakenBack) {
     if (slid.halvings > 0) ++taken_back;
   EXPECT_GT(taken_back, 0u);
   // Half a move often clears the crossing and keeps part of the wider
-  // angle: taken back wholly at once, the thinnest triangle had 3.5 degrees.
+  // angle: no triangle is left below 5 degrees.
   double smallest = 180;
   for (const auto& t : net.triangles)
     for (int k = 0; k < 3; ++k) {
