@@ -2,6 +2,7 @@
 #include "core/volume_mesh/mesh_file_parts.h"
 
 #include <algorithm>
+#include <charconv>
 
 #include <vtkExecutive.h>
 #include <vtkFieldData.h>
@@ -102,6 +103,23 @@ void write_medit_head(TextFile& file, const std::vector<int32_t>& labels,
   }
 }
 
+namespace {
+
+// A coordinate in at most 20 characters, the widest field CalculiX reads:
+// the shortest exact form where it fits, else 13 significant digits (a
+// ten-thousandth of a nanometre at half a metre). A coordinate a rounding
+// from zero, such as -1.1314057027034252e-05, would otherwise take 23.
+void write_abaqus_real(TextFile& file, double value) {
+  constexpr size_t kWidest = 20;
+  char digits[32];
+  auto end = std::to_chars(digits, digits + sizeof digits, value).ptr;
+  if (static_cast<size_t>(end - digits) > kWidest)
+    end = std::to_chars(digits, digits + sizeof digits, value, std::chars_format::general, 13).ptr;
+  file << std::string_view(digits, static_cast<size_t>(end - digits));
+}
+
+}  // namespace
+
 void write_abaqus_head(TextFile& file, std::string_view what,
                        const std::vector<std::array<double, 3>>& points,
                        const VolumeFileInfo& info) {
@@ -111,7 +129,12 @@ void write_abaqus_head(TextFile& file, std::string_view what,
   file << "*NODE\n";
   for (size_t i = 0; i < points.size(); ++i) {
     const auto p = in_frame(points[i], info.frame);
-    file << i + 1 << ", " << p[0] << ", " << p[1] << ", " << p[2] << '\n';
+    file << i + 1;
+    for (const double coordinate : p) {
+      file << ", ";
+      write_abaqus_real(file, coordinate);
+    }
+    file << '\n';
   }
 }
 

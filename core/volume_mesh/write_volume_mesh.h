@@ -58,7 +58,9 @@ std::string label_group_name(int32_t label, const VolumeFileInfo& info);
 //   label. Tetrahedra with ref = label, and the
 //   triangles of each label's boundary (see label_boundary_faces) with ref = label, wound out of
 //   that label's region; vertices have ref 0.
-// - kAbaqus: Abaqus/CalculiX .inp with 1-based ids (element id = tetrahedron index + 1). C3D4
+// - kAbaqus: Abaqus/CalculiX .inp with 1-based ids (element id = tetrahedron index + 1); each
+//   coordinate within the 20 characters CalculiX reads (13 significant digits where the
+//   shortest exact form is longer). C3D4
 //   elements in ELSET=<G>, NSET=<G>_BOUNDARY with the nodes of that label's boundary, and
 //   SURFACE NAME=<G>_SURFACE, TYPE=ELEMENT with the element faces on it, where <G> is
 //   label_group_name in upper case (LABEL_5_LIVER).

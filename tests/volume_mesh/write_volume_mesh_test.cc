@@ -298,6 +298,47 @@ TEST(WriteVolumeMesh, TetgenNodeAndEleCarryLabelsAsRegions) {
   EXPECT_EQ(summary.at("tetra:tetgen:ref"), "1 2");
 }
 
+// CalculiX reads at most 20 characters a field: a coordinate a rounding
+// from zero, whose shortest exact form takes 23, is written within 20 and
+// reads back to within 1e-13 of it; ordinary ones keep their exact form.
+TEST(WriteVolumeMesh, AbaqusCoordinatesFitCalculixFields) {
+  TetMesh mesh = two_labels();
+  mesh.points[0][1] = -1.1314057027034252e-05;
+  mesh.points[1][2] = 26.14549617436983;
+  const auto dir = testing::scratch_dir("write-volume-inp-fields");
+  const auto path = path_in(dir, VolumeFormat::kAbaqus);
+  ASSERT_THAT(write_volume_mesh(mesh, {}, path, VolumeFormat::kAbaqus), testing::IsOk());
+  std::istringstream text(read_text(path));
+  std::string line;
+  bool in_nodes = false;
+  size_t node_lines = 0;
+  std::map<long, Point> nodes;
+  while (std::getline(text, line)) {
+    if (line.rfind('*', 0) == 0) {
+      in_nodes = line == "*NODE";
+      continue;
+    }
+    if (!in_nodes) continue;
+    ++node_lines;
+    std::istringstream fields(line);
+    std::string field;
+    long id = 0;
+    Point p{};
+    for (int k = 0; std::getline(fields, field, ','); ++k) {
+      const auto first = field.find_first_not_of(' ');
+      EXPECT_LE(field.size() - first, 20u) << line;
+      if (k == 0)
+        id = std::stol(field);
+      else
+        p[k - 1] = std::stod(field);
+    }
+    nodes[id] = p;
+  }
+  ASSERT_EQ(node_lines, mesh.points.size());
+  EXPECT_NEAR(nodes.at(1)[1], -1.1314057027034252e-05, 1e-13);
+  EXPECT_EQ(nodes.at(2)[2], 26.14549617436983);
+}
+
 // The C3D4 node order and face numbers, independently of the writer: the Jacobian of
 // u = (1-g-h-r)u1 + g u2 + h u3 + r u4 is det[p2-p1, p3-p1, p4-p1] (CalculiX shape4tet.f), and
 // faces are S1 = 1-2-3, S2 = 1-4-2, S3 = 2-4-3, S4 = 3-4-1.
