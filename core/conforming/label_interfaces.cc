@@ -196,12 +196,34 @@ void add_quads(const PaddedLabels& labels, const std::vector<VoxelPair>& pairs,
   }
 }
 
+// Whether a junction curve turns at `cube` (its neighbours along two
+// axes) and again at the cube diagonal to it, which holds a junction point
+// too: then it runs round three sides of one quad, and smoothed along itself
+// it would lie on the straight line between the quad's ends, collapsing the
+// quad onto it. Such a point stays where it is.
+bool turns_back(const std::array<int64_t, 3>& cube,
+                const std::array<std::array<int64_t, 3>, 2>& neighbours, const MarkedCubes& cubes,
+                const Net& net) {
+  std::array<int64_t, 3> diagonal = cube;
+  int axes = 0;
+  for (int k = 0; k < 3; ++k) {
+    const int64_t step = (neighbours[0][k] - cube[k]) + (neighbours[1][k] - cube[k]);
+    diagonal[k] += step;
+    axes += step != 0;
+  }
+  if (axes != 2) return false;  // straight on
+  const uint32_t r = cubes.point(cubes.index(diagonal[0], diagonal[1], diagonal[2]));
+  return r != kNoPoint && net.label_count[r] > 2;
+}
+
 // Two points are neighbours when their cubes share a face whose four voxels
 // do not all hold one label: a quad then has both as consecutive corners.
 // The six directions in this order give each point's neighbours in
-// increasing index, as the points are numbered in cube index order.
+// increasing index, as the points are numbered in cube index order. With
+// `fix_turns_back` (on thinner slices, whose interpolated labels make such
+// curves) a junction point where its curve turns back stays fixed.
 Stencil smoothing_stencil(const Net& net, const PaddedLabels& labels, const MarkedCubes& cubes,
-                          InterfaceFigures& figures) {
+                          bool fix_turns_back, InterfaceFigures& figures) {
   constexpr std::array<std::array<int, 2>, 6> kDirections{
       {{2, -1}, {1, -1}, {0, -1}, {0, 1}, {1, 1}, {2, 1}}};  // axis, sign
   const size_t n = net.centre.size();
@@ -213,6 +235,9 @@ Stencil smoothing_stencil(const Net& net, const PaddedLabels& labels, const Mark
     const size_t first = stencil.neighbours.size();
     const bool junction = net.label_count[p] > 2;
     const std::array<int64_t, 3> cube = cubes.cube(i);
+    // The cubes of the neighbours taken, for a junction's turn test.
+    std::array<std::array<int64_t, 3>, 2> taken{};
+    size_t count = 0;
     for (const auto& [axis, sign] : kDirections) {
       std::array<int64_t, 3> next = cube;
       next[axis] += sign;
@@ -232,11 +257,14 @@ Stencil smoothing_stencil(const Net& net, const PaddedLabels& labels, const Mark
         other[v] += k >> 1;
         uniform = labels.at(other[0], other[1], other[2]) == label;
       }
-      if (!uniform) stencil.neighbours.push_back(q);
+      if (uniform) continue;
+      if (count < 2) taken[count] = next;
+      ++count;
+      stencil.neighbours.push_back(q);
     }
     if (junction) {
       ++figures.junction_points;
-      if (stencil.neighbours.size() - first != 2) {
+      if (count != 2 || (fix_turns_back && turns_back(cube, taken, cubes, net))) {
         stencil.neighbours.resize(first);
         ++figures.fixed_points;
       }
@@ -443,8 +471,9 @@ InterfaceSurface label_interfaces(const volume::LabelVolume& volume,
     net.quad_sides.reserve(pairs.size());
     net.quad_axis.reserve(pairs.size());
     net.quad_voxels.reserve(pairs.size());
-    side_by_side([&] { add_quads(padded, pairs, cubes, net); },
-                 [&] { stencil = smoothing_stencil(net, padded, cubes, figures); });
+    side_by_side(
+        [&] { add_quads(padded, pairs, cubes, net); },
+        [&] { stencil = smoothing_stencil(net, padded, cubes, params.drawn_axis >= 0, figures); });
   }
   // The labels are not read again: their memory goes before smoothing's.
   std::vector<int32_t>().swap(padded.labels);

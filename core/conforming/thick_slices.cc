@@ -190,12 +190,23 @@ class SliceInterpolator {
         held = i;
       }
       const auto weight = catmull_rom_weights(t);
+      // The drawn slices below and above the thin one, in the box.
+      const auto in_box = [&](int64_t slice) {
+        return std::clamp<int64_t>(slice, lo_[a_], lo_[a_] + dims_[a_] - 1) - lo_[a_];
+      };
+      const int64_t below = in_box(i), above = in_box(i + 1);
       for (int64_t pv = 0; pv < nv; ++pv) {
         for (int64_t pu = 0; pu < nu; ++pu) {
           const size_t p = static_cast<size_t>(pv * nu + pu);
-          size_t best = 0;
+          // A thin voxel takes the label of one of the two drawn voxels
+          // around it, whichever's distance is the larger there: the cubic
+          // may overshoot, and labels compete, but no label reaches a pixel
+          // that neither drawn slice gives it.
+          const std::array<size_t, 2> candidates{at(source_[index(below, pu, pv)]),
+                                                 at(source_[index(above, pu, pv)])};
+          size_t best = candidates[0];
           double best_value = -std::numeric_limits<double>::infinity();
-          for (size_t l = 0; l < present_.size(); ++l) {
+          for (const size_t l : candidates) {
             double value = bias[l];
             for (int k = 0; k < 4; ++k) value += weight[k] * (*around[k])[l][p];
             if (value > best_value) {

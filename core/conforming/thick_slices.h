@@ -2,8 +2,9 @@
 // Thick slices (one voxel axis much coarser than the others, as in most 2D
 // MR and many CT series) cut into thinner ones by shape-based interpolation:
 // each label's signed distance within every slice, interpolated between
-// slice centres by a cubic through the four nearest, the largest one
-// winning. A surface net on the thinner grid can then slope between slices
+// slice centres by a cubic through the four nearest; of the labels of the
+// drawn voxels below and above a thin voxel's pixel, the larger wins. A
+// surface net on the thinner grid can then slope between slices
 // instead of stepping a whole slice at once, which folds it.
 // Reference: S. P. Raya and J. K. Udupa, "Shape-based interpolation of
 // multidimensional objects", IEEE Trans. Medical Imaging 9(1), 1990.

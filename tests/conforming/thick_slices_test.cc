@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 
@@ -13,6 +14,7 @@
 #include "core/volume/phantom_grid.h"
 #include "core/volume/voxel_access.h"
 #include "support/label_volumes.h"
+#include "support/organs_on_slices.h"
 #include "support/status_matchers.h"
 
 namespace labelmesh::conforming {
@@ -125,6 +127,41 @@ TEST(ThickSlices, KeepEachSliceAndEachLabelsVolume) {
   // of thin voxels, as it gains or loses them 60-70 at a time.
   EXPECT_NEAR(fine_volumes.at(1) / thick_volumes.at(1), 1.0, 0.01);
   EXPECT_NEAR(fine_volumes.at(2) / thick_volumes.at(2), 1.0, 0.005);
+}
+
+// Five organs that grow and meet from slice to slice: every thin voxel
+// holds the label of the drawn voxel below or above its pixel, however the
+// labels' distances compete or the cubic overshoots between slices.
+TEST(ThickSlices, AThinVoxelTakesALabelItsPixelIsDrawnWith) {
+  const auto thick = testing::five_organs_on_three_slices();
+  ThickSliceParams params;
+  params.min_ratio = 2.5;
+  params.thin_ratio = 1;
+  const ThickSlices cut = find_thick_slices(thick.geometry, params);
+  ASSERT_EQ(cut.axis, 2);
+  ASSERT_GE(cut.parts, 4);
+  const auto fine = interpolated(thick, cut);
+  const auto drawn = labels_of(thick);
+  const auto thin = labels_of(fine);
+  const auto& dims = thick.geometry.dims;
+  const int64_t plane = dims[0] * dims[1];
+  ASSERT_EQ(thin.size(), static_cast<size_t>(plane * dims[2] * cut.parts));
+  size_t foreign = 0, between = 0;
+  for (int64_t j = 0; j < dims[2] * cut.parts; ++j) {
+    const double position =
+        std::clamp((j + 0.5) / cut.parts - 0.5, 0.0, static_cast<double>(dims[2] - 1));
+    const int64_t below = std::min<int64_t>(static_cast<int64_t>(position), dims[2] - 2);
+    for (int64_t p = 0; p < plane; ++p) {
+      const int32_t label = thin[static_cast<size_t>(j * plane + p)];
+      const int32_t under = drawn[static_cast<size_t>(below * plane + p)];
+      const int32_t over = drawn[static_cast<size_t>((below + 1) * plane + p)];
+      if (label != under && label != over) ++foreign;
+      if (under != over) ++between;
+    }
+  }
+  EXPECT_EQ(foreign, 0u);
+  // The organs do change between slices: the test has pixels to fail on.
+  EXPECT_GT(between, 10'000u);
 }
 
 TEST(ThickSlices, FollowTheShapeBetweenSlicesBetterThanTheSlicesDo) {
