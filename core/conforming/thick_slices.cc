@@ -143,7 +143,7 @@ class SliceInterpolator {
   // Voxels of each present label in the thick slices.
   std::vector<uint64_t> source_counts() const {
     std::vector<uint64_t> counts(present_.size(), 0);
-    for (int32_t label : source_) ++counts[at(label)];
+    for (const uint32_t slot : source_slots_) ++counts[slot];
     add_outside_box(counts, 1);
     return counts;
   }
@@ -172,10 +172,12 @@ class SliceInterpolator {
           std::clamp((fine_lo[a_] + j + 0.5) / cut_.parts - 0.5, 0.0, double(na - 1));
       const int64_t i = std::min(static_cast<int64_t>(position), na - 2);
       const double t = position - i;
+      // Slice i - 1 + k of the volume as a slice of the box (k = 0 to 3:
+      // before, below, above, after); the box's end slices stand in beyond.
+      const auto slice = [&](int k) {
+        return std::clamp<int64_t>(i - 1 + k, lo_[a_], lo_[a_] + dims_[a_] - 1) - lo_[a_];
+      };
       if (held != i) {
-        const auto slice = [&](int k) {
-          return std::clamp<int64_t>(i - 1 + k, lo_[a_], lo_[a_] + dims_[a_] - 1) - lo_[a_];
-        };
         // At the box's ends a slice stands in for its missing neighbour:
         // the same distances, computed once even when the cache is full.
         const auto take = [&](int k) {
@@ -190,11 +192,7 @@ class SliceInterpolator {
         held = i;
       }
       const auto weight = catmull_rom_weights(t);
-      // The drawn slices below and above the thin one, in the box.
-      const auto in_box = [&](int64_t slice) {
-        return std::clamp<int64_t>(slice, lo_[a_], lo_[a_] + dims_[a_] - 1) - lo_[a_];
-      };
-      const int64_t below = in_box(i), above = in_box(i + 1);
+      const int64_t below = slice(1), above = slice(2);
       for (int64_t pv = 0; pv < nv; ++pv) {
         for (int64_t pu = 0; pu < nu; ++pu) {
           const size_t p = static_cast<size_t>(pv * nu + pu);
@@ -202,8 +200,8 @@ class SliceInterpolator {
           // around it, whichever's distance is the larger there: the cubic
           // may overshoot, and labels compete, but no label reaches a pixel
           // that neither drawn slice gives it.
-          const std::array<size_t, 2> candidates{at(source_[index(below, pu, pv)]),
-                                                 at(source_[index(above, pu, pv)])};
+          const std::array<size_t, 2> candidates{source_slots_[index(below, pu, pv)],
+                                                 source_slots_[index(above, pu, pv)]};
           size_t best = candidates[0];
           double best_value = -std::numeric_limits<double>::infinity();
           for (const size_t l : candidates) {
@@ -249,7 +247,8 @@ class SliceInterpolator {
   // two slices along the thick axis (the cubic reads two on either side),
   // and in the slices twice a slice's thickness (the most a label's bias
   // and the cubic's overshoot can grow it) and two voxels. Outside it every
-  // thinner voxel is 0, as it would be from the whole volume.
+  // thinner voxel is 0, as it would be from the whole volume. present_ must
+  // hold every label of `all` already.
   void crop_to_labels(const std::vector<int32_t>& all) {
     const auto& dims = geometry_.dims;
     auto box = volume::voxel_box(all.data(), dims, [](int32_t label) { return label != 0; });
@@ -264,12 +263,13 @@ class SliceInterpolator {
       lo_[k] = std::max<int64_t>(0, first[k] - margin);
       dims_[k] = std::min(dims[k] - 1, last[k] + margin) - lo_[k] + 1;
     }
-    source_.resize(static_cast<size_t>(dims_[0] * dims_[1] * dims_[2]));
+    source_slots_.resize(static_cast<size_t>(dims_[0] * dims_[1] * dims_[2]));
     size_t o = 0;
     for (int64_t z = lo_[2]; z < lo_[2] + dims_[2]; ++z)
       for (int64_t y = lo_[1]; y < lo_[1] + dims_[1]; ++y)
         for (int64_t x = lo_[0]; x < lo_[0] + dims_[0]; ++x)
-          source_[o++] = all[static_cast<size_t>((z * dims[1] + y) * dims[0] + x)];
+          source_slots_[o++] =
+              static_cast<uint32_t>(at(all[static_cast<size_t>((z * dims[1] + y) * dims[0] + x)]));
   }
 
   // Adds the voxels outside the box, `parts` per thick one, to label 0's
@@ -310,11 +310,11 @@ class SliceInterpolator {
     const double su = geometry_.spacing[u_], sv = geometry_.spacing[v_];
     std::vector<std::vector<float>> distances;
     std::vector<uint8_t> inside(static_cast<size_t>(nu * nv)), outside(inside.size());
-    for (int32_t label : present_) {
+    for (uint32_t slot = 0; slot < present_.size(); ++slot) {
       bool any = false;
       for (int64_t pv = 0; pv < nv; ++pv) {
         for (int64_t pu = 0; pu < nu; ++pu) {
-          const bool in = source_[index(i, pu, pv)] == label;
+          const bool in = source_slots_[index(i, pu, pv)] == slot;
           inside[pv * nu + pu] = in;
           outside[pv * nu + pu] = !in;
           any |= in;
@@ -339,9 +339,10 @@ class SliceInterpolator {
   const ThickSlices cut_;
   const int a_, u_, v_;
   const float band_;
-  // The selected labels' box (crop_to_labels) and its labels.
+  // The selected labels' box (crop_to_labels), and each of its voxels'
+  // label as its place in present_, so the fill weighs labels by place.
   std::array<int64_t, 3> lo_{0, 0, 0}, dims_{0, 0, 0};
-  std::vector<int32_t> source_;
+  std::vector<uint32_t> source_slots_;
   std::vector<int32_t> present_;
   mutable std::vector<std::shared_ptr<const Distances>> cache_;
   mutable size_t cached_floats_ = 0;

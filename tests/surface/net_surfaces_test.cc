@@ -520,15 +520,8 @@ TEST(NetSurfacesRealData, CrossingMovesAreTakenBack) {
   EXPECT_GT(taken_back, 0u);
   // Half a move often clears the crossing and keeps part of the wider
   // angle: no triangle is left below 5 degrees.
-  double smallest = 180;
-  for (const auto& t : net.triangles)
-    for (int k = 0; k < 3; ++k) {
-      const auto& at = net.points[t[k]];
-      const auto u = geometry::sub(net.points[t[(k + 1) % 3]], at);
-      const auto v = geometry::sub(net.points[t[(k + 2) % 3]], at);
-      const double cosine = geometry::dot(u, v) / (geometry::norm(u) * geometry::norm(v));
-      smallest = std::min(smallest, std::acos(std::clamp(cosine, -1.0, 1.0)) * 180 / M_PI);
-    }
+  const double smallest =
+      surface::compute_surface_statistics({net.points, net.triangles}).min_angle_deg;
   EXPECT_GT(smallest, 5);
   EXPECT_EQ(pairs, surface::crossing_triangles(net.points, net.triangles));
   std::vector<bool> still_moved(net.points.size(), false);
