@@ -21,6 +21,8 @@ namespace {
 constexpr float kFar = std::numeric_limits<float>::max();
 // Rounds of tuning each label's bias to its volume.
 constexpr int kBiasRounds = 4;
+// The signed distances' clamp, in slices.
+constexpr float kBandSlices = 2;
 // Slice distances kept between rounds: at most 256 MiB of them.
 constexpr size_t kCacheFloats = size_t{64} << 20;
 
@@ -115,6 +117,10 @@ std::array<double, 4> catmull_rom_weights(double t) {
           0.5 * (t3 - t2)};
 }
 
+// How much of a label's bias acts on a thin slice at place t (0 to 1)
+// between two drawn slices: none on them, all of it half way.
+double bias_taper(double t) { return 4 * t * (1 - t); }
+
 // The thinner grid's labels from the thick slices' signed distances, each
 // label's shifted by a bias (mm) that the caller tunes to keep its volume.
 class SliceInterpolator {
@@ -126,10 +132,15 @@ class SliceInterpolator {
         a_(cut.axis),
         u_((cut.axis + 1) % 3),
         v_((cut.axis + 2) % 3),
-        // Clamped to a slice's thickness: where a label fills a slice or is
-        // absent from it, the next slice's shape takes over half way
-        // between them, where the voxels say it does.
-        band_(static_cast<float>(volume.geometry.spacing[cut.axis])) {
+        // Clamped to two slices' thickness. Where a label fills a slice
+        // or is absent from it, the next slice's shape still takes over half
+        // way between them, where the voxels say it does. Below the clamp
+        // the crossing follows the distances: a clamp of one slice flattened
+        // every wall leaning more than 45 degrees from the axis (its contour
+        // moves more than a slice's thickness from slice to slice) into
+        // terraces half way, and a label's last slice into a plateau with a
+        // step at its rim.
+        band_(static_cast<float>(kBandSlices * volume.geometry.spacing[cut.axis])) {
     const auto all = selected_labels(volume, labels);
     present_ = all;
     std::sort(present_.begin(), present_.end());
@@ -139,6 +150,16 @@ class SliceInterpolator {
   }
 
   const std::vector<int32_t>& present() const { return present_; }
+
+  // The bias taper's mean over the thin slices of one thick slice.
+  double mean_taper() const {
+    double sum = 0;
+    for (int j = 0; j < cut_.parts; ++j) {
+      const double position = (j + 0.5) / cut_.parts - 0.5;
+      sum += bias_taper(position - std::floor(position));
+    }
+    return sum / cut_.parts;
+  }
 
   // Voxels of each present label in the thick slices.
   std::vector<uint64_t> source_counts() const {
@@ -192,6 +213,9 @@ class SliceInterpolator {
         held = i;
       }
       const auto weight = catmull_rom_weights(t);
+      // The bias acts between the drawn slices, not on them: their voxels
+      // are data, where the volume error comes from the guess between.
+      const double taper = bias_taper(t);
       const int64_t below = slice(1), above = slice(2);
       for (int64_t pv = 0; pv < nv; ++pv) {
         for (int64_t pu = 0; pu < nu; ++pu) {
@@ -205,7 +229,7 @@ class SliceInterpolator {
           size_t best = candidates[0];
           double best_value = -std::numeric_limits<double>::infinity();
           for (const size_t l : candidates) {
-            double value = bias[l];
+            double value = taper * bias[l];
             for (int k = 0; k < 4; ++k) value += weight[k] * (*around[k])[l][p];
             if (value > best_value) {
               best_value = value;
@@ -243,12 +267,12 @@ class SliceInterpolator {
                                present_.begin());
   }
 
-  // The selected labels' box with a margin the interpolation cannot cross:
-  // two slices along the thick axis (the cubic reads two on either side),
-  // and in the slices twice a slice's thickness (the most a label's bias
-  // and the cubic's overshoot can grow it) and two voxels. Outside it every
-  // thinner voxel is 0, as it would be from the whole volume. present_ must
-  // hold every label of `all` already.
+  // The selected labels' box with a margin: two slices along the thick axis
+  // (the cubic reads two on either side), and in the slices the distances'
+  // clamp and two voxels, so every clamped distance is the whole volume's.
+  // A thin voxel takes only labels drawn at its pixel, so outside the box
+  // every thinner voxel is 0, as it would be from the whole volume.
+  // present_ must hold every label of `all` already.
   void crop_to_labels(const std::vector<int32_t>& all) {
     const auto& dims = geometry_.dims;
     auto box = volume::voxel_box(all.data(), dims, [](int32_t label) { return label != 0; });
@@ -258,8 +282,7 @@ class SliceInterpolator {
     const auto& last = box.last;
     for (int k = 0; k < 3; ++k) {
       const auto margin =
-          k == a_ ? int64_t{2}
-                  : static_cast<int64_t>(std::ceil(2 * band_ / geometry_.spacing[k])) + 2;
+          k == a_ ? int64_t{2} : static_cast<int64_t>(std::ceil(band_ / geometry_.spacing[k])) + 2;
       lo_[k] = std::max<int64_t>(0, first[k] - margin);
       dims_[k] = std::min(dims[k] - 1, last[k] + margin) - lo_[k] + 1;
     }
@@ -397,9 +420,10 @@ absl::StatusOr<volume::LabelVolume> interpolate_thick_slices(const volume::Label
 
   // Interpolation thins narrow shapes; each label's bias is raised by its
   // missing volume spread over its boundary (by half a band for a label that
-  // vanished, which has none), at most half a band a round and a band in
-  // all, until every label has its voxels' volume to within a tenth of a
-  // percent or the rounds run out; the best round's biases are kept.
+  // vanished, which has none) and over the thin slices' mean taper, at most
+  // half a band a round and a band in all, until every label has its
+  // voxels' volume to within a tenth of a percent or the rounds run out; the
+  // best round's biases are kept. The band here is one slice's thickness.
   std::fill(out, out + fine.geometry.voxel_count(), 0);
   const SliceInterpolator interpolator(volume, labels, cut);
   const auto& present = interpolator.present();
@@ -408,6 +432,7 @@ absl::StatusOr<volume::LabelVolume> interpolate_thick_slices(const volume::Label
   const double step =
       std::cbrt(fine.geometry.spacing[0] * fine.geometry.spacing[1] * fine.geometry.spacing[2]);
   const double band = geometry.spacing[cut.axis];
+  const double taper = interpolator.mean_taper();
   std::vector<double> bias(present.size(), 0), best_bias;
   double best_error = std::numeric_limits<double>::infinity();
   std::vector<uint64_t> counts, boundary;
@@ -430,7 +455,7 @@ absl::StatusOr<volume::LabelVolume> interpolate_thick_slices(const volume::Label
     }
     for (size_t l = 0; l < present.size(); ++l) {
       const double missing = double(target[l]) - double(counts[l]);
-      const double change = boundary[l] > 0 ? missing * step / double(boundary[l])
+      const double change = boundary[l] > 0 ? missing * step / (taper * double(boundary[l]))
                             : missing > 0   ? band / 2
                                             : 0;
       bias[l] = std::clamp(bias[l] + std::clamp(change, -band / 2, band / 2), -band, band);

@@ -50,7 +50,8 @@ ThickSlices find_thick_slices(const volume::ImageGeometry& geometry,
 // for each slice along `cut.axis`, int32 voxels. Beyond the first and last
 // slice centres the labels do not change along the axis. Each label's
 // distances carry a bias that keeps its volume within 0.1 % of its voxels'
-// where a few rounds can, so a thin slice near a thick one's centre may
+// where a few rounds can. The bias fades to nothing at the thick slices'
+// centres: a thin slice through one holds its labels, and one near it may
 // differ from it at label edges.
 // Errors: INVALID_ARGUMENT unless cut.axis is 0, 1 or 2, cut.parts >= 2 and
 // the axis has two slices or more; RESOURCE_EXHAUSTED when the thinner

@@ -13,6 +13,7 @@
 #include "core/volume/label_statistics.h"
 #include "core/volume/phantom_grid.h"
 #include "core/volume/voxel_access.h"
+#include "support/analytic_shapes.h"
 #include "support/label_volumes.h"
 #include "support/organs_on_slices.h"
 #include "support/status_matchers.h"
@@ -186,6 +187,68 @@ TEST(ThickSlices, FollowTheShapeBetweenSlicesBetterThanTheSlicesDo) {
   }
   EXPECT_GT(sliced_wrong, 3000u);
   EXPECT_LT(interpolated_wrong, sliced_wrong / 2);
+}
+
+// A ring whose volume the bias restores (its thin slices lose 4 % before
+// it, and the bias moves its edges by more than a pixel): the bias acts between drawn slices only,
+// so each thin slice through a drawn slice's centre holds that slice's labels voxel for voxel, and
+// the voxel centres the surface is judged by stay as they were drawn.
+TEST(ThickSlices, DrawnSlicesKeepTheirVoxelsWhileTheBiasRestoresVolume) {
+  const auto ring = testing::torus_shape(25, 9);
+  const auto thick = testing::sample_shape(ring, {0.6, 0.6, 4});
+  const ThickSlices cut = find_thick_slices(thick.geometry, {});
+  ASSERT_EQ(cut.axis, 2);
+  ASSERT_EQ(cut.parts, 3);
+  const auto fine = interpolated(thick, cut);
+  const auto drawn = labels_of(thick);
+  const auto thin = labels_of(fine);
+  const auto& dims = thick.geometry.dims;
+  const int64_t plane = dims[0] * dims[1];
+  size_t changed = 0;
+  for (int64_t slice = 0; slice < dims[2]; ++slice) {
+    const int64_t centre = slice * cut.parts + cut.parts / 2;
+    for (int64_t p = 0; p < plane; ++p) {
+      changed += thin[static_cast<size_t>(centre * plane + p)] !=
+                 drawn[static_cast<size_t>(slice * plane + p)];
+    }
+  }
+  EXPECT_EQ(changed, 0u);
+  const auto thick_volumes = label_volumes(thick);
+  const auto fine_volumes = label_volumes(fine);
+  EXPECT_NEAR(fine_volumes.at(1) / thick_volumes.at(1), 1.0, 0.005);
+}
+
+// A sphere of radius 25 mm on 1 x 1 x 3 mm slices, where its walls lean
+// more than 45 degrees from the slice axis (the contour moves more than a
+// slice's thickness from one slice to the next) and at its poles, beyond
+// the last drawn slice: the thin voxels follow the true sphere there.
+// Distances clamped at one slice's thickness made terraces of those walls
+// half way between slices and a plateau over each pole: 17 % of the thin
+// voxels there on the wrong side, against 6 %.
+TEST(ThickSlices, ShallowWallsAndPolesFollowTheShape) {
+  const auto sphere = testing::sphere_shape(25);
+  const auto thick = testing::sample_shape(sphere, {1, 1, 3});
+  const ThickSlices cut = find_thick_slices(thick.geometry, {});
+  ASSERT_EQ(cut.axis, 2);
+  const auto fine = interpolated(thick, cut);
+  const auto thin = labels_of(fine);
+  const auto& d = fine.geometry.dims;
+  size_t shallow = 0, wrong = 0;
+  size_t i = 0;
+  for (int64_t z = 0; z < d[2]; ++z) {
+    for (int64_t y = 0; y < d[1]; ++y) {
+      for (int64_t x = 0; x < d[0]; ++x, ++i) {
+        const auto p = fine.geometry.to_physical({double(x), double(y), double(z)});
+        // Within two pixels of the sphere, where its normal is within 45
+        // degrees of the slice axis.
+        if (sphere.distance(p) > 2 || std::abs(p[2]) < std::sqrt(0.5) * 25) continue;
+        ++shallow;
+        wrong += (thin[i] == 1) != sphere.inside(p);
+      }
+    }
+  }
+  EXPECT_GT(shallow, 5'000u);
+  EXPECT_LT(double(wrong), 0.1 * double(shallow)) << wrong << " of " << shallow;
 }
 
 TEST(ThickSlices, AnyAxisCanBeThick) {

@@ -268,6 +268,8 @@ TEST(NetSurfaces, ThickSliceShapesAreTruerThanTheSlicerLikePipeline) {
   };
   const std::vector<Case> cases{{testing::sphere_shape(25), {0.6, 0.6, 4}},
                                 {testing::ellipsoid_shape(32, 22, 15), {0.6, 0.6, 4}},
+                                {testing::sphere_shape(25), {1, 1, 3}},
+                                {testing::ellipsoid_shape(32, 22, 15), {1, 1, 3}},
                                 {testing::torus_shape(25, 9), {3, 3, 3}}};
   for (const auto& [shape, spacing] : cases) {
     const auto both = both_surfaces(testing::sample_shape(shape, spacing));
@@ -321,12 +323,14 @@ TEST(NetSurfaces, ThinRingsOnThickSlicesKeepTheNet) {
     std::array<double, 3> spacing;
     std::string stage;
   };
-  // The thin tube on 3 mm slices puts a few voxel centres, a hundredth of a
-  // voxel from the surface, on the wrong side once the boxes widen between
-  // drawn slices: the net smoothed half as much is delivered.
+  // The thin tube on 3 mm slices, and the thicker ring on 4 mm slices where
+  // its top and bottom skim the drawn slices, put 1-1.5 % of their boundary
+  // voxel centres, a hundredth of a voxel from the surface, on the wrong
+  // side with the full smoothing: the net smoothed half as much is
+  // delivered.
   const std::vector<Case> cases{
       {testing::torus_shape(25, 4.5, "thin tube"), {0.6, 0.6, 4}, "net"},
-      {testing::torus_shape(25, 9), {0.6, 0.6, 4}, "net"},
+      {testing::torus_shape(25, 9), {0.6, 0.6, 4}, "net_lighter"},
       {testing::torus_shape(25, 4.5, "thin tube"), {1, 1, 3}, "net_lighter"}};
   for (const auto& [shape, spacing, stage] : cases) {
     const std::string name = shape.name + " on " + std::to_string(spacing[2]) + " mm";
@@ -372,6 +376,22 @@ TEST(NetSurfaces, WiderBoxesBetweenDrawnSlicesSmoothTheInterpolatedSteps) {
     const auto stepped_error = testing::shape_error(stepped->mesh, sphere);
     EXPECT_LT(smooth_error.normal_p95_deg, 0.85 * stepped_error.normal_p95_deg) << degrees;
     EXPECT_LT(smooth_error.rms_mm, stepped_error.rms_mm + 0.01) << degrees;
+  }
+}
+
+// A sphere on 1 x 1 x 3 mm slices, straight and turned: 95 % of its area
+// within 10 degrees of the true normal, poles included, where the last
+// drawn slice's disc must round off into a cap.
+TEST(NetSurfaces, ASphereOnThickSlicesHasTrueNormalsToItsPoles) {
+  const auto sphere = testing::sphere_shape(25);
+  for (const double degrees : {0.0, 25.0}) {
+    const auto result =
+        run_pipeline_on_volume(testing::sample_shape(sphere, {1, 1, 3}, degrees), {}, {});
+    ASSERT_THAT(result, testing::IsOk());
+    const auto* ours = output_of(*result, 1);
+    ASSERT_NE(ours, nullptr);
+    EXPECT_EQ(ours->stage, "net") << degrees;
+    EXPECT_LT(testing::shape_error(ours->mesh, sphere).normal_p95_deg, 10) << degrees;
   }
 }
 
