@@ -25,7 +25,8 @@ PointBoxes thirds() {
 }
 
 TEST(PointBoxes, WithoutDrawnSlicesAPointIsClampedAlongEachAxis) {
-  const PointBoxes boxes{{0.5, 0.25, 1}};
+  PointBoxes boxes;
+  boxes.half = {0.5, 0.25, 1};
   const Vec3 held = boxes.hold(0, {10, 20, 30}, {11, 19, 30.5});
   EXPECT_EQ(held, (Vec3{10.5, 19.75, 30.5}));
 }

@@ -55,7 +55,8 @@ TEST(WidenSmallAngles, TwoPointsPressedTogetherSlideApartAlongTheSurface) {
   net.points[6][0] -= 0.45;
   const double before = smallest_angle_deg(net);
   ASSERT_LT(before, 10);
-  const PointBoxes boxes{{0.475, 0.475, 0.475}};
+  PointBoxes boxes;
+  boxes.half = {0.475, 0.475, 0.475};
   const auto widened = widen_small_angles(net.quads, net.sides, net.slides, net.centre, boxes,
                                           {0.2, 0.2, 0.2}, 20, net.points);
   EXPECT_GE(widened.points_moved, 1u);
@@ -75,9 +76,10 @@ TEST(WidenSmallAngles, WideAnglesAreLeftAlone) {
   FlatNet net = flat_net();
   net.points[5][0] += 0.2;
   const auto moved_before = net.points;
-  const auto widened =
-      widen_small_angles(net.quads, net.sides, net.slides, net.centre,
-                         PointBoxes{{0.475, 0.475, 0.475}}, {0.2, 0.2, 0.2}, 20, net.points);
+  PointBoxes boxes;
+  boxes.half = {0.475, 0.475, 0.475};
+  const auto widened = widen_small_angles(net.quads, net.sides, net.slides, net.centre, boxes,
+                                          {0.2, 0.2, 0.2}, 20, net.points);
   EXPECT_EQ(widened.points_moved, 0u);
   EXPECT_EQ(net.points, moved_before);
 }
