@@ -313,59 +313,71 @@ std::vector<double> label_volumes(const Net& net, const SideSlots& slots,
   return volume;
 }
 
-// Moves the points where only one label meets the outside along their
-// normal, by the label's lost volume over its area there, so each label
-// keeps its voxels' volume where smoothing shrank it (thin labels most):
-// interfaces between labels stay where smoothing put them. Points stay in
-// their boxes.
+// Rounds of giving labels back their volume.
+constexpr int kRestoreRounds = 6;
+
+// Moves the points that lie between one pair of sides along their normal,
+// so that each label keeps its voxels' volume where smoothing shrank it
+// (thin labels most): by the volume the first side lost over its area, less
+// what the second lost over its own (the outside loses nothing). A thin
+// label between two thick ones so takes its volume from them, and two
+// labels that both lost leave their interface where it is. Points where
+// more than one pair meets stay; every point stays in its box.
 void restore_volumes(const Net& net, const std::vector<Vec3>& centre, const PointBoxes& boxes,
                      std::vector<Vec3>& points) {
   const SideSlots slots = side_slots(net);
   const auto outside = static_cast<uint32_t>(
       std::lower_bound(slots.labels.begin(), slots.labels.end(), kOutside) - slots.labels.begin());
   const bool has_outside = outside < slots.labels.size() && slots.labels[outside] == kOutside;
+  const auto is_outside = [&](uint32_t slot) { return has_outside && slot == outside; };
   const auto target = label_volumes(net, slots, centre);
-  constexpr uint32_t kUnowned = UINT32_MAX, kShared = UINT32_MAX - 1;
-  // Per point: the one label (slot) it bounds against the outside, or
-  // kShared when it touches another label too; and its area-weighted
-  // outward normal.
-  std::vector<uint32_t> owner(points.size());
+  // Per point: the pair of sides its quads lie between (the outside, if
+  // there, second), whether more than one pair meets there, and its
+  // area-weighted normal from the first side into the second.
+  std::vector<std::array<uint32_t, 2>> pair(points.size());
+  enum class Between : uint8_t { kNone, kOnePair, kMore };
+  std::vector<Between> between(points.size());
   std::vector<Vec3> normal(points.size());
-  std::vector<double> area(slots.labels.size());
-  for (int round = 0; round < 3; ++round) {
+  std::vector<double> area(slots.labels.size()), need(slots.labels.size());
+  for (int round = 0; round < kRestoreRounds; ++round) {
     const auto now = label_volumes(net, slots, points);
-    std::fill(owner.begin(), owner.end(), kUnowned);
+    std::fill(between.begin(), between.end(), Between::kNone);
     std::fill(normal.begin(), normal.end(), Vec3{0, 0, 0});
     std::fill(area.begin(), area.end(), 0.0);
     for (size_t q = 0; q < net.quads.size(); ++q) {
       const auto& c = net.quads[q];
-      const auto& sides = slots.sides[q];
-      const bool outer = has_outside && (sides[0] == outside || sides[1] == outside);
-      const uint32_t label = sides[0] == outside ? sides[1] : sides[0];
+      auto sides = slots.sides[q];
       // Twice the quad's vector area, pointing from sides[0] to sides[1].
       Vec3 n = geometry::add(geometry::cross(geometry::sub(points[c[1]], points[c[0]]),
                                              geometry::sub(points[c[2]], points[c[0]])),
                              geometry::cross(geometry::sub(points[c[2]], points[c[0]]),
                                              geometry::sub(points[c[3]], points[c[0]])));
-      if (sides[0] == outside) n = geometry::scale(n, -1);
-      if (outer) area[label] += 0.5 * geometry::norm(n);
-      for (uint32_t p : c) {
-        if (!outer || (owner[p] != kUnowned && owner[p] != label)) {
-          owner[p] = kShared;
-          continue;
+      if (is_outside(sides[0]) || (!is_outside(sides[1]) && sides[0] > sides[1])) {
+        std::swap(sides[0], sides[1]);
+        n = geometry::scale(n, -1);
+      }
+      const double half = 0.5 * geometry::norm(n);
+      area[sides[0]] += half;
+      area[sides[1]] += half;
+      for (const uint32_t p : c) {
+        if (between[p] == Between::kNone) {
+          between[p] = Between::kOnePair;
+          pair[p] = sides;
+        } else if (pair[p] != sides) {
+          between[p] = Between::kMore;
         }
-        owner[p] = label;
         normal[p] = geometry::add(normal[p], n);
       }
     }
+    for (size_t l = 0; l < need.size(); ++l)
+      need[l] =
+          area[l] > 0 && !is_outside(static_cast<uint32_t>(l)) ? (target[l] - now[l]) / area[l] : 0;
     for (size_t p = 0; p < points.size(); ++p) {
-      if (owner[p] == kUnowned || owner[p] == kShared) continue;
-      const uint32_t label = owner[p];
-      const double lost = target[label] - now[label];
       const double length = geometry::norm(normal[p]);
-      if (length == 0 || area[label] == 0) continue;
-      const Vec3 step = geometry::scale(normal[p], lost / area[label] / length);
-      points[p] = boxes.hold(p, centre[p], geometry::add(points[p], step));
+      if (between[p] != Between::kOnePair || length == 0) continue;
+      const double move = need[pair[p][0]] - need[pair[p][1]];
+      points[p] = boxes.hold(p, centre[p],
+                             geometry::add(points[p], geometry::scale(normal[p], move / length)));
     }
   }
 }

@@ -26,9 +26,11 @@
 #include "core/util/vec3.h"
 #include "core/volume/label_statistics.h"
 #include "core/volume/phantom.h"
+#include "core/volume/phantom_grid.h"
 #include "core/volume/read_label_volume.h"
 #include "support/analytic_shapes.h"
 #include "support/label_grid.h"
+#include "support/label_volumes.h"
 #include "support/organs_on_slices.h"
 #include "support/slicer_like.h"
 #include "support/status_matchers.h"
@@ -259,6 +261,33 @@ TEST(NetSurfaces, NestedLabelsShareTheirInterfacesWithoutOverlap) {
   EXPECT_EQ(inside, 0u);
 }
 
+// A shell a voxel and a half thick between a ball and a thicker shell, on
+// 1 mm voxels: it meets the outside nowhere, so only its interfaces can give
+// it back what smoothing took (held still, they left its net outside the
+// volume tolerance, and it got the meshed mask). They move into its thick
+// neighbours, which hardly notice: all three labels are the net within the
+// voxel tolerance.
+TEST(NetSurfaces, AThinLabelBetweenTwoThickOnesKeepsItsVolume) {
+  const std::array<double, 3> centre{0, 0, 0};
+  const auto volume = volume::rasterise(
+      volume::centred_grid({45, 45, 45}, {1, 1, 1}, testing::kIdentityDirection, centre),
+      [](const std::array<double, 3>& p) {
+        const double r = geometry::norm(p);
+        return r < 10 ? 1 : r < 11.5 ? 2 : r < 20 ? 3 : 0;
+      });
+  auto result = run_pipeline_on_volume(volume, MeshParams{}, {});
+  ASSERT_THAT(result, testing::IsOk());
+  for (const int32_t label : {1, 2, 3}) {
+    const auto* s = output_of(*result, label);
+    ASSERT_NE(s, nullptr) << label;
+    EXPECT_EQ(s->stage, "net") << label;
+    EXPECT_TRUE(s->fidelity->within_tolerance()) << label;
+    const auto& voxels = *s->fidelity->attempts[s->fidelity->delivered].voxels;
+    EXPECT_LT(std::abs(voxels.volume_change), 0.03) << label;
+    EXPECT_EQ(voxels.misclassified, 0u) << label;
+  }
+}
+
 // Analytic shapes on the grids hospitals send: closer to the true surface,
 // with truer normals, than the Slicer-like pipeline on the same volume.
 TEST(NetSurfaces, ThickSliceShapesAreTruerThanTheSlicerLikePipeline) {
@@ -462,10 +491,11 @@ TEST(NetSurfaces, CoarseIsotropicSphereIsWithinAQuarterVoxel) {
   EXPECT_LT(error.normal_p95_deg, 10);
 }
 
-// The 3 mm MR of 23 labels: every label delivered within the voxel tolerance
-// or named in the warnings; the net's surfaces closed, manifold, without thin
-// triangles, faithful to every voxel centre and far smoother than Marching
-// Cubes; --strict refuses the run when any label is outside.
+// The 3 mm MR of 23 labels: every label delivered within the voxel
+// tolerance (the thin ones between organs take their volume back from
+// them); the net's surfaces closed, manifold, without thin triangles,
+// faithful to every voxel centre and far smoother than Marching Cubes; so
+// --strict accepts the run.
 TEST(NetSurfacesRealData, MrLabelsAreFaithfulSmoothOrWarned) {
   LABELMESH_SKIP_WITHOUT_SHARED_DATA();
   const auto path = testing::shared_data("totalseg_example_seg_mr.nii.gz");
@@ -493,8 +523,8 @@ TEST(NetSurfacesRealData, MrLabelsAreFaithfulSmoothOrWarned) {
   }
   EXPECT_EQ(outputs, 23u);
   EXPECT_GE(nets, 21u);
-  EXPECT_EQ(result->warnings.size(), outside);
-  EXPECT_LE(outside, 3u);
+  EXPECT_EQ(outside, 0u);
+  EXPECT_TRUE(result->warnings.empty());
   const auto median = [](std::vector<double> v) {
     std::sort(v.begin(), v.end());
     return v[v.size() / 2];
@@ -503,11 +533,7 @@ TEST(NetSurfacesRealData, MrLabelsAreFaithfulSmoothOrWarned) {
 
   MeshParams strict;
   strict.guard.strict = true;
-  auto refused = run_pipeline(path, strict, {});
-  ASSERT_FALSE(refused.ok());
-  EXPECT_THAT(refused, testing::StatusIs(absl::StatusCode::kFailedPrecondition));
-  EXPECT_NE(refused.status().message().find("voxel centres on the wrong side"), std::string::npos)
-      << refused.status();
+  EXPECT_THAT(run_pipeline(path, strict, {}), testing::IsOk());
 }
 
 // The whole-brain segmentation's 40 labels touch one another in every way
