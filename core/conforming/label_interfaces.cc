@@ -318,11 +318,11 @@ constexpr int kRestoreRounds = 6;
 
 // Moves the points that lie between one pair of sides along their normal,
 // so that each label keeps its voxels' volume where smoothing shrank it
-// (thin labels most): by the volume the first side lost over its area, less
-// what the second lost over its own (the outside loses nothing). A thin
-// label between two thick ones so takes its volume from them, and two
-// labels that both lost leave their interface where it is. Points where
-// more than one pair meets stay; every point stays in its box.
+// (thin labels most): by the volume the first side lost over the area its
+// moving points carry, less the same for the second (the outside loses
+// nothing). A thin label between two thick ones so takes its volume from
+// them, and two labels that both lost leave their interface where it is.
+// Points where more than one pair meets stay; every point stays in its box.
 void restore_volumes(const Net& net, const std::vector<Vec3>& centre, const PointBoxes& boxes,
                      std::vector<Vec3>& points) {
   const SideSlots slots = side_slots(net);
@@ -339,6 +339,7 @@ void restore_volumes(const Net& net, const std::vector<Vec3>& centre, const Poin
   std::vector<Between> between(points.size());
   std::vector<Vec3> normal(points.size());
   std::vector<double> area(slots.labels.size()), need(slots.labels.size());
+  std::vector<double> quad_area(net.quads.size());
   for (int round = 0; round < kRestoreRounds; ++round) {
     const auto now = label_volumes(net, slots, points);
     std::fill(between.begin(), between.end(), Between::kNone);
@@ -356,9 +357,7 @@ void restore_volumes(const Net& net, const std::vector<Vec3>& centre, const Poin
         std::swap(sides[0], sides[1]);
         n = geometry::scale(n, -1);
       }
-      const double half = 0.5 * geometry::norm(n);
-      area[sides[0]] += half;
-      area[sides[1]] += half;
+      quad_area[q] = 0.5 * geometry::norm(n);
       for (const uint32_t p : c) {
         if (between[p] == Between::kNone) {
           between[p] = Between::kOnePair;
@@ -368,6 +367,13 @@ void restore_volumes(const Net& net, const std::vector<Vec3>& centre, const Poin
         }
         normal[p] = geometry::add(normal[p], n);
       }
+    }
+    // The area each side's moving points carry: a point moved by d along
+    // its normal moves a quarter of each of its quads by d.
+    for (size_t q = 0; q < net.quads.size(); ++q) {
+      int moving = 0;
+      for (const uint32_t p : net.quads[q]) moving += between[p] == Between::kOnePair;
+      for (const uint32_t side : slots.sides[q]) area[side] += quad_area[q] * moving / 4;
     }
     for (size_t l = 0; l < need.size(); ++l)
       need[l] =
