@@ -162,7 +162,12 @@ absl::StatusOr<volume_mesh::TetMesh> mesh_conforming(const volume::LabelVolume& 
   }
   figures.slide = slid;
   if (params.improve.target_quality > 0) {
-    if (auto status = volume_mesh::improve_tet_mesh(*mesh, params.improve, context, improve);
+    // Inside the labels the pass lifts what the slides aim for on the
+    // interfaces: tetrahedra whose corners are not all on them.
+    volume_mesh::ImproveParams inside = params.improve;
+    inside.target_dihedral_deg =
+        std::max(inside.target_dihedral_deg, params.slide.target_dihedral_deg);
+    if (auto status = volume_mesh::improve_tet_mesh(*mesh, inside, context, improve);
         !status.ok()) {
       return status;
     }

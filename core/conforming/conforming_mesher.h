@@ -84,8 +84,9 @@ struct ConformingFigures {
 
 // Meshes `labels` of `volume` (every non-zero label when empty) as one
 // conforming mesh, then slides interface points, runs the improvement pass
-// when params.improve.target_quality > 0 (`improve` gets its figures), and
-// slides them again.
+// when params.improve.target_quality > 0 (`improve` gets its figures; it
+// works on tetrahedra below the slides' dihedral target too), and slides
+// them again.
 // Errors: INVALID_ARGUMENT for parameters out of range or no voxel of any
 // selected label; FAILED_PRECONDITION when TetGen refuses the surface or the
 // result fails the conformity check (never delivered); RESOURCE_EXHAUSTED;

@@ -27,6 +27,9 @@ class WorkMesh {
   WorkMesh(TetMesh& mesh, const ImproveParams& params)
       : max_volume(params.max_volume_mm3),
         max_peel_depth(params.max_peel_depth_mm),
+        dihedral_scale_(params.target_dihedral_deg > 0
+                            ? params.target_quality / params.target_dihedral_deg
+                            : 0),
         mesh_(mesh),
         star_(mesh.points.size()) {
     tets_.reserve(mesh.tetrahedra.size() + mesh.tetrahedra.size() / 8);
@@ -49,7 +52,16 @@ class WorkMesh {
   const std::vector<uint32_t>& star(uint32_t v) const { return star_[v]; }
   Vec3& point(uint32_t v) { return mesh_.points[v]; }
 
-  double quality_of(const Tet& t) const { return quality::tetra_quality(corners(t)); }
+  // Q, or with a dihedral target the lower of Q and the smallest dihedral
+  // angle scaled to Q's target: what every operation must raise.
+  double quality_of(const Tet& t) const {
+    const auto p = corners(t);
+    const double q = quality::tetra_quality(p);
+    if (dihedral_scale_ == 0) return q;
+    return std::min(q, dihedral_scale_ * quality::tetra_dihedral_range_deg(p).first);
+  }
+  // Q alone, for the figures.
+  double q_of(uint32_t t) const { return quality::tetra_quality(corners(tets_[t])); }
   double volume_of(const Tet& t) const { return quality::tetra_signed_volume(corners(t)); }
 
   uint32_t add(const Tet& t, int32_t label) {
@@ -149,6 +161,7 @@ class WorkMesh {
     return {mesh_.points[t[0]], mesh_.points[t[1]], mesh_.points[t[2]], mesh_.points[t[3]]};
   }
 
+  const double dihedral_scale_;  // target Q per degree; 0: Q alone
   TetMesh& mesh_;
   std::vector<Tet> tets_;
   std::vector<int32_t> labels_;
@@ -541,7 +554,7 @@ absl::Status improve_tet_mesh(TetMesh& mesh, const ImproveParams& params, const 
   auto lowest_alive = [&w] {
     double lowest = kNone;
     for (uint32_t t = 0; t < w.size(); ++t) {
-      if (w.alive(t)) lowest = std::min(lowest, w.quality(t));
+      if (w.alive(t)) lowest = std::min(lowest, w.q_of(t));
     }
     return lowest;
   };
