@@ -313,16 +313,52 @@ std::vector<double> label_volumes(const Net& net, const SideSlots& slots,
   return volume;
 }
 
-// Rounds of giving labels back their volume.
+// Rounds of giving labels back their volume, and of the label-graph
+// solve within each.
 constexpr int kRestoreRounds = 6;
+constexpr int kSolveSweeps = 200;
+
+// The move d[l] of each label's boundary (mm, outward) that gives every
+// label back `lost[l]` (mm^3) when a point between labels l and m moves by
+// d[l] - d[m]: for each label, the sum over its neighbours m of
+// area[l m] (d[l] - d[m]) is lost[l], with the outside's move 0. Gauss-Seidel
+// sweeps; the system is a graph Laplacian held at the outside, so they
+// converge where a label reaches the outside through its neighbours, and a
+// label whose moving area is nil keeps d = 0.
+std::vector<double> label_moves(const std::vector<std::array<uint32_t, 2>>& pairs,
+                                const std::vector<double>& pair_area,
+                                const std::vector<double>& lost, uint32_t outside) {
+  const size_t n = lost.size();
+  std::vector<std::vector<std::pair<uint32_t, double>>> around(n);
+  std::vector<double> total(n, 0);
+  for (size_t k = 0; k < pairs.size(); ++k) {
+    if (pair_area[k] <= 0) continue;
+    const auto [l, m] = pairs[k];
+    around[l].push_back({m, pair_area[k]});
+    around[m].push_back({l, pair_area[k]});
+    total[l] += pair_area[k];
+    total[m] += pair_area[k];
+  }
+  std::vector<double> d(n, 0);
+  for (int sweep = 0; sweep < kSolveSweeps; ++sweep) {
+    for (size_t l = 0; l < n; ++l) {
+      if (l == outside || total[l] <= 0) continue;
+      double sum = lost[l];
+      for (const auto& [m, a] : around[l]) sum += a * d[m];
+      d[l] = sum / total[l];
+    }
+  }
+  return d;
+}
 
 // Moves the points that lie between one pair of sides along their normal,
 // so that each label keeps its voxels' volume where smoothing shrank it
-// (thin labels most): by the volume the first side lost over the area its
-// moving points carry, less the same for the second (the outside loses
-// nothing). A thin label between two thick ones so takes its volume from
-// them, and two labels that both lost leave their interface where it is.
-// Points where more than one pair meets stay; every point stays in its box.
+// (thin labels most): each label's boundary moves out by d (label_moves),
+// and a point between two labels by the difference of theirs. A thin label
+// between two thick ones so takes its volume from them, the thick ones
+// pass what they give on to their own neighbours or the outside, and the
+// outside moves nothing. Points where more than one pair meets stay; every
+// point stays in its box.
 void restore_volumes(const Net& net, const std::vector<Vec3>& centre, const PointBoxes& boxes,
                      std::vector<Vec3>& points) {
   const SideSlots slots = side_slots(net);
@@ -331,57 +367,68 @@ void restore_volumes(const Net& net, const std::vector<Vec3>& centre, const Poin
   const bool has_outside = outside < slots.labels.size() && slots.labels[outside] == kOutside;
   const auto is_outside = [&](uint32_t slot) { return has_outside && slot == outside; };
   const auto target = label_volumes(net, slots, centre);
-  // Per point: the pair of sides its quads lie between (the outside, if
-  // there, second), whether more than one pair meets there, and its
-  // area-weighted normal from the first side into the second.
-  std::vector<std::array<uint32_t, 2>> pair(points.size());
-  enum class Between : uint8_t { kNone, kOnePair, kMore };
-  std::vector<Between> between(points.size());
+  // Each quad's pair of sides, ordered: the outside (if there) second, two
+  // labels by slot; and the list of pairs.
+  std::vector<std::array<uint32_t, 2>> quad_pair(net.quads.size()), pairs;
+  std::vector<uint32_t> pair_of(net.quads.size());
+  {
+    for (size_t q = 0; q < net.quads.size(); ++q) {
+      auto sides = slots.sides[q];
+      if (is_outside(sides[0]) || (!is_outside(sides[1]) && sides[0] > sides[1]))
+        std::swap(sides[0], sides[1]);
+      quad_pair[q] = sides;
+    }
+    pairs = quad_pair;
+    std::sort(pairs.begin(), pairs.end());
+    pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
+    for (size_t q = 0; q < net.quads.size(); ++q)
+      pair_of[q] = static_cast<uint32_t>(
+          std::lower_bound(pairs.begin(), pairs.end(), quad_pair[q]) - pairs.begin());
+  }
+  // Per point: its pair (kMore where several meet) and its area-weighted
+  // normal from the pair's first side into its second.
+  constexpr uint32_t kNoPair = UINT32_MAX, kMore = UINT32_MAX - 1;
+  std::vector<uint32_t> point_pair(points.size());
   std::vector<Vec3> normal(points.size());
-  std::vector<double> area(slots.labels.size()), need(slots.labels.size());
+  std::vector<double> pair_area(pairs.size()), lost(slots.labels.size());
   std::vector<double> quad_area(net.quads.size());
   for (int round = 0; round < kRestoreRounds; ++round) {
     const auto now = label_volumes(net, slots, points);
-    std::fill(between.begin(), between.end(), Between::kNone);
+    std::fill(point_pair.begin(), point_pair.end(), kNoPair);
     std::fill(normal.begin(), normal.end(), Vec3{0, 0, 0});
-    std::fill(area.begin(), area.end(), 0.0);
+    std::fill(pair_area.begin(), pair_area.end(), 0.0);
     for (size_t q = 0; q < net.quads.size(); ++q) {
       const auto& c = net.quads[q];
-      auto sides = slots.sides[q];
       // Twice the quad's vector area, pointing from sides[0] to sides[1].
       Vec3 n = geometry::add(geometry::cross(geometry::sub(points[c[1]], points[c[0]]),
                                              geometry::sub(points[c[2]], points[c[0]])),
                              geometry::cross(geometry::sub(points[c[2]], points[c[0]]),
                                              geometry::sub(points[c[3]], points[c[0]])));
-      if (is_outside(sides[0]) || (!is_outside(sides[1]) && sides[0] > sides[1])) {
-        std::swap(sides[0], sides[1]);
-        n = geometry::scale(n, -1);
-      }
+      if (quad_pair[q][0] != slots.sides[q][0]) n = geometry::scale(n, -1);
       quad_area[q] = 0.5 * geometry::norm(n);
       for (const uint32_t p : c) {
-        if (between[p] == Between::kNone) {
-          between[p] = Between::kOnePair;
-          pair[p] = sides;
-        } else if (pair[p] != sides) {
-          between[p] = Between::kMore;
+        if (point_pair[p] == kNoPair) {
+          point_pair[p] = pair_of[q];
+        } else if (point_pair[p] != pair_of[q]) {
+          point_pair[p] = kMore;
         }
         normal[p] = geometry::add(normal[p], n);
       }
     }
-    // The area each side's moving points carry: a point moved by d along
+    // The area each pair's moving points carry: a point moved by d along
     // its normal moves a quarter of each of its quads by d.
     for (size_t q = 0; q < net.quads.size(); ++q) {
       int moving = 0;
-      for (const uint32_t p : net.quads[q]) moving += between[p] == Between::kOnePair;
-      for (const uint32_t side : slots.sides[q]) area[side] += quad_area[q] * moving / 4;
+      for (const uint32_t p : net.quads[q]) moving += point_pair[p] == pair_of[q];
+      pair_area[pair_of[q]] += quad_area[q] * moving / 4;
     }
-    for (size_t l = 0; l < need.size(); ++l)
-      need[l] =
-          area[l] > 0 && !is_outside(static_cast<uint32_t>(l)) ? (target[l] - now[l]) / area[l] : 0;
+    for (size_t l = 0; l < lost.size(); ++l) lost[l] = target[l] - now[l];
+    const auto d = label_moves(pairs, pair_area, lost, has_outside ? outside : kNoPair);
     for (size_t p = 0; p < points.size(); ++p) {
       const double length = geometry::norm(normal[p]);
-      if (between[p] != Between::kOnePair || length == 0) continue;
-      const double move = need[pair[p][0]] - need[pair[p][1]];
+      if (point_pair[p] >= kMore || length == 0) continue;
+      const auto& [first, second] = pairs[point_pair[p]];
+      const double move = d[first] - d[second];
       points[p] = boxes.hold(p, centre[p],
                              geometry::add(points[p], geometry::scale(normal[p], move / length)));
     }

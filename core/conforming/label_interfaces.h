@@ -35,7 +35,8 @@ struct InterfaceParams {
   double cube_fraction = 0.9;
   // After smoothing, give each label back the volume smoothing took, by
   // moving the points between one pair of sides along their normals: a
-  // label that lost more than its neighbour there gains from it.
+  // thin label between others takes its volume from them, and they from
+  // the outside.
   bool restore_volumes = false;
   // The box along each axis is this many times cube_fraction's (a grid cut
   // into thinner slices may let its points move as far as the thick ones').

@@ -41,7 +41,7 @@ struct NetOptions {
   // voxel centre changes sides (on thinner slices the guard measures it).
   double cube_fraction = 0.95;
   // Give each label back the volume smoothing took from it (thin labels
-  // shrink most), from the outside or from neighbours that lost less.
+  // shrink most), from the outside or through its neighbours.
   bool restore_volumes = true;
   // An axis whose spacing is at least thick_ratio times the others' is cut
   // into slices about thin_ratio times theirs by shape-based interpolation

@@ -41,9 +41,9 @@ struct ImproveParams {
   // neighbours. Above the Table 1 "questionable" bound of 0.2, so the pass
   // also lifts elements that are just good enough.
   double target_quality = 0.3;
-  // Tetrahedra whose smallest dihedral angle is below this (degrees) are
-  // worked on too: each counts as the lower of its Q and target_quality
-  // times its smallest dihedral over this. 0: Q alone.
+  // Tetrahedra whose smallest dihedral angle is below this (degrees, 0 to
+  // 60) are worked on too: each counts as the lower of its Q and
+  // target_quality times its smallest dihedral over this. 0: Q alone.
   double target_dihedral_deg = 0;
   // Full sweeps over the bad tetrahedra; a sweep that changes nothing ends
   // the pass early.

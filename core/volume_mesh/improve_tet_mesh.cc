@@ -60,8 +60,8 @@ class WorkMesh {
     if (dihedral_scale_ == 0) return q;
     return std::min(q, dihedral_scale_ * quality::tetra_dihedral_range_deg(p).first);
   }
-  // Q alone, for the figures.
-  double q_of(uint32_t t) const { return quality::tetra_quality(corners(tets_[t])); }
+  // Q alone, for the figures and the peeling rule.
+  double plain_q(uint32_t t) const { return quality::tetra_quality(corners(tets_[t])); }
   double volume_of(const Tet& t) const { return quality::tetra_signed_volume(corners(t)); }
 
   uint32_t add(const Tet& t, int32_t label) {
@@ -491,7 +491,7 @@ bool edge_on_outer_face(const WorkMesh& w, uint32_t t, uint32_t c, uint32_t d) {
 // does the surface move further than the peel depth.
 bool peel_sliver(WorkMesh& w, uint32_t t, ImproveFigures& figures) {
   if (!(w.max_peel_depth > 0) ||
-      quality::categorize(w.quality(t)) == quality::QualityCategory::kGood) {
+      quality::categorize(w.plain_q(t)) == quality::QualityCategory::kGood) {
     return false;
   }
   const Tet k = w.tet(t);
@@ -554,7 +554,7 @@ absl::Status improve_tet_mesh(TetMesh& mesh, const ImproveParams& params, const 
   auto lowest_alive = [&w] {
     double lowest = kNone;
     for (uint32_t t = 0; t < w.size(); ++t) {
-      if (w.alive(t)) lowest = std::min(lowest, w.q_of(t));
+      if (w.alive(t)) lowest = std::min(lowest, w.plain_q(t));
     }
     return lowest;
   };

@@ -30,8 +30,11 @@ struct ImproveFigures {
 // tetrahedron has) never move, and no tetrahedron changes label: flips and
 // insertions only replace tetrahedra of one label inside the region they
 // fill, and smoothing moves only points no boundary face uses. Every
-// operation is kept only if it raises the lowest Q among the tetrahedra it
-// replaces, so the worst element never gets worse, and none becomes inverted.
+// operation is kept only if it raises the lowest score among the tetrahedra
+// it replaces, so the worst element never gets worse, and none becomes
+// inverted. The score is Q, or with params.target_dihedral_deg the lower of
+// Q and target_quality times the smallest dihedral over that target: then
+// a tetrahedron's Q may fall, but never below the lowest score before.
 //
 // The one exception to a fixed boundary is peeling: a questionable sliver
 // (Q <= 0.2) that nothing else lifts, whose two outer surface faces fold over
