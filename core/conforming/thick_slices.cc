@@ -117,6 +117,10 @@ std::array<double, 4> catmull_rom_weights(double t) {
           0.5 * (t3 - t2)};
 }
 
+// Where thin slice j's centre lies along the cut axis, in thick slices (0 at
+// the first thick slice's centre), with `parts` thin slices to a thick one.
+double thick_place(int64_t j, int parts) { return (double(j) + 0.5) / parts - 0.5; }
+
 // How much of a label's bias acts on a thin slice at place t (0 to 1)
 // between two drawn slices: none on them, all of it half way.
 double bias_taper(double t) { return 4 * t * (1 - t); }
@@ -158,7 +162,7 @@ class SliceInterpolator {
   double mean_taper() const {
     double sum = 0;
     for (int j = 0; j < cut_.parts; ++j) {
-      const double position = (j + 0.5) / cut_.parts - 0.5;
+      const double position = thick_place(j, cut_.parts);
       sum += bias_taper(position - std::floor(position));
     }
     return sum / cut_.parts;
@@ -193,7 +197,7 @@ class SliceInterpolator {
     std::array<std::shared_ptr<const Distances>, 4> around;
     for (int64_t j = 0; j < fine_box[a_]; ++j) {
       const double position =
-          std::clamp((fine_lo[a_] + j + 0.5) / cut_.parts - 0.5, 0.0, double(na - 1));
+          std::clamp(thick_place(fine_lo[a_] + j, cut_.parts), 0.0, double(na - 1));
       const int64_t i = std::min(static_cast<int64_t>(position), na - 2);
       const double t = position - i;
       // Slice i - 1 + k of the volume as a slice of the box (k = 0 to 3:
