@@ -11,7 +11,6 @@
 namespace labelmesh::volume {
 namespace {
 
-// changed[p]: plane p differs from plane p - 1 (p >= 1), along each axis.
 using Changes = std::array<std::vector<bool>, 3>;
 
 template <typename T>
@@ -71,6 +70,15 @@ int common_run(const std::vector<bool>& changed, int64_t first, int64_t last) {
 
 }  // namespace
 
+Changes find_plane_changes(const LabelVolume& volume) {
+  const auto& dims = volume.geometry.dims;
+  Changes changed{std::vector<bool>(size_t(dims[0])), std::vector<bool>(size_t(dims[1])),
+                  std::vector<bool>(size_t(dims[2]))};
+  visit_voxels(volume.voxels,
+               [&](const auto* voxels, size_t) { changed = find_changes(voxels, dims); });
+  return changed;
+}
+
 std::array<int, 3> find_repeated_planes(const LabelVolume& volume,
                                         const VolumeStatistics& statistics) {
   std::array<int, 3> repeated{1, 1, 1};
@@ -84,12 +92,7 @@ std::array<int, 3> find_repeated_planes(const LabelVolume& volume,
       high[axis] = std::max(high[axis], label.max_index[axis]);
     }
   }
-  Changes changed;
-  if (!visit_voxels(volume.voxels, [&](const auto* voxels, size_t) {
-        changed = find_changes(voxels, volume.geometry.dims);
-      })) {
-    return repeated;
-  }
+  const Changes changed = find_plane_changes(volume);
   for (int axis = 0; axis < 3; ++axis)
     repeated[axis] = common_run(changed[axis], low[axis], high[axis]);
   return repeated;

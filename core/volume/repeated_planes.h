@@ -7,6 +7,7 @@
 #pragma once
 
 #include <array>
+#include <vector>
 
 #include "core/volume/label_statistics.h"
 #include "core/volume/label_volume.h"
@@ -18,6 +19,11 @@ namespace labelmesh::volume {
 // lie inside it; the box's first and last runs may be shorter (the
 // resampling may have cut them). 1 for any other axis: planes that change
 // from one to the next, runs of mixed lengths, or too few runs to tell.
+// Per voxel axis, changed[p] for each plane p: whether any voxel of plane p
+// differs from its neighbour in plane p - 1 (false for plane 0). All false
+// for a voxel type labelmesh does not keep in memory.
+std::array<std::vector<bool>, 3> find_plane_changes(const LabelVolume& volume);
+
 std::array<int, 3> find_repeated_planes(const LabelVolume& volume,
                                         const VolumeStatistics& statistics);
 

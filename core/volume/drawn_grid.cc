@@ -1,0 +1,161 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+#include "core/volume/drawn_grid.h"
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "core/util/text.h"
+#include "core/volume/repeated_planes.h"
+#include "core/volume/voxel_access.h"
+
+#include <vtkImageData.h>
+
+namespace labelmesh::volume {
+namespace {
+
+// At most this share of the lattice's steps between the first and last
+// change may hold no change (labels that do not reach across the whole
+// image), and no more than this pitch, in file voxels, is looked for.
+constexpr double kMaxEmptySteps = 0.25;
+constexpr double kMaxPitch = 8;
+
+// The lattice the changes along one axis lie on, or pitch 1. Plane p
+// changing means a boundary at p - 1/2.
+DrawnAxis drawn_axis(const std::vector<bool>& changed) {
+  DrawnAxis axis;
+  axis.count = static_cast<int64_t>(changed.size());
+  std::vector<double> boundary;
+  for (size_t p = 1; p < changed.size(); ++p)
+    if (changed[p]) boundary.push_back(static_cast<double>(p) - 0.5);
+  if (boundary.size() < kMinDrawnChanges) return axis;
+  std::vector<double> gap(boundary.size() - 1);
+  for (size_t i = 0; i + 1 < boundary.size(); ++i) gap[i] = boundary[i + 1] - boundary[i];
+  const double shortest = *std::min_element(gap.begin(), gap.end());
+  if (shortest < 2) return axis;
+  // A first pitch from the single steps (gaps under 1.5 the shortest), then
+  // each gap's whole number of steps, then the pitch over all of them.
+  double single_sum = 0;
+  int singles = 0;
+  for (double g : gap) {
+    if (g < 1.5 * shortest) {
+      single_sum += g;
+      ++singles;
+    }
+  }
+  const double first_pitch = single_sum / singles;
+  if (first_pitch > kMaxPitch) return axis;
+  std::vector<double> step_at(boundary.size(), 0);
+  for (size_t i = 0; i + 1 < boundary.size(); ++i)
+    step_at[i + 1] = step_at[i] + std::round(gap[i] / first_pitch);
+  const double steps = step_at.back();
+  if (steps > (1 + kMaxEmptySteps) * static_cast<double>(gap.size())) return axis;
+  // Nearest-neighbour rounding puts each boundary within half a voxel of
+  // the lattice's: their offsets from it span at most one voxel. The
+  // spread is convex in the pitch; a ternary search finds its least.
+  const auto spread = [&](double pitch, double& low, double& high) {
+    low = high = 0;
+    for (size_t i = 0; i < boundary.size(); ++i) {
+      const double offset = boundary[i] - boundary.front() - pitch * step_at[i];
+      low = std::min(low, offset);
+      high = std::max(high, offset);
+    }
+    return high - low;
+  };
+  double low = 0, high = 0;
+  double below = first_pitch - 2 / steps, above = first_pitch + 2 / steps;
+  below = std::max(below, 2.0);
+  for (int i = 0; i < 100; ++i) {
+    const double a = below + (above - below) / 3, b = above - (above - below) / 3;
+    if (spread(a, low, high) < spread(b, low, high)) {
+      above = b;
+    } else {
+      below = a;
+    }
+  }
+  const double pitch = 0.5 * (below + above);
+  if (spread(pitch, low, high) > 1 + 1e-9) return axis;
+  // The lattice's boundary nearest the file's first voxel edge, -1/2.
+  const double anchor = boundary.front() + 0.5 * (low + high);
+  axis.pitch = pitch;
+  axis.first_boundary = anchor - std::ceil((anchor + 0.5) / pitch) * pitch;
+  // Drawn voxels up to the one that holds the file's last edge.
+  const double last_edge = static_cast<double>(changed.size()) - 0.5;
+  axis.count = static_cast<int64_t>(std::ceil((last_edge - axis.first_boundary) / pitch - 1e-9));
+  return axis;
+}
+
+// The file voxel nearest drawn voxel c's centre along `axis`.
+int64_t file_index(const DrawnAxis& axis, int64_t c, int64_t file_count) {
+  const double centre = axis.first_boundary + (static_cast<double>(c) + 0.5) * axis.pitch;
+  return std::clamp<int64_t>(std::llround(centre), 0, file_count - 1);
+}
+
+}  // namespace
+
+bool DrawnGrid::resampled() const {
+  return std::count_if(axes.begin(), axes.end(), [](const DrawnAxis& a) { return a.pitch >= 2; }) >=
+         2;
+}
+
+DrawnGrid find_drawn_grid(const LabelVolume& volume) {
+  const auto changed = find_plane_changes(volume);
+  DrawnGrid grid;
+  for (int k = 0; k < 3; ++k) grid.axes[k] = drawn_axis(changed[k]);
+  return grid;
+}
+
+absl::StatusOr<LabelVolume> resample_to_drawn_grid(const LabelVolume& volume,
+                                                   const DrawnGrid& grid) {
+  const auto& file = volume.geometry;
+  LabelVolume drawn;
+  drawn.format = volume.format;
+  drawn.file_voxel_type = volume.file_voxel_type;
+  drawn.descriptions = volume.descriptions;
+  drawn.geometry = file;
+  std::array<double, 3> first_centre{};
+  std::array<std::vector<int64_t>, 3> source;
+  for (int k = 0; k < 3; ++k) {
+    const DrawnAxis& axis = grid.axes[k];
+    drawn.geometry.dims[k] = axis.count;
+    drawn.geometry.spacing[k] = file.spacing[k] * axis.pitch;
+    first_centre[k] = axis.first_boundary + 0.5 * axis.pitch;
+    source[k].resize(static_cast<size_t>(axis.count));
+    for (int64_t c = 0; c < axis.count; ++c)
+      source[k][static_cast<size_t>(c)] = file_index(axis, c, file.dims[k]);
+  }
+  drawn.geometry.origin = file.to_physical(first_centre);
+  const auto& dims = drawn.geometry.dims;
+  const auto resample = [&](vtkImageData* image) -> absl::StatusOr<vtkSmartPointer<vtkImageData>> {
+    auto out = vtkSmartPointer<vtkImageData>::New();
+    out->SetDimensions(static_cast<int>(dims[0]), static_cast<int>(dims[1]),
+                       static_cast<int>(dims[2]));
+    out->AllocateScalars(VTK_INT, 1);
+    auto* to = static_cast<int32_t*>(out->GetScalarPointer());
+    if (to == nullptr) {
+      return absl::ResourceExhaustedError(
+          cat("drawn grid: no memory for ", drawn.geometry.voxel_count(), " voxels"));
+    }
+    const int64_t nx = file.dims[0], ny = file.dims[1];
+    visit_voxels(image, [&](const auto* from, size_t) {
+      for (int64_t z = 0; z < dims[2]; ++z)
+        for (int64_t y = 0; y < dims[1]; ++y) {
+          const auto* row = from + (source[2][size_t(z)] * ny + source[1][size_t(y)]) * nx;
+          for (int64_t x = 0; x < dims[0]; ++x)
+            *to++ = static_cast<int32_t>(row[source[0][size_t(x)]]);
+        }
+    });
+    return out;
+  };
+  auto voxels = resample(volume.voxels);
+  if (!voxels.ok()) return voxels.status();
+  drawn.voxels = *voxels;
+  for (const auto& layer : volume.more_layers) {
+    auto more = resample(layer);
+    if (!more.ok()) return more.status();
+    drawn.more_layers.push_back(*more);
+  }
+  return drawn;
+}
+
+}  // namespace labelmesh::volume

@@ -1,0 +1,48 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// The grid a segmentation was drawn on, when the file holds it resampled by
+// nearest neighbour to finer pixels: a 3 mm segmentation stored on a CT's
+// 0.98 mm grid holds blocks of 3 or 4 equal pixels along x and y. Faithful
+// to those pixels a surface must step with the blocks; on the grid the
+// labels were drawn on the same labels allow a smooth one.
+#pragma once
+
+#include <array>
+#include <cstdint>
+
+#include "absl/status/statusor.h"
+#include "core/volume/label_volume.h"
+
+namespace labelmesh::volume {
+
+// One voxel axis of the drawn grid, in the file's voxel index: drawn voxel c
+// spans [first_boundary + c pitch, first_boundary + (c + 1) pitch] (the first
+// begins at or before the file's first voxel edge, -1/2) and takes
+// the label of the file's voxel nearest its centre.
+struct DrawnAxis {
+  double pitch = 1;  // file voxels per drawn voxel
+  double first_boundary = -0.5;
+  int64_t count = 0;  // drawn voxels that overlap the file's extent
+};
+
+struct DrawnGrid {
+  std::array<DrawnAxis, 3> axes;
+  // Blocks along two axes or more: the whole image was resampled. Planes
+  // repeated along one axis alone are slices drawn apart, which the delivery
+  // tolerance allows for (repeated_planes.h) and the meshers keep.
+  bool resampled() const;
+};
+
+// An axis counts as drawn coarser when every plane where a label changes
+// lies within half a voxel of one lattice of pitch >= 2 (the rounding of
+// nearest-neighbour resampling), with at least kMinDrawnChanges such planes
+// and at most a few lattice steps where no label changes; else its pitch is 1.
+inline constexpr int kMinDrawnChanges = 8;
+DrawnGrid find_drawn_grid(const LabelVolume& volume);
+
+// The volume on `grid` (every layer), in the same physical space: spacing
+// times pitch, the origin at the first drawn voxel's centre, int32 voxels.
+// Errors: RESOURCE_EXHAUSTED when it cannot be allocated.
+absl::StatusOr<LabelVolume> resample_to_drawn_grid(const LabelVolume& volume,
+                                                   const DrawnGrid& grid);
+
+}  // namespace labelmesh::volume
