@@ -80,6 +80,10 @@ void add_pipeline_flags(CLI::App& command, PipelineFlags& flags) {
   command.add_flag("--no-fall-back", flags.no_fall_back,
                    "Delivery guard: only measure and warn; never rebuild a surface outside "
                    "tolerance");
+  command.add_flag("--file-grid", flags.file_grid,
+                   "Mesh on the file's own grid even where its labels were resampled by nearest "
+                   "neighbour from a coarser one (by default they are meshed and judged on the "
+                   "coarser grid they were drawn on)");
   command.add_flag("--strict", guard.strict,
                    "Fail (exit 4) when any label is delivered outside tolerance or not at all");
   command.add_flag("--keep-strands", flags.keep_strands,
@@ -227,6 +231,7 @@ absl::StatusOr<v1::MeshOptions> to_mesh_options(const PipelineFlags& flags) {
   poisson.adapt_to_thickness = !flags.no_adapt_to_thickness;
   poisson.prune_strands = !flags.keep_strands;
   params.guard.fall_back = !flags.no_fall_back;
+  params.mesh_on_drawn_grid = !flags.file_grid;
   params.tetgen.keep_boundary = !flags.tet_split_boundary;
   poisson.normals = flags.normals == "area" ? surface::NormalWeighting::kArea
                                             : surface::NormalWeighting::kUniform;

@@ -35,6 +35,7 @@ struct PipelineFlags {
   bool tet_split_boundary = false;
   bool no_adapt_to_thickness = false;
   bool no_fall_back = false;
+  bool file_grid = false;
   // LABEL:EDGE_MM[:DISTANCE_MM], one per label.
   std::vector<std::string> label_sizing;
   // A label table: ITK-SNAP, FreeSurfer or JSON (volume/label_table.h).

@@ -274,6 +274,7 @@ absl::Status read_volume_options(const v1::MeshOptions& options, MeshParams& par
   }
   if (options.has_conforming_max_interface_faces())
     params.conforming_max_interface_faces = options.conforming_max_interface_faces();
+  if (options.has_mesh_on_drawn_grid()) params.mesh_on_drawn_grid = options.mesh_on_drawn_grid();
   if (options.has_hex_size_mm()) params.hex_size_mm = options.hex_size_mm();
   if (!(params.hex_size_mm == 0 || (params.hex_size_mm >= 0.05 && params.hex_size_mm <= 1000)))
     return absl::InvalidArgumentError(
@@ -353,6 +354,7 @@ v1::MeshOptions make_options(const MeshParams& params) {
   options.set_hausdorff_tolerance_mm(guard.hausdorff_mm);
   options.set_fall_back(guard.fall_back);
   options.set_strict(guard.strict);
+  options.set_mesh_on_drawn_grid(params.mesh_on_drawn_grid);
 
   for (auto format : params.formats)
     options.add_formats(std::string(surface::surface_format_name(format)));

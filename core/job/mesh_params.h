@@ -164,6 +164,10 @@ struct GuardOptions {
 struct MeshParams {
   // Labels to mesh; empty means every non-zero label in the volume.
   std::vector<int32_t> labels;
+  // A volume resampled by nearest neighbour from a coarser grid (blocks of
+  // equal pixels along two axes or more, volume/drawn_grid.h) is meshed and
+  // judged on that grid; false keeps the file's grid.
+  bool mesh_on_drawn_grid = true;
   SurfaceMethod surface = SurfaceMethod::kNet;
   NetOptions net;
   PoissonOptions poisson;

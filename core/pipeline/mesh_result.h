@@ -32,6 +32,10 @@ struct VolumeSummary {
   volume::ImageFormat format = volume::ImageFormat::kNifti;
   std::string file_voxel_type;
   volume::ImageGeometry geometry;
+  // Where the labels were meshed on the grid they were drawn on
+  // (volume/drawn_grid.h), the file's own grid; `geometry` and the label
+  // counts are then the drawn grid's.
+  std::optional<volume::ImageGeometry> file_geometry;
   volume::VolumeStatistics statistics;
   // Runs of equal planes per voxel axis (find_repeated_planes): 3 along z
   // means the segmentation was drawn on every third slice.

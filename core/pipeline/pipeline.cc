@@ -26,6 +26,7 @@
 #include "core/util/side_by_side.h"
 #include "core/util/status_macros.h"
 #include "core/util/text.h"
+#include "core/volume/drawn_grid.h"
 #include "core/volume/label_table.h"
 #include "core/volume/read_label_volume.h"
 #include "core/volume/repeated_planes.h"
@@ -443,10 +444,25 @@ absl::StatusOr<MeshResult> run_on_volume(const std::string& path,
                                          MeshResult result) {
   if (auto s = check_sizing_for_grid(params.poisson, volume->geometry); !s.ok())
     return absl::InvalidArgumentError(cat(path, ": ", std::string(s.message())));
+  std::optional<volume::ImageGeometry> file_geometry;
+  if (params.mesh_on_drawn_grid) {
+    StageTimer timer(result.stages, "drawn_grid");
+    const auto grid = volume::find_drawn_grid(*volume);
+    if (grid.resampled()) {
+      file_geometry = volume->geometry;
+      auto drawn = volume::resample_to_drawn_grid(*volume, grid);
+      if (!drawn.ok()) {
+        return absl::Status(drawn.status().code(),
+                            cat(path, ": ", std::string(drawn.status().message())));
+      }
+      volume = std::move(*drawn);
+    }
+  }
   const std::vector<volume::LabelVolume> layers = volume_layers(*volume);
   {
     StageTimer timer(result.stages, "label_statistics");
     result.input = summary_of(layers);
+    result.input.file_geometry = file_geometry;
     volume::apply_label_table(params.label_names, result.input.descriptions);
   }
   LABELMESH_ASSIGN_OR_RETURN(auto labels,

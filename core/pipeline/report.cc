@@ -272,13 +272,19 @@ void describe_label(int32_t label, const volume::LabelDescriptions& descriptions
 v1::InputSummary make_input_summary(const VolumeSummary& summary) {
   v1::InputSummary input;
   const auto& g = summary.geometry;
+  const auto& file = summary.file_geometry ? *summary.file_geometry : g;
   input.set_format(std::string(volume::format_name(summary.format)));
   for (int axis = 0; axis < 3; ++axis) {
-    input.add_dims(static_cast<uint32_t>(g.dims[axis]));
-    input.add_spacing(g.spacing[axis]);
-    input.add_origin(g.origin[axis] + 0.0);  // + 0.0 turns -0 into 0.
+    input.add_dims(static_cast<uint32_t>(file.dims[axis]));
+    input.add_spacing(file.spacing[axis]);
+    input.add_origin(file.origin[axis] + 0.0);  // + 0.0 turns -0 into 0.
+    if (summary.file_geometry) {
+      input.add_meshed_dims(static_cast<uint32_t>(g.dims[axis]));
+      input.add_meshed_spacing(g.spacing[axis]);
+      input.add_meshed_origin(g.origin[axis] + 0.0);
+    }
   }
-  for (double d : g.direction) input.add_direction(d + 0.0);
+  for (double d : file.direction) input.add_direction(d + 0.0);
   input.set_convention(std::string(kPatientConvention));
   input.set_voxel_type(summary.file_voxel_type);
   const double voxel_volume = g.voxel_volume();

@@ -160,8 +160,13 @@ std::string input_section(const v1::Report& report) {
              "</td></tr>\n", "<tr><th>Grid (voxels)</th><td>", triple(input.dims(), 0),
              "</td></tr>\n", "<tr><th>Spacing (mm)</th><td>", triple(input.spacing(), 4),
              "</td></tr>\n", "<tr><th>Drawn spacing (mm)</th><td>",
-             triple(input.drawn_spacing(), 4), "</td></tr>\n", "<tr><th>Origin (mm)</th><td>",
-             triple(input.origin(), 3), "</td></tr>\n",
+             triple(input.drawn_spacing(), 4), "</td></tr>\n",
+             input.meshed_spacing_size() == 3
+                 ? cat("<tr><th>Meshed on (mm)</th><td>", triple(input.meshed_spacing(), 4), " (",
+                       triple(input.meshed_dims(), 0),
+                       " voxels: the labels were resampled from this grid)</td></tr>\n")
+                 : std::string(),
+             "<tr><th>Origin (mm)</th><td>", triple(input.origin(), 3), "</td></tr>\n",
              "<tr><th>Background voxels</th><td class=\"num\">", input.background_voxels(),
              "</td></tr>\n", "<tr><th>File</th><td>",
              input.file_name().empty() ? std::string(kNone) : html_escape(input.file_name()),
