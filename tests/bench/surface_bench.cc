@@ -36,6 +36,7 @@
 #include "core/surface/voxel_fidelity.h"
 #include "core/surface/write_surface.h"
 #include "core/util/side_by_side.h"
+#include "core/volume/drawn_grid.h"
 #include "core/volume/label_statistics.h"
 #include "core/volume/read_label_volume.h"
 #include "core/volume/write_label_volume.h"
@@ -209,6 +210,8 @@ struct VolumeFigures {
   std::vector<double> ours_share, slicer_share, mc_share;  // labels >= 1000 voxels
   // The Slicer-like surfaces against the voxels, per label.
   std::vector<double> slicer_misclassified, slicer_hausdorff, slicer_volume;
+  // Where the labels were meshed on their drawn grid: each judged on the other grid.
+  std::vector<double> ours_file_misclassified, slicer_drawn_misclassified, slicer_drawn_volume;
   int labels = 0, ours_within = 0, slicer_within = 0, ours_within_slicer_plus5 = 0;
   double ours_min_angle = 180;
   int ours_poisson = 0;
@@ -233,12 +236,18 @@ std::optional<ReadVolume> read_volume(const std::string& path) {
 // Our surfaces without the guard's checks: the file read, the shared net
 // built and smoothed as the pipeline does by default, and every label cut
 // out of it, on two threads as the pipeline's are.
-// On the volume's own grid: where the pipeline first cuts thick slices
-// thinner, this leaves that step out.
+// On the grid the labels were drawn on, as the pipeline's (a volume
+// resampled from a coarser grid is taken back to it); where the pipeline
+// then cuts thick slices thinner, this leaves that step out.
 void our_surfaces_alone(const std::string& path) {
-  const auto read = read_volume(path);
+  auto read = read_volume(path);
   if (!read) return;
   const auto& labels = read->labels;
+  if (const auto grid = volume::find_drawn_grid(read->volume); grid.resampled()) {
+    auto drawn = volume::resample_to_drawn_grid(read->volume, grid);
+    if (!drawn.ok()) return;
+    read->volume = std::move(*drawn);
+  }
   conforming::InterfaceFigures figures;
   const auto net = conforming::label_interfaces(read->volume, labels,
                                                 net_interface_params(our_params().net), figures);
@@ -304,6 +313,16 @@ int bench_volume(const std::string& path, int rounds) {
   flat.subdivide_thick_quads = false;
   conforming::InterfaceFigures figures;
   const auto staircase = conforming::label_interfaces(volume, labels, flat, figures);
+  // Where the pipeline meshed on the grid the labels were drawn on.
+  std::optional<volume::LabelVolume> drawn;
+  volume::VolumeStatistics drawn_statistics;
+  if (result->input.file_geometry) {
+    auto taken = volume::resample_to_drawn_grid(volume, volume::find_drawn_grid(volume));
+    if (taken.ok()) {
+      drawn = std::move(*taken);
+      drawn_statistics = volume::compute_label_statistics(*drawn);
+    }
+  }
   VolumeFigures f;
   for (size_t i = 0; i < labels.size() && i < slicer.size(); ++i) {
     const auto* label = statistics.find(labels[i]);
@@ -337,6 +356,20 @@ int bench_volume(const std::string& path, int rounds) {
     SurfaceAttempt attempt;
     attempt.voxels = *slicer_voxels;
     if (is_within(attempt, ours->fidelity->tolerance)) ++f.slicer_within;
+    if (drawn) {
+      // Each surface judged on the other grid too.
+      const auto* drawn_label = drawn_statistics.find(labels[i]);
+      auto ours_on_file = surface::measure_voxel_fidelity(ours->mesh, volume, *label, {});
+      auto slicer_on_drawn =
+          drawn_label ? surface::measure_voxel_fidelity(slicer[i].mesh, *drawn, *drawn_label, {})
+                      : absl::StatusOr<surface::VoxelFidelity>(absl::NotFoundError("label"));
+      if (ours_on_file.ok())
+        f.ours_file_misclassified.push_back(100 * ours_on_file->misclassified_fraction());
+      if (slicer_on_drawn.ok()) {
+        f.slicer_drawn_misclassified.push_back(100 * slicer_on_drawn->misclassified_fraction());
+        f.slicer_drawn_volume.push_back(100 * std::abs(slicer_on_drawn->volume_change));
+      }
+    }
     if (label->voxels < 1000) continue;
     const double our_share = ours->axis_aligned_share.value_or(1);
     f.ours_share.push_back(our_share);
@@ -357,6 +390,15 @@ int bench_volume(const std::string& path, int rounds) {
       "Slicer-like %.1f %%, ours %.1f %%; ours within Slicer-like + 5 points: %d\n",
       f.ours_share.size(), 100 * median(f.mc_share), 100 * median(f.slicer_share),
       100 * median(f.ours_share), f.ours_within_slicer_plus5);
+  if (drawn) {
+    const auto& g = drawn->geometry;
+    std::printf(
+        "  meshed on the drawn grid %.3f x %.3f x %.3f mm; median misclassified boundary "
+        "voxels: ours on the file's grid %.2f %%, Slicer-like on the drawn grid %.2f %% "
+        "(|volume change| %.2f %%)\n",
+        g.spacing[0], g.spacing[1], g.spacing[2], median(f.ours_file_misclassified),
+        median(f.slicer_drawn_misclassified), median(f.slicer_drawn_volume));
+  }
   return 0;
 }
 

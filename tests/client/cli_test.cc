@@ -81,8 +81,9 @@ TEST(Cli, MeshWritesSurfacesAndReport) {
   EXPECT_NEAR(report.surfaces(0).volume_mm3() / ball, 1.0, 0.03);
   std::vector<std::string> stages;
   for (const auto& stage : report.stages()) stages.push_back(stage.name());
-  EXPECT_EQ(stages, (std::vector<std::string>{"read", "label_statistics", "marching_cubes",
-                                              "surface_statistics", "write", "report_pictures"}));
+  EXPECT_EQ(stages,
+            (std::vector<std::string>{"read", "drawn_grid", "label_statistics", "marching_cubes",
+                                      "surface_statistics", "write", "report_pictures"}));
   // The raw JSON keeps the proto field names.
   EXPECT_NE(slurp(dir / "out" / "report.json").find("\"min_angle_deg\""), std::string::npos);
 }
