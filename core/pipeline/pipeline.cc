@@ -444,25 +444,33 @@ absl::StatusOr<MeshResult> run_on_volume(const std::string& path,
                                          MeshResult result) {
   if (auto s = check_sizing_for_grid(params.poisson, volume->geometry); !s.ok())
     return absl::InvalidArgumentError(cat(path, ": ", std::string(s.message())));
-  std::optional<volume::ImageGeometry> file_geometry;
+  // The file's volume, where the labels are meshed on the grid they were
+  // drawn on (the scene formats write the labels as read).
+  std::optional<volume::LabelVolume> file_volume;
   if (params.mesh_on_drawn_grid) {
     StageTimer timer(result.stages, "drawn_grid");
     const auto grid = volume::find_drawn_grid(*volume);
     if (grid.resampled()) {
-      file_geometry = volume->geometry;
       auto drawn = volume::resample_to_drawn_grid(*volume, grid);
       if (!drawn.ok()) {
         return absl::Status(drawn.status().code(),
                             cat(path, ": ", std::string(drawn.status().message())));
       }
+      file_volume = std::move(*volume);
       volume = std::move(*drawn);
+      if (auto s = check_sizing_for_grid(params.poisson, volume->geometry); !s.ok()) {
+        return absl::InvalidArgumentError(
+            cat(path, ": ", std::string(s.message()),
+                " (the labels were drawn on this coarser grid; --file-grid meshes on the "
+                "file's)"));
+      }
     }
   }
   const std::vector<volume::LabelVolume> layers = volume_layers(*volume);
   {
     StageTimer timer(result.stages, "label_statistics");
     result.input = summary_of(layers);
-    result.input.file_geometry = file_geometry;
+    if (file_volume) result.input.file_geometry = file_volume->geometry;
     volume::apply_label_table(params.label_names, result.input.descriptions);
   }
   LABELMESH_ASSIGN_OR_RETURN(auto labels,
@@ -472,7 +480,8 @@ absl::StatusOr<MeshResult> run_on_volume(const std::string& path,
   const auto keep_label_image = [&] {
     if (std::any_of(params.scene_formats.begin(), params.scene_formats.end(),
                     [](SceneFormat f) { return f != SceneFormat::kVtm; })) {
-      result.label_image = std::make_shared<const volume::LabelVolume>(std::move(*volume));
+      result.label_image = std::make_shared<const volume::LabelVolume>(
+          std::move(file_volume ? *file_volume : *volume));
     }
   };
   if (params.volume == VolumeMethod::kConforming) {

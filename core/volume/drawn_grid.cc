@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 #include "core/volume/drawn_grid.h"
 
+#include <vtkImageData.h>
+
 #include <algorithm>
 #include <cmath>
 #include <vector>
@@ -9,63 +11,72 @@
 #include "core/volume/repeated_planes.h"
 #include "core/volume/voxel_access.h"
 
-#include <vtkImageData.h>
-
 namespace labelmesh::volume {
 namespace {
 
-// At most this share of the lattice's steps between the first and last
-// change may hold no change (labels that do not reach across the whole
-// image), and no more than this pitch, in file voxels, is looked for.
-constexpr double kMaxEmptySteps = 0.25;
+// At most this share of the gaps between the first and last change may
+// span more than one lattice step (labels that do not reach across the
+// whole image); no pitch above kMaxPitch file voxels is looked for, and an
+// axis with more than kMaxChanges changes is not looked at (no coarser grid
+// has them, and the fit's memory stays bounded on any header's sizes).
+constexpr double kMaxLongGaps = 0.25;
 constexpr double kMaxPitch = 8;
+constexpr size_t kMaxChanges = size_t{1} << 20;
 
 // The lattice the changes along one axis lie on, or pitch 1. Plane p
 // changing means a boundary at p - 1/2.
 DrawnAxis drawn_axis(const std::vector<bool>& changed) {
   DrawnAxis axis;
   axis.count = static_cast<int64_t>(changed.size());
-  std::vector<double> boundary;
-  for (size_t p = 1; p < changed.size(); ++p)
-    if (changed[p]) boundary.push_back(static_cast<double>(p) - 0.5);
+  std::vector<int64_t> boundary;  // the changing planes
+  for (size_t p = 1; p < changed.size(); ++p) {
+    if (!changed[p]) continue;
+    if (boundary.size() == kMaxChanges) return axis;
+    boundary.push_back(static_cast<int64_t>(p));
+  }
   if (boundary.size() < kMinDrawnChanges) return axis;
-  std::vector<double> gap(boundary.size() - 1);
+  std::vector<int64_t> gap(boundary.size() - 1);
   for (size_t i = 0; i + 1 < boundary.size(); ++i) gap[i] = boundary[i + 1] - boundary[i];
-  const double shortest = *std::min_element(gap.begin(), gap.end());
-  if (shortest < 2) return axis;
-  // A first pitch from the single steps (gaps under 1.5 the shortest), then
-  // each gap's whole number of steps, then the pitch over all of them.
+  const int64_t shortest = *std::min_element(gap.begin(), gap.end());
+  if (shortest < 2 || static_cast<double>(shortest) > kMaxPitch) return axis;
+  // One lattice step covers floor(pitch) or ceil(pitch) planes, so the
+  // single steps are the gaps of at most shortest + 1 (two steps cover at
+  // least 2 floor(pitch) >= shortest + 2). Their mean is a first pitch;
+  // each gap then counts its whole number of steps.
   double single_sum = 0;
-  int singles = 0;
-  for (double g : gap) {
-    if (g < 1.5 * shortest) {
-      single_sum += g;
+  int64_t singles = 0;
+  for (int64_t g : gap) {
+    if (g <= shortest + 1) {
+      single_sum += static_cast<double>(g);
       ++singles;
     }
   }
-  const double first_pitch = single_sum / singles;
-  if (first_pitch > kMaxPitch) return axis;
+  const double first_pitch = single_sum / static_cast<double>(singles);
   std::vector<double> step_at(boundary.size(), 0);
   for (size_t i = 0; i + 1 < boundary.size(); ++i)
-    step_at[i + 1] = step_at[i] + std::round(gap[i] / first_pitch);
+    step_at[i + 1] = step_at[i] + std::max(1.0, std::round(double(gap[i]) / first_pitch));
   const double steps = step_at.back();
-  if (steps > (1 + kMaxEmptySteps) * static_cast<double>(gap.size())) return axis;
+  if (static_cast<double>(singles) < (1 - kMaxLongGaps) * static_cast<double>(gap.size()))
+    return axis;
   // Nearest-neighbour rounding puts each boundary within half a voxel of
-  // the lattice's: their offsets from it span at most one voxel. The
-  // spread is convex in the pitch; a ternary search finds its least.
+  // the lattice's: their offsets from it span at most one voxel, which
+  // bounds the pitch to [(span - 1) / steps, (span + 1) / steps]. The spread
+  // is convex in the pitch; a ternary search finds its least.
   const auto spread = [&](double pitch, double& low, double& high) {
     low = high = 0;
     for (size_t i = 0; i < boundary.size(); ++i) {
-      const double offset = boundary[i] - boundary.front() - pitch * step_at[i];
+      const double offset = double(boundary[i] - boundary.front()) - pitch * step_at[i];
       low = std::min(low, offset);
       high = std::max(high, offset);
     }
     return high - low;
   };
+  const double span = static_cast<double>(boundary.back() - boundary.front());
+  double below = std::max(2.0, (span - 1) / steps);
+  double above = std::min(kMaxPitch, (span + 1) / steps);
+  if (below > above) return axis;
   double low = 0, high = 0;
-  double below = first_pitch - 2 / steps, above = first_pitch + 2 / steps;
-  below = std::max(below, 2.0);
-  for (int i = 0; i < 100; ++i) {
+  for (int i = 0; i < 60; ++i) {
     const double a = below + (above - below) / 3, b = above - (above - below) / 3;
     if (spread(a, low, high) < spread(b, low, high)) {
       above = b;
@@ -75,13 +86,14 @@ DrawnAxis drawn_axis(const std::vector<bool>& changed) {
   }
   const double pitch = 0.5 * (below + above);
   if (spread(pitch, low, high) > 1 + 1e-9) return axis;
-  // The lattice's boundary nearest the file's first voxel edge, -1/2.
-  const double anchor = boundary.front() + 0.5 * (low + high);
+  // A lattice boundary: the first change's plane edge, moved to the middle
+  // of the offsets. The first drawn voxel is the one holding the file's
+  // first voxel centre (0), the last the one holding its last.
+  const double anchor = static_cast<double>(boundary.front()) - 0.5 + 0.5 * (low + high);
   axis.pitch = pitch;
-  axis.first_boundary = anchor - std::ceil((anchor + 0.5) / pitch) * pitch;
-  // Drawn voxels up to the one that holds the file's last edge.
-  const double last_edge = static_cast<double>(changed.size()) - 0.5;
-  axis.count = static_cast<int64_t>(std::ceil((last_edge - axis.first_boundary) / pitch - 1e-9));
+  axis.first_boundary = anchor - std::ceil(anchor / pitch) * pitch;
+  const double last_centre = static_cast<double>(changed.size()) - 1;
+  axis.count = static_cast<int64_t>(std::floor((last_centre - axis.first_boundary) / pitch)) + 1;
   return axis;
 }
 
@@ -99,7 +111,18 @@ bool DrawnGrid::resampled() const {
 }
 
 DrawnGrid find_drawn_grid(const LabelVolume& volume) {
-  const auto changed = find_plane_changes(volume);
+  // Changes in any layer count: overlapping segments kept apart were all
+  // resampled alike, or one of them was not.
+  auto changed = find_plane_changes(volume);
+  for (const auto& layer : volume.more_layers) {
+    LabelVolume more;
+    more.geometry = volume.geometry;
+    more.voxels = layer;
+    const auto also = find_plane_changes(more);
+    for (int k = 0; k < 3; ++k)
+      for (size_t p = 0; p < changed[k].size() && p < also[k].size(); ++p)
+        if (also[k][p]) changed[k][p] = true;
+  }
   DrawnGrid grid;
   for (int k = 0; k < 3; ++k) grid.axes[k] = drawn_axis(changed[k]);
   return grid;
@@ -117,6 +140,8 @@ absl::StatusOr<LabelVolume> resample_to_drawn_grid(const LabelVolume& volume,
   std::array<std::vector<int64_t>, 3> source;
   for (int k = 0; k < 3; ++k) {
     const DrawnAxis& axis = grid.axes[k];
+    if (axis.count < 1 || axis.pitch < 1)
+      return absl::InvalidArgumentError(cat("drawn grid: axis ", k, " has no voxel"));
     drawn.geometry.dims[k] = axis.count;
     drawn.geometry.spacing[k] = file.spacing[k] * axis.pitch;
     first_centre[k] = axis.first_boundary + 0.5 * axis.pitch;
@@ -127,6 +152,11 @@ absl::StatusOr<LabelVolume> resample_to_drawn_grid(const LabelVolume& volume,
   drawn.geometry.origin = file.to_physical(first_centre);
   const auto& dims = drawn.geometry.dims;
   const auto resample = [&](vtkImageData* image) -> absl::StatusOr<vtkSmartPointer<vtkImageData>> {
+    const int* image_dims = image->GetDimensions();
+    for (int k = 0; k < 3; ++k) {
+      if (image_dims[k] != file.dims[k])
+        return absl::InvalidArgumentError("drawn grid: a layer's grid differs from the volume's");
+    }
     auto out = vtkSmartPointer<vtkImageData>::New();
     out->SetDimensions(static_cast<int>(dims[0]), static_cast<int>(dims[1]),
                        static_cast<int>(dims[2]));
@@ -137,7 +167,7 @@ absl::StatusOr<LabelVolume> resample_to_drawn_grid(const LabelVolume& volume,
           cat("drawn grid: no memory for ", drawn.geometry.voxel_count(), " voxels"));
     }
     const int64_t nx = file.dims[0], ny = file.dims[1];
-    visit_voxels(image, [&](const auto* from, size_t) {
+    const bool known = visit_voxels(image, [&](const auto* from, size_t) {
       for (int64_t z = 0; z < dims[2]; ++z)
         for (int64_t y = 0; y < dims[1]; ++y) {
           const auto* row = from + (source[2][size_t(z)] * ny + source[1][size_t(y)]) * nx;
@@ -145,6 +175,7 @@ absl::StatusOr<LabelVolume> resample_to_drawn_grid(const LabelVolume& volume,
             *to++ = static_cast<int32_t>(row[source[0][size_t(x)]]);
         }
     });
+    if (!known) return absl::InvalidArgumentError("drawn grid: a voxel type it cannot read");
     return out;
   };
   auto voxels = resample(volume.voxels);

@@ -16,7 +16,7 @@ namespace labelmesh::volume {
 
 // One voxel axis of the drawn grid, in the file's voxel index: drawn voxel c
 // spans [first_boundary + c pitch, first_boundary + (c + 1) pitch] (the first
-// begins at or before the file's first voxel edge, -1/2) and takes
+// holds the file's first voxel centre, 0, the last its last) and takes
 // the label of the file's voxel nearest its centre.
 struct DrawnAxis {
   double pitch = 1;  // file voxels per drawn voxel
@@ -24,6 +24,7 @@ struct DrawnAxis {
   int64_t count = 0;  // drawn voxels that overlap the file's extent
 };
 
+// The drawn grid along each of the file's voxel axes.
 struct DrawnGrid {
   std::array<DrawnAxis, 3> axes;
   // Blocks along two axes or more: the whole image was resampled. Planes
@@ -33,9 +34,11 @@ struct DrawnGrid {
 };
 
 // An axis counts as drawn coarser when every plane where a label changes
-// lies within half a voxel of one lattice of pitch >= 2 (the rounding of
-// nearest-neighbour resampling), with at least kMinDrawnChanges such planes
-// and at most a few lattice steps where no label changes; else its pitch is 1.
+// (in any layer) lies within half a voxel of one lattice of pitch 2 to 8
+// (the rounding of nearest-neighbour resampling), with at least
+// kMinDrawnChanges such planes and at most a quarter of the gaps between
+// them longer than one step; else its pitch is 1. The pitch is the one whose
+// offsets span the least (a minimax line fit).
 inline constexpr int kMinDrawnChanges = 8;
 DrawnGrid find_drawn_grid(const LabelVolume& volume);
 

@@ -212,6 +212,7 @@ struct VolumeFigures {
   std::vector<double> slicer_misclassified, slicer_hausdorff, slicer_volume;
   // Where the labels were meshed on their drawn grid: each judged on the other grid.
   std::vector<double> ours_file_misclassified, slicer_drawn_misclassified, slicer_drawn_volume;
+  int slicer_drawn_within = 0;
   int labels = 0, ours_within = 0, slicer_within = 0, ours_within_slicer_plus5 = 0;
   double ours_min_angle = 180;
   int ours_poisson = 0;
@@ -316,11 +317,13 @@ int bench_volume(const std::string& path, int rounds) {
   // Where the pipeline meshed on the grid the labels were drawn on.
   std::optional<volume::LabelVolume> drawn;
   volume::VolumeStatistics drawn_statistics;
+  std::optional<conforming::InterfaceSurface> drawn_staircase;
   if (result->input.file_geometry) {
     auto taken = volume::resample_to_drawn_grid(volume, volume::find_drawn_grid(volume));
     if (taken.ok()) {
       drawn = std::move(*taken);
       drawn_statistics = volume::compute_label_statistics(*drawn);
+      drawn_staircase = conforming::label_interfaces(*drawn, labels, flat, figures);
     }
   }
   VolumeFigures f;
@@ -368,6 +371,13 @@ int bench_volume(const std::string& path, int rounds) {
       if (slicer_on_drawn.ok()) {
         f.slicer_drawn_misclassified.push_back(100 * slicer_on_drawn->misclassified_fraction());
         f.slicer_drawn_volume.push_back(100 * std::abs(slicer_on_drawn->volume_change));
+        const auto drawn_cut =
+            conforming::net_label_surface(*drawn_staircase, labels[i], drawn->geometry);
+        slicer_on_drawn->hausdorff_voxels = surface::sampled_hausdorff_voxels(
+            slicer[i].mesh, drawn_cut.staircase, drawn->geometry, RunContext{});
+        SurfaceAttempt on_drawn;
+        on_drawn.voxels = *slicer_on_drawn;
+        if (is_within(on_drawn, ours->fidelity->tolerance)) ++f.slicer_drawn_within;
       }
     }
     if (label->voxels < 1000) continue;
@@ -395,9 +405,9 @@ int bench_volume(const std::string& path, int rounds) {
     std::printf(
         "  meshed on the drawn grid %.3f x %.3f x %.3f mm; median misclassified boundary "
         "voxels: ours on the file's grid %.2f %%, Slicer-like on the drawn grid %.2f %% "
-        "(|volume change| %.2f %%)\n",
+        "(|volume change| %.2f %%; within the tolerance there: %d)\n",
         g.spacing[0], g.spacing[1], g.spacing[2], median(f.ours_file_misclassified),
-        median(f.slicer_drawn_misclassified), median(f.slicer_drawn_volume));
+        median(f.slicer_drawn_misclassified), median(f.slicer_drawn_volume), f.slicer_drawn_within);
   }
   return 0;
 }

@@ -50,6 +50,7 @@ TEST(PipelineFlags, NoFlagsGiveThePipelinesDefaults) {
   EXPECT_EQ(params.poisson.prune_strands, defaults.poisson.prune_strands);
   EXPECT_EQ(params.poisson.adapt_to_thickness, defaults.poisson.adapt_to_thickness);
   EXPECT_EQ(params.guard.fall_back, defaults.guard.fall_back);
+  EXPECT_TRUE(params.mesh_on_drawn_grid);
   EXPECT_EQ(params.guard.volume_percent, defaults.guard.volume_percent);
   EXPECT_EQ(params.limits.max_voxels, defaults.limits.max_voxels);
   EXPECT_EQ(params.formats, defaults.formats);
@@ -90,6 +91,7 @@ TEST(PipelineFlags, EveryFlagReachesThePipeline) {
                                   "--hausdorff-tolerance",
                                   "1.5",
                                   "--no-fall-back",
+                                  "--file-grid",
                                   "--strict",
                                   "--keep-strands",
                                   "--smoothing-iterations",
@@ -155,6 +157,7 @@ TEST(PipelineFlags, EveryFlagReachesThePipeline) {
   EXPECT_EQ(p.guard.small_volume_percent, 12);
   EXPECT_EQ(p.guard.hausdorff_mm, 1.5);
   EXPECT_FALSE(p.guard.fall_back);
+  EXPECT_FALSE(p.mesh_on_drawn_grid);
   EXPECT_TRUE(p.guard.strict);
   EXPECT_FALSE(p.poisson.prune_strands);
   EXPECT_EQ(p.poisson.smoothing.iterations, 7);

@@ -25,6 +25,7 @@ TEST(JobOptions, DefaultsAreValidAndSurviveTheRoundTrip) {
   EXPECT_EQ(make_options(*reread).SerializeAsString(), again.SerializeAsString());
   EXPECT_DOUBLE_EQ(reread->poisson.min_angle_deg, 30);
   EXPECT_TRUE(reread->guard.fall_back);
+  EXPECT_TRUE(reread->mesh_on_drawn_grid);
 }
 
 TEST(JobOptions, SetValuesSurviveTheRoundTrip) {
@@ -35,6 +36,7 @@ TEST(JobOptions, SetValuesSurviveTheRoundTrip) {
   options.set_volume_tolerance_percent(4);
   options.set_hausdorff_tolerance_mm(1.5);
   options.set_strict(true);
+  options.set_mesh_on_drawn_grid(false);
   options.set_volume(v1::VOLUME_METHOD_TETGEN);
   options.set_tet_max_volume_mm3(2);
   auto* sizing = options.add_label_sizing();
@@ -50,12 +52,14 @@ TEST(JobOptions, SetValuesSurviveTheRoundTrip) {
   EXPECT_DOUBLE_EQ(params->guard.volume_percent, 4);
   EXPECT_DOUBLE_EQ(params->guard.hausdorff_mm, 1.5);
   EXPECT_TRUE(params->guard.strict);
+  EXPECT_FALSE(params->mesh_on_drawn_grid);
   EXPECT_EQ(params->volume, VolumeMethod::kTetgen);
   ASSERT_EQ(params->poisson.label_sizing.size(), 1u);
   EXPECT_DOUBLE_EQ(params->poisson.label_sizing[0].max_edge_mm, 1.25);
   const auto reread = params_from_options(make_options(*params));
   ASSERT_THAT(reread, testing::IsOk());
   EXPECT_DOUBLE_EQ(reread->poisson.label_sizing[0].max_edge_mm, 1.25);
+  EXPECT_FALSE(reread->mesh_on_drawn_grid);
   EXPECT_EQ(reread->formats.size(), 1u);
   EXPECT_EQ(reread->volume_formats.size(), 1u);
 }

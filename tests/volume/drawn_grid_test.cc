@@ -53,35 +53,68 @@ std::map<int32_t, uint64_t> label_counts(const LabelVolume& v) {
 }
 
 TEST(DrawnGrid, PixelsResampledFromACoarserGridAreFoundWithTheirPitch) {
-  for (double pitch : {3.072, 2.0, 4.0}) {
+  for (double pitch : {2.0, 2.2, 2.5, 3.072, 4.0, 5.5}) {
     const auto grid = find_drawn_grid(resampled_organs(pitch));
     EXPECT_TRUE(grid.resampled()) << pitch;
-    EXPECT_NEAR(grid.axes[0].pitch, pitch, 0.01) << pitch;
-    EXPECT_NEAR(grid.axes[1].pitch, pitch, 0.01) << pitch;
+    EXPECT_NEAR(grid.axes[0].pitch, pitch, 0.015 * pitch) << pitch;
+    EXPECT_NEAR(grid.axes[1].pitch, pitch, 0.015 * pitch) << pitch;
     EXPECT_EQ(grid.axes[2].pitch, 1) << pitch;
   }
 }
 
+// The drawn voxel holding a file voxel's centre along `axis`.
+int64_t drawn_index(const DrawnAxis& axis, int64_t file) {
+  return static_cast<int64_t>(std::floor((double(file) - axis.first_boundary) / axis.pitch));
+}
+
 TEST(DrawnGrid, TheDrawnGridGivesBackTheDrawnVoxels) {
-  const auto fine = resampled_organs(3.072);
-  const auto grid = find_drawn_grid(fine);
-  ASSERT_TRUE(grid.resampled());
-  auto drawn = resample_to_drawn_grid(fine, grid);
-  ASSERT_THAT(drawn, testing::IsOk());
-  const auto& g = drawn->geometry;
-  // Any pitch that puts every change within half a voxel of the lattice
-  // fits; the one found is within half a percent of the true one here.
-  EXPECT_NEAR(g.spacing[0], 3, 0.015);
-  EXPECT_NEAR(g.spacing[1], 3, 0.015);
-  EXPECT_EQ(g.spacing[2], 3);
-  EXPECT_EQ(g.dims[2], 20);
-  // The drawn voxels' centres lie on the first grid's: whole voxels from
-  // the fine grid's first edge, -0.5 fine voxels.
-  for (int axis = 0; axis < 2; ++axis) {
-    const double from_edge = (g.origin[axis] + 0.5 * fine.geometry.spacing[axis]) / 3;
-    EXPECT_NEAR(from_edge - std::floor(from_edge), 0.5, 0.02) << axis;
+  for (double pitch : {2.5, 3.072}) {
+    const auto fine = resampled_organs(pitch);
+    const auto grid = find_drawn_grid(fine);
+    ASSERT_TRUE(grid.resampled());
+    auto drawn = resample_to_drawn_grid(fine, grid);
+    ASSERT_THAT(drawn, testing::IsOk());
+    const auto& g = drawn->geometry;
+    EXPECT_EQ(g.dims, (std::array<int64_t, 3>{30, 26, 20})) << pitch;
+    EXPECT_NEAR(g.spacing[0], 3, 0.015 * 3) << pitch;
+    EXPECT_EQ(g.spacing[2], 3);
+    // The first drawn centre: half a drawn voxel from the fine grid's first
+    // edge, half a fine voxel before its first centre; the changes tell it
+    // to within half a fine voxel (they lie on whole fine voxels).
+    const double first = 1.5 - 0.5 * fine.geometry.spacing[0];
+    EXPECT_NEAR(g.origin[0], first, 0.5 * fine.geometry.spacing[0]) << pitch;
+    EXPECT_NEAR(g.origin[1], first, 0.5 * fine.geometry.spacing[1]) << pitch;
+    EXPECT_EQ(g.origin[2], 0);
+    EXPECT_EQ(label_counts(*drawn), label_counts(drawn_organs())) << pitch;
+    // Resampled back to the file's pixels, the drawn grid gives every
+    // pixel its label.
+    const auto* file_labels = static_cast<const uint8_t*>(fine.voxels->GetScalarPointer());
+    const auto* drawn_labels = static_cast<const int32_t*>(drawn->voxels->GetScalarPointer());
+    const auto& d = fine.geometry.dims;
+    int64_t differing = 0;
+    for (int64_t z = 0; z < d[2]; ++z)
+      for (int64_t y = 0; y < d[1]; ++y)
+        for (int64_t x = 0; x < d[0]; ++x) {
+          const int64_t cx = drawn_index(grid.axes[0], x), cy = drawn_index(grid.axes[1], y);
+          const int32_t back = drawn_labels[(z * g.dims[1] + cy) * g.dims[0] + cx];
+          if (back != file_labels[(z * d[1] + y) * d[0] + x]) ++differing;
+        }
+    EXPECT_EQ(differing, 0) << pitch;
   }
-  EXPECT_EQ(label_counts(*drawn), label_counts(drawn_organs()));
+}
+
+TEST(DrawnGrid, ASegmentOfFinerPixelsInAnotherLayerKeepsTheFileGrid) {
+  auto v = resampled_organs(3.072);
+  ASSERT_TRUE(find_drawn_grid(v).resampled());
+  // An overlapping segment drawn on the fine pixels, kept in a layer.
+  const auto& d = v.geometry.dims;
+  const auto fine_ball =
+      testing::label_grid({int(d[0]), int(d[1]), int(d[2])}, [](int i, int j, int k) -> uint8_t {
+        const double x = i - 40.3, y = j - 37.6, z = k - 9.2;
+        return x * x + y * y + 9 * z * z < 150 ? 9 : 0;
+      });
+  v.more_layers.push_back(fine_ball.voxels);
+  EXPECT_FALSE(find_drawn_grid(v).resampled());
 }
 
 TEST(DrawnGrid, ANativeSegmentationKeepsItsGrid) {
