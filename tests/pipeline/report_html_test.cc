@@ -253,6 +253,16 @@ TEST(ReportHtml, NamesTheInputItsDigestAndWhenItWasMade) {
   EXPECT_FALSE(absl::StrContains(absl::AsciiStrToLower(html), "<script"));
 }
 
+TEST(ReportHtml, ShowsTheGridMeshedOnOnlyWhereItIsNotTheFiles) {
+  v1::Report report = sample_report();
+  EXPECT_FALSE(absl::StrContains(report_html(report), "Meshed on"));
+  for (double spacing : {3.006, 3.006, 2.0}) report.mutable_input()->add_meshed_spacing(spacing);
+  for (uint32_t dims : {167, 167, 20}) report.mutable_input()->add_meshed_dims(dims);
+  const std::string html = report_html(report);
+  EXPECT_TRUE(absl::StrContains(html, "<tr><th>Meshed on (mm)</th><td>3.0060"));
+  EXPECT_TRUE(absl::StrContains(html, "167"));
+}
+
 TEST(ReportHtml, EscapesHostileNames) {
   const std::string html = report_html(sample_report());
   EXPECT_TRUE(absl::StrContains(html, kEscapedHostileName));
