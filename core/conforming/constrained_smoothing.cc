@@ -88,6 +88,10 @@ void smooth_in_boxes(const Stencil& stencil, const std::vector<Vec3>& centre,
             std::clamp(moved[drawn], box[p][drawn] - half[drawn], box[p][drawn] + half[drawn]);
         width += between_drawn(along, drawn_first, drawn_spacing) * widening;
       }
+      if (const uint8_t axes = point_boxes.pinned_axes(p); axes != 0) {
+        for (int k = 0; k < 3; ++k)
+          if (axes & (1u << k)) moved[k] = box[p][k];
+      }
       const Lanes lo = box[p] - width, hi = box[p] + width;
       moved = moved < lo ? lo : moved;
       to[p] = hi < moved ? hi : moved;

@@ -14,7 +14,30 @@ Vec3 PointBoxes::hold(size_t point, const Vec3& centre, Vec3 p) const {
     for (int k = 0; k < 3; ++k) width[k] += between * widening[k];
   }
   for (int k = 0; k < 3; ++k) p[k] = std::clamp(p[k], centre[k] - width[k], centre[k] + width[k]);
+  if (const uint8_t axes = pinned_axes(point); axes != 0) {
+    for (int k = 0; k < 3; ++k)
+      if (axes & (1u << k)) p[k] = centre[k];
+  }
   return p;
+}
+
+std::vector<uint8_t> edge_pinned_axes(const std::vector<Vec3>& centre,
+                                      const volume::ImageGeometry& geometry) {
+  std::vector<uint8_t> pinned(centre.size(), 0);
+  bool any = false;
+  for (size_t p = 0; p < centre.size(); ++p) {
+    for (int k = 0; k < 3; ++k) {
+      // The cube's lower voxel index along k: -1 or the last voxel reach past
+      // the edge.
+      const double low = centre[p][k] / geometry.spacing[k] - 0.5;
+      if (low < -0.5 || low > double(geometry.dims[k]) - 1.5) {
+        pinned[p] |= static_cast<uint8_t>(1u << k);
+        any = true;
+      }
+    }
+  }
+  if (!any) pinned.clear();
+  return pinned;
 }
 
 PointBoxes point_boxes(const volume::ImageGeometry& geometry, const InterfaceParams& params) {

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 #include "core/conforming/label_interfaces.h"
@@ -28,18 +29,30 @@ struct PointBoxes {
   // Points whose boxes never widen (where three labels or more meet): a
   // junction curve held to its pixels keeps its points apart.
   std::vector<bool> narrow;
+  // Per point, the axes (bit k for axis k) along which it stays on its
+  // centre: points whose cube reaches past the volume's edge, so that a
+  // label cut by the edge ends in a flat cap on it. Empty: none.
+  std::vector<uint8_t> pinned;
 
   bool widens(size_t point) const {
     return drawn_axis >= 0 && (point >= narrow.size() || !narrow[point]);
   }
+  uint8_t pinned_axes(size_t point) const { return point < pinned.size() ? pinned[point] : 0; }
   // Point `point`, at p, held in its box around `centre`.
   geometry::Vec3 hold(size_t point, const geometry::Vec3& centre, geometry::Vec3 p) const;
 };
 
 // Each point's box on `geometry` (cube_fraction of half a voxel along each
 // axis, times box_scale), wider between drawn slices when params name a
-// drawn axis cut into two parts or more. `narrow` is left empty.
+// drawn axis cut into two parts or more. `narrow` and `pinned` are left
+// empty.
 PointBoxes point_boxes(const volume::ImageGeometry& geometry, const InterfaceParams& params);
+
+// The pinned axes of points at `centre` (cube centres in mm from voxel
+// (0, 0, 0), as the net's): bit k where the cube reaches past the first or
+// last voxel along axis k of `geometry`.
+std::vector<uint8_t> edge_pinned_axes(const std::vector<geometry::Vec3>& centre,
+                                      const volume::ImageGeometry& geometry);
 
 // Within this fraction of the way from a drawn slice to the middle between
 // two, boxes stay as narrow as on the drawn slice: a triangle reaching the

@@ -221,6 +221,35 @@ TEST(NetSurfaces, ThinRodsKeepTheirVolumeWhateverTheLabelValue) {
   EXPECT_LT(surface::signed_volume(shrunk.mesh), 0.97 * 270);
 }
 
+// A ball cut by the volume's top edge, as an organ by a CT's field of view:
+// its cap lies flat on the edge, and no point strays past it.
+TEST(NetSurfaces, ALabelCutByTheVolumesEdgeEndsInAFlatCapOnIt) {
+  const auto volume = testing::label_grid({26, 26, 14}, [](int i, int j, int k) -> uint8_t {
+    const double x = i - 12.4, y = j - 12.7, z = k - 10.2;
+    return x * x + y * y + z * z < 81 ? 1 : 0;
+  });
+  const double edge = 13.5;  // mm: the last voxel centre, 13, and half a voxel
+  const auto net = smoothed_net(volume);
+  size_t on_cap = 0;
+  for (size_t p = 0; p < net.points.size(); ++p) {
+    EXPECT_LE(net.points[p][2], edge + 1e-9);
+    if (net.staircase[p][2] >= edge - 1e-9) {
+      ++on_cap;
+      EXPECT_NEAR(net.points[p][2], edge, 1e-9);
+    }
+  }
+  EXPECT_GT(on_cap, 100u);
+  auto result = run_pipeline_on_volume(volume, MeshParams{}, {});
+  ASSERT_THAT(result, testing::IsOk());
+  const auto* ours = output_of(*result, 1);
+  ASSERT_NE(ours, nullptr);
+  EXPECT_EQ(ours->stage, "net");
+  EXPECT_TRUE(result->warnings.empty());
+  double top = -1e9;
+  for (const auto& point : ours->mesh.points) top = std::max(top, point[2]);
+  EXPECT_NEAR(top, edge, 1e-6);
+}
+
 TEST(NetSurfaces, NestedLabelsShareTheirInterfacesWithoutOverlap) {
   auto result = run_pipeline_on_volume(
       volume::make_phantom(volume::PhantomShape::kNestedSpheres).volume, MeshParams{}, {});
