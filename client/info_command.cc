@@ -49,13 +49,6 @@ void print_text(const std::string& path, const v1::InputSummary& s) {
                 s.drawn_spacing(0), s.drawn_spacing(1), s.drawn_spacing(2), s.repeated_planes(0),
                 s.repeated_planes(1), s.repeated_planes(2));
   }
-  if (s.meshed_spacing_size() == 3 && s.meshed_dims_size() == 3) {
-    std::printf(
-        "meshed on    %.6g x %.6g x %.6g mm, %u x %u x %u voxels (the labels were resampled "
-        "from this grid; counts below are its voxels; mesh --file-grid keeps the file's)\n",
-        s.meshed_spacing(0), s.meshed_spacing(1), s.meshed_spacing(2), s.meshed_dims(0),
-        s.meshed_dims(1), s.meshed_dims(2));
-  }
   std::printf("background   %llu voxels\n", static_cast<unsigned long long>(s.background_voxels()));
   std::printf("labels       %d\n", s.labels_size());
   std::printf("  %10s %14s %16s  %s\n", "label", "voxels", "volume (mm3)", "name");

@@ -355,19 +355,6 @@ absl::Status add_volume_mesh(const MeshParams& params, const volume::ImageGeomet
   return absl::OkStatus();
 }
 
-// `volume` on the grid its labels were drawn on, when it was resampled
-// from a coarser one (volume/drawn_grid.h); nullopt when it was not.
-absl::StatusOr<std::optional<volume::LabelVolume>> on_drawn_grid(
-    const std::string& path, const volume::LabelVolume& volume) {
-  const auto grid = volume::find_drawn_grid(volume);
-  if (!grid.resampled()) return std::nullopt;
-  auto drawn = volume::resample_to_drawn_grid(volume, grid);
-  if (!drawn.ok())
-    return absl::Status(drawn.status().code(),
-                        cat(path, ": ", std::string(drawn.status().message())));
-  return std::optional<volume::LabelVolume>(std::move(*drawn));
-}
-
 }  // namespace
 
 absl::StatusOr<VolumeSummary> summarise_volume(const std::string& path,
@@ -375,12 +362,7 @@ absl::StatusOr<VolumeSummary> summarise_volume(const std::string& path,
                                                const RunContext& context) {
   try {
     LABELMESH_ASSIGN_OR_RETURN(auto volume, volume::read_label_volume(path, limits, context));
-    // As `mesh` sees it by default.
-    LABELMESH_ASSIGN_OR_RETURN(auto drawn, on_drawn_grid(path, volume));
-    if (!drawn) return summary_of(volume_layers(volume));
-    VolumeSummary summary = summary_of(volume_layers(*drawn));
-    summary.file_geometry = volume.geometry;
-    return summary;
+    return summary_of(volume_layers(volume));
   } catch (...) {
     return current_exception_status(path);
   }
@@ -467,8 +449,13 @@ absl::StatusOr<MeshResult> run_on_volume(const std::string& path,
   std::optional<volume::LabelVolume> file_volume;
   if (params.mesh_on_drawn_grid) {
     StageTimer timer(result.stages, "drawn_grid");
-    LABELMESH_ASSIGN_OR_RETURN(auto drawn, on_drawn_grid(path, *volume));
-    if (drawn) {
+    const auto grid = volume::find_drawn_grid(*volume);
+    if (grid.resampled()) {
+      auto drawn = volume::resample_to_drawn_grid(*volume, grid);
+      if (!drawn.ok()) {
+        return absl::Status(drawn.status().code(),
+                            cat(path, ": ", std::string(drawn.status().message())));
+      }
       file_volume = std::move(*volume);
       volume = std::move(*drawn);
       if (auto s = check_sizing_for_grid(params.poisson, volume->geometry); !s.ok()) {

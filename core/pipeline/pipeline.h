@@ -14,9 +14,7 @@
 
 namespace labelmesh {
 
-// Reads `path` and counts its labels (what `labelmesh info` shows), on the
-// grid they were drawn on where `mesh` would take them there by default
-// (VolumeSummary::file_geometry then keeps the file's).
+// Reads `path` and counts its labels (what `labelmesh info` shows).
 absl::StatusOr<VolumeSummary> summarise_volume(const std::string& path,
                                                const volume::ReadLimits& limits,
                                                const RunContext& context);

@@ -257,32 +257,6 @@ TEST(Cli, InfoJsonOnRealData) {
   EXPECT_NEAR(summary.labels(3).volume_mm3(), 6322002 * 0.617188 * 0.617188 * 0.666667, 1.0);
 }
 
-// The CT slab's 3 mm labels on 0.98 mm pixels: info gives the file's grid
-// and the one `mesh` works on, with the labels counted there.
-TEST(Cli, InfoShowsTheGridTheLabelsWereDrawnOn) {
-  LABELMESH_SKIP_WITHOUT_SHARED_DATA();
-  const std::string slab = testing::shared_data("totalseg_example_seg_dicom.nii.gz");
-  const CliRun json = run_cli("info --json " + slab);
-  ASSERT_EQ(json.exit_code, 0) << json.output;
-  v1::InputSummary summary;
-  ASSERT_THAT(google::protobuf::util::JsonStringToMessage(json.output, &summary), testing::IsOk());
-  EXPECT_EQ(summary.dims(0), 512u);
-  ASSERT_EQ(summary.meshed_spacing_size(), 3);
-  EXPECT_NEAR(summary.meshed_spacing(0), 3, 0.05);
-  EXPECT_EQ(summary.meshed_spacing(2), 2);
-  ASSERT_EQ(summary.meshed_dims_size(), 3);
-  EXPECT_LT(summary.meshed_dims(0), 512u / 3 + 2);
-  EXPECT_EQ(summary.labels_size(), 31);
-  // The spleen's 130,634 voxels of the file, counted on a grid of voxels
-  // 9.5 times larger.
-  ASSERT_EQ(summary.labels(0).label(), 1);
-  EXPECT_NEAR(double(summary.labels(0).voxels()), 130634 / 9.47, 130634 / 9.47 * 0.03);
-  const CliRun text = run_cli("info " + slab);
-  EXPECT_NE(text.output.find("meshed on    3.00"), std::string::npos) << text.output;
-  const CliRun liver = run_cli("info " + testing::shared_data("liver.inr.gz"));
-  EXPECT_EQ(liver.output.find("meshed on"), std::string::npos) << liver.output;
-}
-
 TEST(Cli, ExitCodes) {
   const auto dir = testing::scratch_dir("cli-codes");
   EXPECT_EQ(run_cli("").exit_code, 2);
