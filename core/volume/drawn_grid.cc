@@ -22,6 +22,12 @@ namespace {
 constexpr double kMaxLongGaps = 0.25;
 constexpr double kMaxPitch = 8;
 constexpr size_t kMaxChanges = size_t{1} << 20;
+// Pitches from kMinPitch to 2 leave gaps of one and two planes between
+// changes, where a gap's count of lattice steps cannot be told: they are
+// looked for only where every lattice boundary has a change (no gap longer
+// than 2), with at least kMinFineChanges of them.
+constexpr double kMinPitch = 1.5;
+constexpr size_t kMinFineChanges = 32;
 
 // The lattice the changes along one axis lie on, or pitch 1. Plane p
 // changing means a boundary at p - 1/2.
@@ -38,26 +44,41 @@ DrawnAxis drawn_axis(const std::vector<bool>& changed) {
   std::vector<int64_t> gap(boundary.size() - 1);
   for (size_t i = 0; i + 1 < boundary.size(); ++i) gap[i] = boundary[i + 1] - boundary[i];
   const int64_t shortest = *std::min_element(gap.begin(), gap.end());
-  if (shortest < 2 || static_cast<double>(shortest) > kMaxPitch) return axis;
-  // One lattice step covers floor(pitch) or ceil(pitch) planes, so the
-  // single steps are the gaps of at most shortest + 1 (two steps cover at
-  // least 2 floor(pitch) >= shortest + 2). Their mean is a first pitch;
-  // each gap then counts its whole number of steps.
-  double single_sum = 0;
-  int64_t singles = 0;
-  for (int64_t g : gap) {
-    if (g <= shortest + 1) {
-      single_sum += static_cast<double>(g);
-      ++singles;
-    }
-  }
-  const double first_pitch = single_sum / static_cast<double>(singles);
+  if (static_cast<double>(shortest) > kMaxPitch) return axis;
   std::vector<double> step_at(boundary.size(), 0);
-  for (size_t i = 0; i + 1 < boundary.size(); ++i)
-    step_at[i + 1] = step_at[i] + std::max(1.0, std::round(double(gap[i]) / first_pitch));
+  double lowest_pitch = 2;
+  double highest_pitch = kMaxPitch;
+  if (shortest == 1) {
+    // Every gap one lattice step: one or two planes, and never two single
+    // planes in a row (three changes in a row need offsets spanning
+    // 2 (pitch - 1) >= 1).
+    if (boundary.size() < kMinFineChanges) return axis;
+    for (size_t i = 0; i < gap.size(); ++i) {
+      if (gap[i] > 2 || (gap[i] == 1 && i > 0 && gap[i - 1] == 1)) return axis;
+      step_at[i + 1] = step_at[i] + 1;
+    }
+    lowest_pitch = kMinPitch;
+    highest_pitch = 2;
+  } else {
+    // One lattice step covers floor(pitch) or ceil(pitch) planes, so the
+    // single steps are the gaps of at most shortest + 1 (two steps cover at
+    // least 2 floor(pitch) >= shortest + 2). Their mean is a first pitch;
+    // each gap then counts its whole number of steps.
+    double single_sum = 0;
+    int64_t singles = 0;
+    for (int64_t g : gap) {
+      if (g <= shortest + 1) {
+        single_sum += static_cast<double>(g);
+        ++singles;
+      }
+    }
+    if (static_cast<double>(singles) < (1 - kMaxLongGaps) * static_cast<double>(gap.size()))
+      return axis;
+    const double first_pitch = single_sum / static_cast<double>(singles);
+    for (size_t i = 0; i + 1 < boundary.size(); ++i)
+      step_at[i + 1] = step_at[i] + std::max(1.0, std::round(double(gap[i]) / first_pitch));
+  }
   const double steps = step_at.back();
-  if (static_cast<double>(singles) < (1 - kMaxLongGaps) * static_cast<double>(gap.size()))
-    return axis;
   // Nearest-neighbour rounding puts each boundary within half a voxel of
   // the lattice's: their offsets from it span at most one voxel, which
   // bounds the pitch to [(span - 1) / steps, (span + 1) / steps]. The spread
@@ -72,8 +93,8 @@ DrawnAxis drawn_axis(const std::vector<bool>& changed) {
     return high - low;
   };
   const double span = static_cast<double>(boundary.back() - boundary.front());
-  double below = std::max(2.0, (span - 1) / steps);
-  double above = std::min(kMaxPitch, (span + 1) / steps);
+  double below = std::max(lowest_pitch, (span - 1) / steps);
+  double above = std::min(highest_pitch, (span + 1) / steps);
   if (below > above) return axis;
   double low = 0, high = 0;
   for (int i = 0; i < 60; ++i) {
@@ -106,7 +127,7 @@ int64_t file_index(const DrawnAxis& axis, int64_t c, int64_t file_count) {
 }  // namespace
 
 bool DrawnGrid::resampled() const {
-  return std::count_if(axes.begin(), axes.end(), [](const DrawnAxis& a) { return a.pitch >= 2; }) >=
+  return std::count_if(axes.begin(), axes.end(), [](const DrawnAxis& a) { return a.pitch > 1; }) >=
          2;
 }
 

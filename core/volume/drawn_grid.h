@@ -34,10 +34,12 @@ struct DrawnGrid {
 };
 
 // An axis counts as drawn coarser when every plane where a label changes
-// (in any layer) lies within half a voxel of one lattice of pitch 2 to 8
+// (in any layer) lies within half a voxel of one lattice of pitch 1.5 to 8
 // (the rounding of nearest-neighbour resampling), with at least
 // kMinDrawnChanges such planes and at most a quarter of the gaps between
-// them longer than one step; else its pitch is 1. The pitch is the one whose
+// them longer than one step (under a pitch of 2: at least 32 planes, and
+// none of the lattice's boundaries between them without a change); else
+// its pitch is 1. The pitch is the one whose
 // offsets span the least (a minimax line fit).
 inline constexpr int kMinDrawnChanges = 8;
 DrawnGrid find_drawn_grid(const LabelVolume& volume);

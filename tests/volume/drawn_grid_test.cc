@@ -103,6 +103,45 @@ TEST(DrawnGrid, TheDrawnGridGivesBackTheDrawnVoxels) {
   }
 }
 
+// Labels that change at every drawn voxel (a 1.5 mm segmentation on 0.98
+// mm pixels gives pitches under 2, where every boundary must show): 40 x 40
+// x 6 drawn voxels of labels 0 to 3, resampled along x and y.
+uint8_t patchwork_at(int i, int j, int k) {
+  uint32_t h = static_cast<uint32_t>(i) * 73856093u + static_cast<uint32_t>(j) * 19349663u +
+               static_cast<uint32_t>(k) * 83492791u;
+  h ^= h >> 13;
+  h *= 0x5bd1e995u;
+  h ^= h >> 15;
+  return static_cast<uint8_t>(h % 4);
+}
+
+LabelVolume resampled_patchwork(double pitch) {
+  const int n = static_cast<int>(40 * pitch);
+  return testing::label_grid({n, n, 6}, [pitch](int i, int j, int k) {
+    const int ci = static_cast<int>(std::lround((i + 0.5) / pitch - 0.5));
+    const int cj = static_cast<int>(std::lround((j + 0.5) / pitch - 0.5));
+    return patchwork_at(ci, cj, k);
+  });
+}
+
+TEST(DrawnGrid, PitchesUnderTwoAreFoundWhereEveryBoundaryShows) {
+  for (double pitch : {1.536, 1.7, 1.9}) {
+    const auto fine = resampled_patchwork(pitch);
+    const auto grid = find_drawn_grid(fine);
+    ASSERT_TRUE(grid.resampled()) << pitch;
+    EXPECT_NEAR(grid.axes[0].pitch, pitch, 0.01 * pitch) << pitch;
+    EXPECT_NEAR(grid.axes[1].pitch, pitch, 0.01 * pitch) << pitch;
+    EXPECT_EQ(grid.axes[2].pitch, 1) << pitch;
+    auto drawn = resample_to_drawn_grid(fine, grid);
+    ASSERT_THAT(drawn, testing::IsOk());
+    EXPECT_EQ(drawn->geometry.dims, (std::array<int64_t, 3>{40, 40, 6})) << pitch;
+    EXPECT_EQ(label_counts(*drawn), label_counts(testing::label_grid({40, 40, 6}, patchwork_at)))
+        << pitch;
+  }
+  // The drawn patchwork itself changes at every plane: pitch 1.
+  EXPECT_FALSE(find_drawn_grid(testing::label_grid({40, 40, 6}, patchwork_at)).resampled());
+}
+
 TEST(DrawnGrid, ASegmentOfFinerPixelsInAnotherLayerKeepsTheFileGrid) {
   auto v = resampled_organs(3.072);
   ASSERT_TRUE(find_drawn_grid(v).resampled());
