@@ -53,6 +53,8 @@ void smooth_in_boxes(const Stencil& stencil, const std::vector<Vec3>& centre,
   const auto drawn_first = static_cast<float>(point_boxes.drawn_first);
   const auto drawn_spacing = static_cast<float>(point_boxes.drawn_spacing);
   const Lanes widening = to_lanes(point_boxes.widening);
+  const Lanes edge_low = to_lanes(point_boxes.edge_low);
+  const Lanes edge_high = to_lanes(point_boxes.edge_high);
   const std::array<Lanes*, 2> places{now.data(), next.data()};
   const auto step_range = [&](int step, size_t begin, size_t end) {
     const auto factor =
@@ -81,6 +83,11 @@ void smooth_in_boxes(const Stencil& stencil, const std::vector<Vec3>& centre,
       }
       const Lanes at = from[p];
       Lanes moved = at + factor * (sum - at);
+      // Pinned axes first: the widening follows from where the point is.
+      if (const uint8_t axes = point_boxes.pinned_axes(p); axes != 0) {
+        for (int k = 0; k < 3; ++k)
+          if (axes & (1u << k)) moved[k] = box[p][k];
+      }
       Lanes width = half;
       if (drawn >= 0 && point_boxes.widens(p)) {
         // Along the drawn axis first: the width across follows from there.
@@ -88,11 +95,9 @@ void smooth_in_boxes(const Stencil& stencil, const std::vector<Vec3>& centre,
             std::clamp(moved[drawn], box[p][drawn] - half[drawn], box[p][drawn] + half[drawn]);
         width += between_drawn(along, drawn_first, drawn_spacing) * widening;
       }
-      if (const uint8_t axes = point_boxes.pinned_axes(p); axes != 0) {
-        for (int k = 0; k < 3; ++k)
-          if (axes & (1u << k)) moved[k] = box[p][k];
-      }
-      const Lanes lo = box[p] - width, hi = box[p] + width;
+      Lanes lo = box[p] - width, hi = box[p] + width;
+      lo = lo < edge_low ? edge_low : lo;
+      hi = edge_high < hi ? edge_high : hi;
       moved = moved < lo ? lo : moved;
       to[p] = hi < moved ? hi : moved;
     }

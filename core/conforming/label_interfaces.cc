@@ -549,7 +549,7 @@ InterfaceSurface label_interfaces(const volume::LabelVolume& volume,
     boxes.narrow.resize(net.label_count.size());
     for (size_t p = 0; p < net.label_count.size(); ++p) boxes.narrow[p] = net.label_count[p] > 2;
   }
-  boxes.pinned = edge_pinned_axes(net.centre, geometry);
+  hold_at_edges(net.centre, geometry, boxes);
   std::vector<Vec3> points = net.centre;
   smooth_in_boxes(stencil, net.centre, boxes, params, points);
   if (params.restore_volumes) restore_volumes(net, net.centre, boxes, points);

@@ -6,6 +6,10 @@ namespace labelmesh::conforming {
 using geometry::Vec3;
 
 Vec3 PointBoxes::hold(size_t point, const Vec3& centre, Vec3 p) const {
+  // Pinned axes first: the widening follows from where the point is.
+  const uint8_t axes = pinned_axes(point);
+  for (int k = 0; k < 3; ++k)
+    if (axes & (1u << k)) p[k] = centre[k];
   Vec3 width = half;
   if (widens(point)) {
     const int a = drawn_axis;
@@ -13,17 +17,21 @@ Vec3 PointBoxes::hold(size_t point, const Vec3& centre, Vec3 p) const {
     const double between = between_drawn(p[a], drawn_first, drawn_spacing);
     for (int k = 0; k < 3; ++k) width[k] += between * widening[k];
   }
-  for (int k = 0; k < 3; ++k) p[k] = std::clamp(p[k], centre[k] - width[k], centre[k] + width[k]);
-  if (const uint8_t axes = pinned_axes(point); axes != 0) {
-    for (int k = 0; k < 3; ++k)
-      if (axes & (1u << k)) p[k] = centre[k];
+  for (int k = 0; k < 3; ++k) {
+    p[k] = std::clamp(p[k], std::max(centre[k] - width[k], edge_low[k]),
+                      std::min(centre[k] + width[k], edge_high[k]));
   }
   return p;
 }
 
-std::vector<uint8_t> edge_pinned_axes(const std::vector<Vec3>& centre,
-                                      const volume::ImageGeometry& geometry) {
-  std::vector<uint8_t> pinned(centre.size(), 0);
+void hold_at_edges(const std::vector<Vec3>& centre, const volume::ImageGeometry& geometry,
+                   PointBoxes& boxes) {
+  for (int k = 0; k < 3; ++k) {
+    boxes.edge_low[k] = -0.5 * geometry.spacing[k];
+    boxes.edge_high[k] = (double(geometry.dims[k]) - 0.5) * geometry.spacing[k];
+  }
+  std::vector<uint8_t>& pinned = boxes.pinned;
+  pinned.assign(centre.size(), 0);
   bool any = false;
   for (size_t p = 0; p < centre.size(); ++p) {
     for (int k = 0; k < 3; ++k) {
@@ -36,8 +44,7 @@ std::vector<uint8_t> edge_pinned_axes(const std::vector<Vec3>& centre,
       }
     }
   }
-  if (!any) pinned.clear();
-  return pinned;
+  if (!any) std::vector<uint8_t>().swap(pinned);
 }
 
 PointBoxes point_boxes(const volume::ImageGeometry& geometry, const InterfaceParams& params) {

@@ -33,6 +33,10 @@ struct PointBoxes {
   // centre: points whose cube reaches past the volume's edge, so that a
   // label cut by the edge ends in a flat cap on it. Empty: none.
   std::vector<uint8_t> pinned;
+  // The volume's edges along each axis (mm, as the centres): no point goes
+  // past them, whatever its box.
+  geometry::Vec3 edge_low{-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+  geometry::Vec3 edge_high{HUGE_VAL, HUGE_VAL, HUGE_VAL};
 
   bool widens(size_t point) const {
     return drawn_axis >= 0 && (point >= narrow.size() || !narrow[point]);
@@ -48,11 +52,11 @@ struct PointBoxes {
 // empty.
 PointBoxes point_boxes(const volume::ImageGeometry& geometry, const InterfaceParams& params);
 
-// The pinned axes of points at `centre` (cube centres in mm from voxel
-// (0, 0, 0), as the net's): bit k where the cube reaches past the first or
-// last voxel along axis k of `geometry`.
-std::vector<uint8_t> edge_pinned_axes(const std::vector<geometry::Vec3>& centre,
-                                      const volume::ImageGeometry& geometry);
+// Pins the points at `centre` (cube centres in mm from voxel (0, 0, 0), as
+// the net's) whose cube reaches past the first or last voxel along an axis
+// of `geometry` to the edge there, and keeps every point within the edges.
+void hold_at_edges(const std::vector<geometry::Vec3>& centre, const volume::ImageGeometry& geometry,
+                   PointBoxes& boxes);
 
 // Within this fraction of the way from a drawn slice to the middle between
 // two, boxes stay as narrow as on the drawn slice: a triangle reaching the

@@ -49,12 +49,12 @@ DrawnAxis drawn_axis(const std::vector<bool>& changed) {
   double lowest_pitch = 2;
   double highest_pitch = kMaxPitch;
   if (shortest == 1) {
-    // Every gap one lattice step: one or two planes, and never two single
-    // planes in a row (three changes in a row need offsets spanning
-    // 2 (pitch - 1) >= 1).
+    // Every gap one lattice step of one or two planes. (Three changes in a
+    // row need offsets spanning 2 (pitch - 1), more than one voxel above a
+    // pitch of 1.5: the spread below rules them out.)
     if (boundary.size() < kMinFineChanges) return axis;
     for (size_t i = 0; i < gap.size(); ++i) {
-      if (gap[i] > 2 || (gap[i] == 1 && i > 0 && gap[i - 1] == 1)) return axis;
+      if (gap[i] > 2) return axis;
       step_at[i + 1] = step_at[i] + 1;
     }
     lowest_pitch = kMinPitch;

@@ -248,6 +248,21 @@ TEST(NetSurfaces, ALabelCutByTheVolumesEdgeEndsInAFlatCapOnIt) {
   double top = -1e9;
   for (const auto& point : ours->mesh.points) top = std::max(top, point[2]);
   EXPECT_NEAR(top, edge, 1e-6);
+
+  // On 3 mm slices, cut into thinner ones first, whose boxes reach across
+  // several thin slices: still nothing past the edge.
+  auto thick = testing::label_grid({26, 26, 6}, [](int i, int j, int k) -> uint8_t {
+    const double x = i - 12.4, y = j - 12.7, z = 3.0 * k - 12;
+    return x * x + y * y + z * z < 81 ? 1 : 0;
+  });
+  thick.geometry.spacing = {1, 1, 3};
+  auto sliced = run_pipeline_on_volume(thick, MeshParams{}, {});
+  ASSERT_THAT(sliced, testing::IsOk());
+  const auto* cut = output_of(*sliced, 1);
+  ASSERT_NE(cut, nullptr);
+  double thick_top = -1e9;
+  for (const auto& point : cut->mesh.points) thick_top = std::max(thick_top, point[2]);
+  EXPECT_NEAR(thick_top, 16.5, 1e-6);  // the last centre, 15 mm, and half a slice
 }
 
 TEST(NetSurfaces, NestedLabelsShareTheirInterfacesWithoutOverlap) {
