@@ -573,7 +573,11 @@ InterfaceSurface label_interfaces(const volume::LabelVolume& volume,
     // Across the surface by a quarter of the grid's own voxel.
     const Vec3 across{0.5 * half * geometry.spacing[0], 0.5 * half * geometry.spacing[1],
                       0.5 * half * geometry.spacing[2]};
-    const auto widened = widen_small_angles(net.quads, net.quad_sides, slides, net.centre, boxes,
+    // A cap's points may leave its plane inwards where that widens a thin
+    // triangle at its rim (they still stay within the edges).
+    PointBoxes sliding = boxes;
+    std::vector<uint8_t>().swap(sliding.pinned);
+    const auto widened = widen_small_angles(net.quads, net.quad_sides, slides, net.centre, sliding,
                                             across, params.widen_angles_below_deg, points);
     figures.widened_points = widened.points_moved;
   }
