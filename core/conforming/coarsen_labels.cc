@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "core/util/text.h"
+#include "core/volume/drawn_grid.h"
 #include "core/volume/voxel_access.h"
 
 namespace labelmesh::conforming {
@@ -74,21 +75,18 @@ absl::StatusOr<volume::LabelVolume> coarsen_labels(const volume::LabelVolume& vo
   coarse.format = volume.format;
   coarse.file_voxel_type = volume.file_voxel_type;
   coarse.descriptions = volume.descriptions;
-  coarse.geometry = geometry;
-  std::array<double, 3> first{};
-  // Input index of each coarser voxel's centre along each axis.
-  std::array<std::vector<int64_t>, 3> nearest;
+  // Blocks of `factors` input voxels from the volume's first edge; each
+  // takes the input voxel nearest its centre.
+  std::array<volume::DrawnAxis, 3> blocks;
   for (int a = 0; a < 3; ++a) {
-    const auto n = std::max<int64_t>(1, static_cast<int64_t>(std::ceil(d[a] / factors[a] - 1e-9)));
-    coarse.geometry.dims[a] = n;
-    coarse.geometry.spacing[a] = geometry.spacing[a] * factors[a];
-    first[a] = 0.5 * factors[a] - 0.5;
-    for (int64_t j = 0; j < n; ++j) {
-      const double centre = (j + 0.5) * factors[a] - 0.5;
-      nearest[a].push_back(std::clamp<int64_t>(std::llround(centre), 0, d[a] - 1));
-    }
+    blocks[a].pitch = factors[a];
+    blocks[a].first_boundary = -0.5;
+    blocks[a].count =
+        std::max<int64_t>(1, static_cast<int64_t>(std::ceil(d[a] / factors[a] - 1e-9)));
   }
-  coarse.geometry.origin = geometry.to_physical(first);
+  volume::DrawnSampling sampling = volume::drawn_sampling(geometry, blocks);
+  coarse.geometry = sampling.geometry;
+  const auto& nearest = sampling.source;
   const auto& cd = coarse.geometry.dims;
   coarse.voxels = vtkSmartPointer<vtkImageData>::New();
   coarse.voxels->SetDimensions(static_cast<int>(cd[0]), static_cast<int>(cd[1]),

@@ -149,28 +149,38 @@ DrawnGrid find_drawn_grid(const LabelVolume& volume) {
   return grid;
 }
 
+DrawnSampling drawn_sampling(const ImageGeometry& file, const std::array<DrawnAxis, 3>& axes) {
+  DrawnSampling sampling;
+  sampling.geometry = file;
+  std::array<double, 3> first_centre{};
+  for (int k = 0; k < 3; ++k) {
+    const DrawnAxis& axis = axes[k];
+    sampling.geometry.dims[k] = axis.count;
+    sampling.geometry.spacing[k] = file.spacing[k] * axis.pitch;
+    first_centre[k] = axis.first_boundary + 0.5 * axis.pitch;
+    auto& source = sampling.source[k];
+    source.resize(static_cast<size_t>(std::max<int64_t>(axis.count, 0)));
+    for (size_t c = 0; c < source.size(); ++c)
+      source[c] = file_index(axis, static_cast<int64_t>(c), file.dims[k]);
+  }
+  sampling.geometry.origin = file.to_physical(first_centre);
+  return sampling;
+}
+
 absl::StatusOr<LabelVolume> resample_to_drawn_grid(const LabelVolume& volume,
                                                    const DrawnGrid& grid) {
   const auto& file = volume.geometry;
+  for (int k = 0; k < 3; ++k) {
+    if (grid.axes[k].count < 1 || grid.axes[k].pitch < 1)
+      return absl::InvalidArgumentError(cat("drawn grid: axis ", k, " has no voxel"));
+  }
+  DrawnSampling sampling = drawn_sampling(file, grid.axes);
+  const auto& source = sampling.source;
   LabelVolume drawn;
   drawn.format = volume.format;
   drawn.file_voxel_type = volume.file_voxel_type;
   drawn.descriptions = volume.descriptions;
-  drawn.geometry = file;
-  std::array<double, 3> first_centre{};
-  std::array<std::vector<int64_t>, 3> source;
-  for (int k = 0; k < 3; ++k) {
-    const DrawnAxis& axis = grid.axes[k];
-    if (axis.count < 1 || axis.pitch < 1)
-      return absl::InvalidArgumentError(cat("drawn grid: axis ", k, " has no voxel"));
-    drawn.geometry.dims[k] = axis.count;
-    drawn.geometry.spacing[k] = file.spacing[k] * axis.pitch;
-    first_centre[k] = axis.first_boundary + 0.5 * axis.pitch;
-    source[k].resize(static_cast<size_t>(axis.count));
-    for (int64_t c = 0; c < axis.count; ++c)
-      source[k][static_cast<size_t>(c)] = file_index(axis, c, file.dims[k]);
-  }
-  drawn.geometry.origin = file.to_physical(first_centre);
+  drawn.geometry = sampling.geometry;
   const auto& dims = drawn.geometry.dims;
   const auto resample = [&](vtkImageData* image) -> absl::StatusOr<vtkSmartPointer<vtkImageData>> {
     const int* image_dims = image->GetDimensions();

@@ -8,6 +8,7 @@
 
 #include <array>
 #include <cstdint>
+#include <vector>
 
 #include "absl/status/statusor.h"
 #include "core/volume/label_volume.h"
@@ -43,6 +44,16 @@ struct DrawnGrid {
 // offsets span the least (a minimax line fit).
 inline constexpr int kMinDrawnChanges = 8;
 DrawnGrid find_drawn_grid(const LabelVolume& volume);
+
+// A grid of drawn voxels over the file's: its geometry (the same directions,
+// spacing times pitch, the origin at drawn voxel 0's centre) and, per axis,
+// the file voxel nearest each drawn voxel's centre. Nearest-neighbour
+// resampling onto any such lattice reads its labels there.
+struct DrawnSampling {
+  ImageGeometry geometry;
+  std::array<std::vector<int64_t>, 3> source;
+};
+DrawnSampling drawn_sampling(const ImageGeometry& file, const std::array<DrawnAxis, 3>& axes);
 
 // The volume on `grid` (every layer), in the same physical space: spacing
 // times pitch, the origin at the first drawn voxel's centre, int32 voxels.
