@@ -444,8 +444,13 @@ absl::StatusOr<MeshResult> run_on_volume(const std::string& path,
                                          MeshResult result) {
   if (auto s = check_sizing_for_grid(params.poisson, volume->geometry); !s.ok())
     return absl::InvalidArgumentError(cat(path, ": ", std::string(s.message())));
-  // The file's volume, where the labels are meshed on the grid they were
-  // drawn on (the scene formats write the labels as read).
+  // The scene formats other than vtm write the label volume as read.
+  const bool writes_label_image =
+      std::any_of(params.scene_formats.begin(), params.scene_formats.end(),
+                  [](SceneFormat f) { return f != SceneFormat::kVtm; });
+  // Where the labels are meshed on the grid they were drawn on: the file's
+  // grid, and its volume when a scene format writes it.
+  std::optional<volume::ImageGeometry> file_geometry;
   std::optional<volume::LabelVolume> file_volume;
   if (params.mesh_on_drawn_grid) {
     StageTimer timer(result.stages, "drawn_grid");
@@ -456,7 +461,8 @@ absl::StatusOr<MeshResult> run_on_volume(const std::string& path,
         return absl::Status(drawn.status().code(),
                             cat(path, ": ", std::string(drawn.status().message())));
       }
-      file_volume = std::move(*volume);
+      file_geometry = volume->geometry;
+      if (writes_label_image) file_volume = std::move(*volume);
       volume = std::move(*drawn);
       if (auto s = check_sizing_for_grid(params.poisson, volume->geometry); !s.ok()) {
         return absl::InvalidArgumentError(
@@ -470,7 +476,7 @@ absl::StatusOr<MeshResult> run_on_volume(const std::string& path,
   {
     StageTimer timer(result.stages, "label_statistics");
     result.input = summary_of(layers);
-    if (file_volume) result.input.file_geometry = file_volume->geometry;
+    result.input.file_geometry = file_geometry;
     volume::apply_label_table(params.label_names, result.input.descriptions);
   }
   LABELMESH_ASSIGN_OR_RETURN(auto labels,
@@ -478,8 +484,7 @@ absl::StatusOr<MeshResult> run_on_volume(const std::string& path,
   auto layer_of = layer_of_labels(layers, labels);
   // The label volume as read, for the scene formats that write it.
   const auto keep_label_image = [&] {
-    if (std::any_of(params.scene_formats.begin(), params.scene_formats.end(),
-                    [](SceneFormat f) { return f != SceneFormat::kVtm; })) {
+    if (writes_label_image) {
       result.label_image = std::make_shared<const volume::LabelVolume>(
           std::move(file_volume ? *file_volume : *volume));
     }
