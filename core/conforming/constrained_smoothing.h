@@ -14,11 +14,13 @@
 namespace labelmesh::conforming {
 
 // Neighbours each point averages over: every neighbour on a patch between
-// two labels; on a junction curve, only its two neighbours on the curve.
-// Points where curves meet or end have none and stay fixed.
+// two labels; on a junction curve held sharp, only its two neighbours on the
+// curve. Points where such curves meet or end have none and stay fixed.
 struct Stencil {
   std::vector<uint32_t> start;  // CSR offsets, one past the last point
   std::vector<uint32_t> neighbours;
+  // Per point: smoothed along a junction curve (its two neighbours).
+  std::vector<bool> along_curve;
 };
 
 // params.smoothing_rounds rounds of a shrink_step and an inflate_step, each

@@ -63,9 +63,11 @@ struct InterfaceParams {
 struct InterfaceFigures {
   size_t points = 0;
   size_t triangles = 0;
-  // Points where three or more labels meet, smoothed along their junction
-  // curve only, and the fixed ones where curves meet.
+  // Points where three or more labels meet; of those, the ones smoothed
+  // along their junction curve only (next to a small label) and the fixed
+  // ones where such curves meet or end.
   size_t junction_points = 0;
+  size_t curve_points = 0;
   size_t fixed_points = 0;
   // The farthest any point lies from its staircase position, mm: the surface
   // is within this distance of the voxel boundary (both share triangles).
