@@ -480,9 +480,10 @@ int bench_conforming_file(const std::string& path, int pairs) {
     const auto& c = figures.conformity;
     std::printf("%s: conforming mesh of %zu labels\n", path.c_str(), figures.labels.size());
     std::printf(
-        "  interfaces   %8.3f s  %zu points (%zu on junctions, %zu fixed), %zu triangles, "
-        "within %.2f mm of the voxel boundary\n",
-        i.seconds, i.points, i.junction_points, i.fixed_points, i.triangles, i.max_offset_mm);
+        "  interfaces   %8.3f s  %zu points (%zu on junctions, %zu held to curves, %zu fixed), "
+        "%zu triangles, within %.2f mm of the voxel boundary\n",
+        i.seconds, i.points, i.junction_points, i.curve_points, i.fixed_points, i.triangles,
+        i.max_offset_mm);
     std::printf("  grid         %8.3f s  %llu voxel faces between labels; spacing x %.2f %.2f %.2f",
                 figures.grid_seconds, (unsigned long long)figures.coarsening.interface_faces, f[0],
                 f[1], f[2]);

@@ -340,6 +340,13 @@ int bench_volume(const std::string& path, int rounds) {
     ++f.labels;
     const auto& chosen = ours->fidelity->attempts[ours->fidelity->delivered];
     if (chosen.within_tolerance) ++f.ours_within;
+    if (!chosen.within_tolerance && chosen.voxels && std::getenv("LABELMESH_BENCH_LABELS") != nullptr)
+      std::printf(
+          "    label %d (%zu voxels) outside: %s, volume %+.1f %%, misclassified %.2f %%, "
+          "farthest %.2f, Hausdorff %.2f voxels\n",
+          labels[i], size_t(label->voxels), ours->stage.c_str(),
+          100 * chosen.voxels->volume_change, 100 * chosen.voxels->misclassified_fraction(),
+          chosen.voxels->farthest_misclassified_voxels, chosen.voxels->hausdorff_voxels);
     if (ours->stage.rfind("poisson", 0) == 0) ++f.ours_poisson;
     f.ours_min_angle = std::min(f.ours_min_angle, ours->statistics.min_angle_deg);
     if (const char* out = std::getenv("LABELMESH_BENCH_OUT")) {
@@ -386,6 +393,16 @@ int bench_volume(const std::string& path, int rounds) {
     f.slicer_share.push_back(slicer_voxels->axis_aligned_share);
     if (mc && mc->axis_aligned_share) f.mc_share.push_back(*mc->axis_aligned_share);
     if (our_share <= slicer_voxels->axis_aligned_share + 0.05) ++f.ours_within_slicer_plus5;
+    // LABELMESH_BENCH_LABELS=1 prints each label's shares.
+    if (std::getenv("LABELMESH_BENCH_LABELS") != nullptr)
+      std::printf(
+          "    label %d (%zu voxels): share MC %.1f %%, Slicer-like %.1f %%, ours %.1f %%; "
+          "misclassified Slicer-like %.1f %%, ours %.2f %% (%s)\n",
+          labels[i], size_t(label->voxels),
+          mc && mc->axis_aligned_share ? 100 * *mc->axis_aligned_share : -1.0,
+          100 * slicer_voxels->axis_aligned_share, 100 * our_share,
+          100 * slicer_voxels->misclassified_fraction(),
+          chosen.voxels ? 100 * chosen.voxels->misclassified_fraction() : -1.0, ours->stage.c_str());
   }
   std::printf(
       "  labels %d: within the voxel tolerance ours %d, Slicer-like %d; ours by Poisson %d; "
