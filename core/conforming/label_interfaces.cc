@@ -76,14 +76,15 @@ PaddedLabels padded_labels(const volume::LabelVolume& volume, std::vector<int32_
   return padded;
 }
 
-// Labels of fewer voxels than this keep sharp junction curves around them
+// Labels of fewer voxels than this (of the grid drawn, not of thinner
+// slices cut from it) keep sharp junction curves around them
 // (smoothing_stencil): moving their junction points takes too large a part
-// of their volume (on the frog's tissues, labels of 4 to 121 voxels lost 11
-// to 49 %).
-constexpr uint64_t kSmallLabelVoxels = 500;
+// of their volume (the frog's tissues of 4 to 121 voxels lost 11 to 49 %).
+constexpr uint64_t kSharpJunctionLabelVoxels = 500;
 
-// The labels of `labels` with fewer than kSmallLabelVoxels voxels, sorted.
-std::vector<int32_t> small_labels(const PaddedLabels& labels) {
+// The labels of `labels` with fewer than kSharpJunctionLabelVoxels voxels
+// times `parts` (the thinner slices each drawn one was cut into), sorted.
+std::vector<int32_t> small_labels(const PaddedLabels& labels, int parts) {
   std::unordered_map<int32_t, uint64_t> voxels;
   const auto& all = labels.labels;
   for (size_t run = 0; run < all.size();) {
@@ -94,7 +95,8 @@ std::vector<int32_t> small_labels(const PaddedLabels& labels) {
   }
   std::vector<int32_t> small;
   for (const auto& [label, count] : voxels)
-    if (label != kOutside && count < kSmallLabelVoxels) small.push_back(label);
+    if (label != kOutside && count < kSharpJunctionLabelVoxels * uint64_t(std::max(parts, 1)))
+      small.push_back(label);
   std::sort(small.begin(), small.end());
   return small;
 }
@@ -252,6 +254,8 @@ bool turns_back(const std::array<int64_t, 3>& cube,
 // point then averages over its two neighbours on the curve, and stays where
 // it has another count or, with `fix_turns_back` (on thinner slices, whose
 // interpolated labels make such curves), where its curve turns back.
+// Anywhere, a junction point with fewer than two junction neighbours (a
+// curve's end, a lone cube holding three labels) stays.
 Stencil smoothing_stencil(const Net& net, const PaddedLabels& labels, const MarkedCubes& cubes,
                           const std::vector<int32_t>& small, bool fix_turns_back,
                           InterfaceFigures& figures) {
@@ -590,8 +594,13 @@ InterfaceSurface label_interfaces(const volume::LabelVolume& volume,
     net.quad_voxels.reserve(pairs.size());
     side_by_side([&] { add_quads(padded, pairs, cubes, net); },
                  [&] {
-                   stencil = smoothing_stencil(net, padded, cubes, small_labels(padded),
-                                               params.drawn_axis >= 0, figures);
+                   // Without smoothing the stencil only matters for widening.
+                   const auto small =
+                       params.smoothing_rounds > 0 || params.widen_angles_below_deg > 0
+                           ? small_labels(padded, params.drawn_axis >= 0 ? params.drawn_parts : 1)
+                           : std::vector<int32_t>{};
+                   stencil = smoothing_stencil(net, padded, cubes, small, params.drawn_axis >= 0,
+                                               figures);
                  });
   }
   // The labels are not read again: their memory goes before smoothing's.
@@ -612,7 +621,7 @@ InterfaceSurface label_interfaces(const volume::LabelVolume& volume,
   // again), so a net cut into smaller quads is not widened.
   if (params.widen_angles_below_deg > 0 && !params.subdivide_thick_quads) {
     before_widening = points;
-    // Junction points stay on their curves, fixed points where they are.
+    // Points of a junction curve held sharp slide along it; fixed points stay.
     std::vector<Slide> slides(points.size());
     for (size_t p = 0; p < points.size(); ++p) {
       const uint32_t first = stencil.start[p], last = stencil.start[p + 1];

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <unordered_map>
 
 namespace labelmesh::conforming {
 namespace {
@@ -189,20 +190,26 @@ WidenedAngles widen_small_angles(const std::vector<std::array<uint32_t, 4>>& qua
   std::vector<uint32_t> candidates = points_of_thin_quads([&](const auto& visit) {
     for (uint32_t q = 0; q < quads.size(); ++q) visit(q);
   });
-  std::vector<bool> moved(points.size(), false);
+  // Where each moved point started: one moved in a pass may come back in a
+  // later one, and counts only if it ends elsewhere.
+  std::unordered_map<uint32_t, Vec3> started;
   // A few passes: a point that moves changes its neighbours' quads too.
   constexpr int kPasses = 3;
   for (int pass = 0; pass < kPasses && !candidates.empty(); ++pass) {
     std::vector<uint32_t> moved_now;
-    for (const uint32_t p : candidates)
-      if (widen_at(p)) moved_now.push_back(p);
-    for (const uint32_t p : moved_now) moved[p] = true;
+    for (const uint32_t p : candidates) {
+      const Vec3 from = points[p];
+      if (!widen_at(p)) continue;
+      moved_now.push_back(p);
+      started.emplace(p, from);
+    }
     candidates = points_of_thin_quads([&](const auto& visit) {
       for (const uint32_t p : moved_now)
         for (uint32_t i = around.start[p]; i < around.start[p + 1]; ++i) visit(around.quads[i]);
     });
   }
-  result.points_moved = static_cast<size_t>(std::count(moved.begin(), moved.end(), true));
+  result.points_moved = static_cast<size_t>(std::count_if(
+      started.begin(), started.end(), [&](const auto& s) { return points[s.first] != s.second; }));
   return result;
 }
 

@@ -30,8 +30,9 @@ QuadSplit best_quad_split(const std::array<uint32_t, 4>& quad,
                           const std::vector<geometry::Vec3>& points);
 
 // How a point may slide: not at all; within the surface's tangent plane
-// (a point between two labels); or, on a junction curve where three or more
-// labels meet, parallel to the line through its two neighbours there.
+// (a point smoothed over all its neighbours, where three labels meet too);
+// or, on a junction curve held sharp, parallel to the line through its two
+// neighbours there.
 struct Slide {
   enum class Kind : uint8_t { kFixed, kSurface, kCurve };
   Kind kind = Kind::kFixed;

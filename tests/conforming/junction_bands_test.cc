@@ -75,9 +75,9 @@ TEST(JunctionBands, SmallLabelsKeepTheirJunctionCurves) {
 
 // TotalSegmentator's 3 mm whole-body segmentation: organs touch one another
 // nearly everywhere, across gaps a voxel wide and along thin tissues. Held to
-// the junction curves there, the surfaces kept the voxels' steps (a median
-// axis-aligned share of 12.5 %) and thin triangles (6.1 degrees); smoothed as
-// anywhere else, every label stays within the voxel tolerance.
+// the junction curves there, the surfaces kept the voxels' steps and thin
+// triangles (docs/benchmarks.md); smoothed as anywhere else, every label
+// stays within the voxel tolerance.
 TEST(JunctionBands, TouchingOrgansOnThreeMillimetresAreSmoothWhereTheyMeet) {
   LABELMESH_SKIP_WITHOUT_SHARED_DATA();
   const auto path = testing::shared_data("totalseg_example_seg_fast_force_split.nii.gz");

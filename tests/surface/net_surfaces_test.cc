@@ -600,8 +600,7 @@ TEST(NetSurfacesRealData, CrossingMovesAreTakenBack) {
   auto net =
       conforming::label_interfaces(*volume, labels, net_interface_params(NetOptions{}), figures);
   const size_t moved = net.widened.size();
-  // A point moved in one pass may come back to its place in a later one.
-  EXPECT_LE(moved, figures.widened_points);
+  EXPECT_EQ(moved, figures.widened_points);
   ASSERT_GT(moved, 100u);
   const auto pairs = conforming::crossings_after_taking_back_slides(net);
   // Moves taken back wholly leave the list; those taken back in part stay.
