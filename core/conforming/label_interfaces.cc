@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "core/conforming/constrained_smoothing.h"
+#include "core/conforming/cube_sheets.h"
 #include "core/conforming/marked_cubes.h"
 #include "core/conforming/widen_small_angles.h"
 #include "core/util/side_by_side.h"
@@ -104,12 +105,27 @@ std::vector<int32_t> small_labels(const PaddedLabels& labels, int parts) {
 struct Net {
   // Positions in scaled voxel space: index times spacing, mm along each axis.
   std::vector<Vec3> centre;
-  std::vector<uint8_t> label_count;  // distinct labels among the cube's corners
+  // Distinct labels among the cube's corners, or on the point's sheets
+  // where cubes hold a point per sheet.
+  std::vector<uint8_t> label_count;
+  // Where cubes hold a point per sheet (cube_sheets.h): each numbered
+  // cube's first point, and one past the last; empty otherwise.
+  std::vector<uint32_t> first_point;
+  // There too: points whose sheets hold a small label (small_labels).
+  std::vector<bool> near_small;
   std::vector<std::array<uint32_t, 4>> quads;
   std::vector<std::array<int32_t, 2>> quad_sides;
   std::vector<uint8_t> quad_axis;                    // the axis between the quad's two voxels
   std::vector<std::array<uint64_t, 2>> quad_voxels;  // padded linear indices
 };
+
+// The labels at the corners of cube (a, b, c), corner k at offsets k & 1,
+// (k >> 1) & 1 and k >> 2.
+std::array<int32_t, 8> corners(const PaddedLabels& labels, int64_t a, int64_t b, int64_t c) {
+  std::array<int32_t, 8> corner{};
+  for (int k = 0; k < 8; ++k) corner[k] = labels.at(a + (k & 1), b + ((k >> 1) & 1), c + (k >> 2));
+  return corner;
+}
 
 uint8_t distinct_labels(const PaddedLabels& labels, int64_t a, int64_t b, int64_t c) {
   std::array<int32_t, 8> seen{};
@@ -169,8 +185,11 @@ constexpr std::array<std::array<int, 2>, 4> kQuadOffsets{{{1, 1}, {0, 1}, {0, 0}
 
 // The net's points, one per cube whose corners hold more than one label,
 // numbered in cube index order.
+// With `split`, a point per sheet through the cube (cube_sheets.h), and
+// `small` (sorted) marks the points next to small labels.
 Net net_points(const PaddedLabels& labels, const std::array<double, 3>& spacing,
-               const std::vector<VoxelPair>& pairs, MarkedCubes& cubes) {
+               const std::vector<VoxelPair>& pairs, MarkedCubes& cubes, bool split,
+               const std::vector<int32_t>& small) {
   // A cube's corners hold more than one label exactly when one of its edges
   // joins two different labels, and every such edge's quad uses the four
   // cubes around it: mark those, then number them in index order.
@@ -184,16 +203,33 @@ Net net_points(const PaddedLabels& labels, const std::array<double, 3>& spacing,
   Net net;
   net.centre.reserve(cubes.points());
   net.label_count.reserve(cubes.points());
+  if (split) net.first_point.reserve(cubes.points() + 1);
   cubes.for_each_point([&](size_t i, uint32_t) {
     const auto [a, b, c] = cubes.cube(i);
     // Padded voxel a is voxel a + first; the cube's centre is half a voxel
     // on.
     const auto& f = labels.first;
-    net.centre.push_back({(double(a + f[0]) + 0.5) * spacing[0],
-                          (double(b + f[1]) + 0.5) * spacing[1],
-                          (double(c + f[2]) + 0.5) * spacing[2]});
-    net.label_count.push_back(distinct_labels(labels, a, b, c));
+    const Vec3 centre{(double(a + f[0]) + 0.5) * spacing[0], (double(b + f[1]) + 0.5) * spacing[1],
+                      (double(c + f[2]) + 0.5) * spacing[2]};
+    if (!split) {
+      net.centre.push_back(centre);
+      net.label_count.push_back(distinct_labels(labels, a, b, c));
+      return;
+    }
+    net.first_point.push_back(static_cast<uint32_t>(net.centre.size()));
+    const CubeSheets sheets = cube_sheets(corners(labels, a, b, c));
+    for (int g = 0; g < sheets.sheet_count; ++g) {
+      net.centre.push_back(centre);
+      net.label_count.push_back(sheets.labels[g]);
+      bool near = false;
+      for (int k = 0; k < sheets.pair_count; ++k)
+        if (sheets.sheet[k] == g)
+          for (const int32_t label : sheets.pairs[k])
+            near = near || std::binary_search(small.begin(), small.end(), label);
+      net.near_small.push_back(near);
+    }
   });
+  if (split) net.first_point.push_back(static_cast<uint32_t>(net.centre.size()));
   return net;
 }
 
@@ -209,13 +245,26 @@ void add_quads(const PaddedLabels& labels, const std::vector<VoxelPair>& pairs,
     const auto axis = static_cast<int>(pair.axis);
     const auto i =
         static_cast<uint64_t>((voxel[2] * labels.dims[1] + voxel[1]) * labels.dims[0] + voxel[0]);
+    const int32_t from = labels.labels[i], to = labels.labels[i + stride[axis]];
     std::array<uint32_t, 4> quad{};
     for (int k = 0; k < 4; ++k) {
       const auto cube = cube_around(voxel, axis, kQuadOffsets[k]);
-      quad[k] = cubes.point(cubes.index(cube[0], cube[1], cube[2]));
+      const uint32_t rank = cubes.point(cubes.index(cube[0], cube[1], cube[2]));
+      if (net.first_point.empty()) {
+        quad[k] = rank;
+        continue;
+      }
+      // The point of this pair's sheet in that cube.
+      const uint32_t first = net.first_point[rank];
+      if (net.first_point[rank + 1] == first + 1) {
+        quad[k] = first;
+        continue;
+      }
+      const int sheet = cube_sheets(corners(labels, cube[0], cube[1], cube[2])).sheet_of(from, to);
+      quad[k] = first + static_cast<uint32_t>(std::max(sheet, 0));
     }
     net.quads.push_back(quad);
-    net.quad_sides.push_back({labels.labels[i], labels.labels[i + stride[axis]]});
+    net.quad_sides.push_back({from, to});
     net.quad_axis.push_back(static_cast<uint8_t>(axis));
     net.quad_voxels.push_back({i, i + stride[axis]});
   }
@@ -326,6 +375,68 @@ Stencil smoothing_stencil(const Net& net, const PaddedLabels& labels, const Mark
     stencil.along_curve[p] = true;
     ++figures.curve_points;
   });
+  stencil.start[n] = static_cast<uint32_t>(stencil.neighbours.size());
+  return stencil;
+}
+
+// The stencil of a net with a point per sheet (Net::first_point): two
+// points are neighbours when a quad has both as consecutive corners (as in
+// smoothing_stencil, where they share a face whose voxels differ). Junction
+// points follow smoothing_stencil's rules, without the turn test (such nets
+// are not made on thinner slices), and a point holds its curve when a small
+// label is on its own sheet, not merely in its cube.
+Stencil stencil_from_quads(const Net& net, InterfaceFigures& figures) {
+  const size_t n = net.centre.size();
+  // Each point's quad neighbours, with repeats (an edge lies on two quads
+  // or more): its two neighbours in each of its quads.
+  std::vector<uint32_t> offset(n + 1, 0);
+  for (const auto& q : net.quads)
+    for (const uint32_t p : q) offset[p + 1] += 2;
+  for (size_t p = 0; p < n; ++p) offset[p + 1] += offset[p];
+  std::vector<uint32_t> around(offset[n]);
+  {
+    std::vector<uint32_t> filled(offset.begin(), offset.end() - 1);
+    for (const auto& q : net.quads) {
+      for (int k = 0; k < 4; ++k) {
+        around[filled[q[k]]++] = q[(k + 1) % 4];
+        around[filled[q[k]]++] = q[(k + 3) % 4];
+      }
+    }
+  }
+  Stencil stencil;
+  stencil.start.assign(n + 1, 0);
+  stencil.neighbours.reserve(around.size() / 2);
+  stencil.along_curve.assign(n, false);
+  for (size_t p = 0; p < n; ++p) {
+    stencil.start[p] = static_cast<uint32_t>(stencil.neighbours.size());
+    const size_t first = stencil.neighbours.size();
+    std::array<uint32_t, 2> curve{};
+    size_t on_curve = 0;
+    const auto begin = around.begin() + offset[p];
+    const auto end = around.begin() + offset[p + 1];
+    std::sort(begin, end);
+    const auto last = std::unique(begin, end);
+    for (auto it = begin; it != last; ++it) {
+      const uint32_t q = *it;
+      if (q == p) continue;
+      stencil.neighbours.push_back(q);
+      if (net.label_count[p] <= 2 || net.label_count[q] <= 2) continue;
+      if (on_curve < 2) curve[on_curve] = q;
+      ++on_curve;
+    }
+    if (net.label_count[p] <= 2) continue;
+    ++figures.junction_points;
+    if (on_curve >= 2 && !net.near_small[p]) continue;
+    stencil.neighbours.resize(first);
+    if (on_curve != 2) {
+      ++figures.fixed_points;
+      continue;
+    }
+    stencil.neighbours.push_back(curve[0]);
+    stencil.neighbours.push_back(curve[1]);
+    stencil.along_curve[p] = true;
+    ++figures.curve_points;
+  }
   stencil.start[n] = static_cast<uint32_t>(stencil.neighbours.size());
   return stencil;
 }
@@ -583,25 +694,33 @@ InterfaceSurface label_interfaces(const volume::LabelVolume& volume,
   Stencil stencil;
   {
     const auto pairs = differing_pairs(padded);
-    net = net_points(padded, geometry.spacing, pairs, cubes);
-    // The quads and the smoothing stencil only read the numbered cubes and
-    // write apart: they are made side by side. The quads' arrays are reserved
-    // here, so that they belong to this thread's heap (glibc keeps one per
-    // thread, and memory freed in another thread's is not reused here).
+    // Without smoothing the stencil only matters for widening.
+    const auto find_small = [&] {
+      return params.smoothing_rounds > 0 || params.widen_angles_below_deg > 0
+                 ? small_labels(padded, params.drawn_axis >= 0 ? params.drawn_parts : 1)
+                 : std::vector<int32_t>{};
+    };
+    const bool split = params.split_sheets && params.drawn_axis < 0;
+    net = net_points(padded, geometry.spacing, pairs, cubes, split,
+                     split ? find_small() : std::vector<int32_t>{});
+    // On one point per cube the quads and the smoothing stencil only read
+    // the numbered cubes and write apart: they are made side by side. The quads' arrays are
+    // reserved here, so that they belong to this thread's heap (glibc keeps one per thread, and
+    // memory freed in another thread's is not reused here).
     net.quads.reserve(pairs.size());
     net.quad_sides.reserve(pairs.size());
     net.quad_axis.reserve(pairs.size());
     net.quad_voxels.reserve(pairs.size());
-    side_by_side([&] { add_quads(padded, pairs, cubes, net); },
-                 [&] {
-                   // Without smoothing the stencil only matters for widening.
-                   const auto small =
-                       params.smoothing_rounds > 0 || params.widen_angles_below_deg > 0
-                           ? small_labels(padded, params.drawn_axis >= 0 ? params.drawn_parts : 1)
-                           : std::vector<int32_t>{};
-                   stencil = smoothing_stencil(net, padded, cubes, small, params.drawn_axis >= 0,
-                                               figures);
-                 });
+    if (split) {
+      add_quads(padded, pairs, cubes, net);
+      stencil = stencil_from_quads(net, figures);
+    } else {
+      side_by_side([&] { add_quads(padded, pairs, cubes, net); },
+                   [&] {
+                     stencil = smoothing_stencil(net, padded, cubes, find_small(),
+                                                 params.drawn_axis >= 0, figures);
+                   });
+    }
   }
   // The labels are not read again: their memory goes before smoothing's.
   std::vector<int32_t>().swap(padded.labels);

@@ -2,7 +2,8 @@
 // The interfaces between the labels of a volume as one smooth triangle
 // surface in which touching labels share their triangles: a multi-label
 // surface net. One point sits in each voxel cube (eight neighbouring voxel
-// centres) whose corners hold more than one label; each pair of
+// centres) whose corners hold more than one label (one per sheet where two
+// labels a voxel apart cross it; InterfaceParams::split_sheets); each pair of
 // face-neighbouring voxels with different labels gives the quad joining the
 // points of the four cubes around the segment between them. With every point
 // at its cube's centre that is exactly the voxels' staircase; the points are
@@ -58,6 +59,9 @@ struct InterfaceParams {
   // Cut each quad on a grid with thicker slices into near-square ones (for
   // tetrahedra); surfaces keep one quad per voxel face.
   bool subdivide_thick_quads = true;
+  // A point per sheet through a cube (cube_sheets.h), so that two faces a
+  // voxel apart can part; not on a grid cut into thinner slices.
+  bool split_sheets = false;
 };
 
 struct InterfaceFigures {

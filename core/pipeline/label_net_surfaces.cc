@@ -36,6 +36,7 @@ conforming::InterfaceParams interface_params(const NetOptions& options) {
   params.restore_volumes = options.restore_volumes;
   params.subdivide_thick_quads = false;
   params.widen_angles_below_deg = kWidenAnglesBelowDeg;
+  params.split_sheets = true;
   return params;
 }
 
@@ -97,16 +98,19 @@ struct LayerNet {
   std::optional<conforming::InterfaceSurface> staircase;
 };
 
+// With `split_sheets` false, one point per cube throughout.
 absl::StatusOr<LayerNet> layer_net(const volume::LabelVolume& layer,
                                    const std::vector<int32_t>& here, const NetOptions& options,
                                    bool with_staircase, const RunContext& context,
-                                   std::vector<StageTiming>& stages) {
+                                   std::vector<StageTiming>& stages, bool split_sheets = true) {
   LayerNet made;
   conforming::InterfaceFigures figures;
   const auto cut = thick_slices(layer.geometry, options);
   if (cut.axis < 0) {
     made.geometry = layer.geometry;
-    made.net = conforming::label_interfaces(layer, here, interface_params(options), figures);
+    auto params = interface_params(options);
+    params.split_sheets = params.split_sheets && split_sheets;
+    made.net = conforming::label_interfaces(layer, here, params, figures);
     return made;
   }
   absl::StatusOr<volume::LabelVolume> thin;
@@ -469,6 +473,43 @@ void find_net_crossings(LabelNets& built, std::vector<StageTiming>& stages) {
     built.crossings[layer] = conforming::crossings_after_taking_back_slides(built.nets[layer]);
 }
 
+// Whether two of `net`'s crossing triangles share no label but the
+// outside: faces of two labels, parted across a gap a voxel wide
+// (conforming/cube_sheets.h), that passed through each other. No label's
+// own check sees such a pair.
+bool parted_faces_cross(const conforming::InterfaceSurface& net,
+                        const surface::TrianglePairs& crossings) {
+  for (const auto& [a, b] : crossings) {
+    bool share = false;
+    for (const int32_t x : net.sides[a])
+      for (const int32_t y : net.sides[b]) share = share || (x == y && x != conforming::kOutside);
+    if (!share) return true;
+  }
+  return false;
+}
+
+// Makes the nets whose parted faces cross again with one point per cube,
+// where faces a voxel apart share their points and cannot cross.
+absl::Status join_crossing_faces(const std::vector<volume::LabelVolume>& layers,
+                                 const MeshParams& params, const RunContext& context,
+                                 LabelNets& built, std::vector<StageTiming>& stages) {
+  for (size_t layer = 0; layer < built.nets.size(); ++layer) {
+    if (!parted_faces_cross(built.nets[layer], built.crossings[layer])) continue;
+    absl::StatusOr<LayerNet> made;
+    {
+      StageTimer timer(stages, "surface_net");
+      made = layer_net(layers[layer], built.layer_labels[layer], params.net,
+                       /*with_staircase=*/true, context, stages, /*split_sheets=*/false);
+    }
+    if (!made.ok()) return made.status();
+    built.nets[layer] = std::move(made->net);
+    built.staircases[layer] = std::move(made->staircase);
+    StageTimer timer(stages, "self_intersections");
+    built.crossings[layer] = conforming::crossings_after_taking_back_slides(built.nets[layer]);
+  }
+  return absl::OkStatus();
+}
+
 }  // namespace
 
 absl::StatusOr<LabelNets> build_label_nets(const std::vector<volume::LabelVolume>& layers,
@@ -480,6 +521,7 @@ absl::StatusOr<LabelNets> build_label_nets(const std::vector<volume::LabelVolume
   auto built = smoothed_nets(layers, layer_of, labels, params, context, stages);
   if (!built.ok()) return built.status();
   find_net_crossings(*built, stages);
+  LABELMESH_RETURN_IF_ERROR(join_crossing_faces(layers, params, context, *built, stages));
   LABELMESH_RETURN_IF_ERROR(context.check_stop());
   return built;
 }
