@@ -347,6 +347,12 @@ int bench_volume(const std::string& path, int rounds) {
           labels[i], size_t(label->voxels), ours->stage.c_str(),
           100 * chosen.voxels->volume_change, 100 * chosen.voxels->misclassified_fraction(),
           chosen.voxels->farthest_misclassified_voxels, chosen.voxels->hausdorff_voxels);
+    if (!chosen.within_tolerance && std::getenv("LABELMESH_BENCH_ATTEMPTS") != nullptr)
+      for (const auto& a : ours->fidelity->attempts)
+        std::printf("      attempt: error '%s', misclassified %.2f %%, farthest %.2f, volume %+.2f %%\n",
+                    a.error.c_str(), a.voxels ? 100 * a.voxels->misclassified_fraction() : -1.0,
+                    a.voxels ? a.voxels->farthest_misclassified_voxels : -1.0,
+                    a.voxels ? 100 * a.voxels->volume_change : -1.0);
     if (ours->stage.rfind("poisson", 0) == 0) ++f.ours_poisson;
     f.ours_min_angle = std::min(f.ours_min_angle, ours->statistics.min_angle_deg);
     if (const char* out = std::getenv("LABELMESH_BENCH_OUT")) {
