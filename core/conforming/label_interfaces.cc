@@ -130,11 +130,9 @@ std::array<int32_t, 8> corners(const PaddedLabels& labels, int64_t a, int64_t b,
 uint8_t distinct_labels(const PaddedLabels& labels, int64_t a, int64_t b, int64_t c) {
   std::array<int32_t, 8> seen{};
   uint8_t count = 0;
-  for (int corner = 0; corner < 8; ++corner) {
-    const int32_t label = labels.at(a + (corner & 1), b + ((corner >> 1) & 1), c + (corner >> 2));
+  for (const int32_t label : corners(labels, a, b, c))
     if (std::find(seen.begin(), seen.begin() + count, label) == seen.begin() + count)
       seen[count++] = label;
-  }
   return count;
 }
 
@@ -290,6 +288,23 @@ bool turns_back(const std::array<int64_t, 3>& cube,
   return r != kNoPoint && net.label_count[r] > 2;
 }
 
+// A junction point `p` held to its curve (next to a small label, or with
+// fewer than two junction neighbours): its neighbours from `first` on give
+// way to its `on_curve` == 2 neighbours on the curve, `curve`; it stays
+// with another count or where its curve `turns_back`.
+void hold_junction(uint32_t p, size_t first, size_t on_curve, const std::array<uint32_t, 2>& curve,
+                   bool turns_back, Stencil& stencil, InterfaceFigures& figures) {
+  stencil.neighbours.resize(first);
+  if (on_curve != 2 || turns_back) {
+    ++figures.fixed_points;
+    return;
+  }
+  stencil.neighbours.push_back(curve[0]);
+  stencil.neighbours.push_back(curve[1]);
+  stencil.along_curve[p] = true;
+  ++figures.curve_points;
+}
+
 // Two points are neighbours when their cubes share a face whose four voxels
 // do not all hold one label: a quad then has both as consecutive corners.
 // The six directions in this order give each point's neighbours in
@@ -316,13 +331,10 @@ Stencil smoothing_stencil(const Net& net, const PaddedLabels& labels, const Mark
   stencil.neighbours.reserve(4 * n);
   stencil.along_curve.assign(n, false);
   const auto next_to_small = [&](const std::array<int64_t, 3>& cube) {
-    if (small.empty()) return false;
-    for (int k = 0; k < 8; ++k) {
-      const int32_t label =
-          labels.at(cube[0] + (k & 1), cube[1] + ((k >> 1) & 1), cube[2] + (k >> 2));
-      if (std::binary_search(small.begin(), small.end(), label)) return true;
-    }
-    return false;
+    const auto corner = corners(labels, cube[0], cube[1], cube[2]);
+    return std::any_of(corner.begin(), corner.end(), [&](int32_t label) {
+      return std::binary_search(small.begin(), small.end(), label);
+    });
   };
   cubes.for_each_point([&](size_t i, uint32_t p) {
     stencil.start[p] = static_cast<uint32_t>(stencil.neighbours.size());
@@ -365,15 +377,9 @@ Stencil smoothing_stencil(const Net& net, const PaddedLabels& labels, const Mark
     if (!junction) return;
     ++figures.junction_points;
     if (on_curve >= 2 && !next_to_small(cube)) return;
-    stencil.neighbours.resize(first);
-    if (on_curve != 2 || (fix_turns_back && turns_back(cube, taken, cubes, net))) {
-      ++figures.fixed_points;
-      return;
-    }
-    stencil.neighbours.push_back(curve[0]);
-    stencil.neighbours.push_back(curve[1]);
-    stencil.along_curve[p] = true;
-    ++figures.curve_points;
+    hold_junction(p, first, on_curve, curve,
+                  on_curve == 2 && fix_turns_back && turns_back(cube, taken, cubes, net), stencil,
+                  figures);
   });
   stencil.start[n] = static_cast<uint32_t>(stencil.neighbours.size());
   return stencil;
@@ -427,15 +433,8 @@ Stencil stencil_from_quads(const Net& net, InterfaceFigures& figures) {
     if (net.label_count[p] <= 2) continue;
     ++figures.junction_points;
     if (on_curve >= 2 && !net.near_small[p]) continue;
-    stencil.neighbours.resize(first);
-    if (on_curve != 2) {
-      ++figures.fixed_points;
-      continue;
-    }
-    stencil.neighbours.push_back(curve[0]);
-    stencil.neighbours.push_back(curve[1]);
-    stencil.along_curve[p] = true;
-    ++figures.curve_points;
+    hold_junction(static_cast<uint32_t>(p), first, on_curve, curve, /*turns_back=*/false, stencil,
+                  figures);
   }
   stencil.start[n] = static_cast<uint32_t>(stencil.neighbours.size());
   return stencil;
@@ -704,9 +703,10 @@ InterfaceSurface label_interfaces(const volume::LabelVolume& volume,
     net = net_points(padded, geometry.spacing, pairs, cubes, split,
                      split ? find_small() : std::vector<int32_t>{});
     // On one point per cube the quads and the smoothing stencil only read
-    // the numbered cubes and write apart: they are made side by side. The quads' arrays are
-    // reserved here, so that they belong to this thread's heap (glibc keeps one per thread, and
-    // memory freed in another thread's is not reused here).
+    // the numbered cubes and write apart: they are made side by side. The
+    // quads' arrays are reserved here, so that they belong to this thread's
+    // heap (glibc keeps one per thread, and memory freed in another thread's
+    // is not reused here).
     net.quads.reserve(pairs.size());
     net.quad_sides.reserve(pairs.size());
     net.quad_axis.reserve(pairs.size());

@@ -473,28 +473,13 @@ void find_net_crossings(LabelNets& built, std::vector<StageTiming>& stages) {
     built.crossings[layer] = conforming::crossings_after_taking_back_slides(built.nets[layer]);
 }
 
-// Whether two of `net`'s crossing triangles share no label but the
-// outside: faces of two labels, parted across a gap a voxel wide
-// (conforming/cube_sheets.h), that passed through each other. No label's
-// own check sees such a pair.
-bool parted_faces_cross(const conforming::InterfaceSurface& net,
-                        const surface::TrianglePairs& crossings) {
-  for (const auto& [a, b] : crossings) {
-    bool share = false;
-    for (const int32_t x : net.sides[a])
-      for (const int32_t y : net.sides[b]) share = share || (x == y && x != conforming::kOutside);
-    if (!share) return true;
-  }
-  return false;
-}
-
 // Makes the nets whose parted faces cross again with one point per cube,
 // where faces a voxel apart share their points and cannot cross.
 absl::Status join_crossing_faces(const std::vector<volume::LabelVolume>& layers,
                                  const MeshParams& params, const RunContext& context,
                                  LabelNets& built, std::vector<StageTiming>& stages) {
   for (size_t layer = 0; layer < built.nets.size(); ++layer) {
-    if (!parted_faces_cross(built.nets[layer], built.crossings[layer])) continue;
+    if (crossings_between_labels(built.nets[layer], built.crossings[layer]) == 0) continue;
     absl::StatusOr<LayerNet> made;
     {
       StageTimer timer(stages, "surface_net");
@@ -511,6 +496,18 @@ absl::Status join_crossing_faces(const std::vector<volume::LabelVolume>& layers,
 }
 
 }  // namespace
+
+size_t crossings_between_labels(const conforming::InterfaceSurface& net,
+                                const surface::TrianglePairs& crossings) {
+  size_t between = 0;
+  for (const auto& [a, b] : crossings) {
+    bool share = false;
+    for (const int32_t x : net.sides[a])
+      for (const int32_t y : net.sides[b]) share = share || (x == y && x != conforming::kOutside);
+    between += share ? 0 : 1;
+  }
+  return between;
+}
 
 absl::StatusOr<LabelNets> build_label_nets(const std::vector<volume::LabelVolume>& layers,
                                            const std::vector<size_t>& layer_of,

@@ -50,6 +50,14 @@ struct LabelNets {
 // The smoothing of the shared net for `options`.
 conforming::InterfaceParams net_interface_params(const NetOptions& options);
 
+// The pairs among `crossings` (triangles of `net`) that share no label but
+// the outside: faces of two labels parted across a gap a voxel wide
+// (conforming/cube_sheets.h) that passed through each other, which no
+// label's own check sees. build_label_nets makes a net with such pairs
+// again with one point per cube.
+size_t crossings_between_labels(const conforming::InterfaceSurface& net,
+                                const surface::TrianglePairs& crossings);
+
 // Builds the nets of `labels`; `layer_of[i]` is the layer of `labels[i]`.
 // Errors: INVALID_ARGUMENT for bad options, RESOURCE_EXHAUSTED when thinner
 // slices cannot be allocated, CANCELLED.

@@ -340,19 +340,21 @@ int bench_volume(const std::string& path, int rounds) {
     ++f.labels;
     const auto& chosen = ours->fidelity->attempts[ours->fidelity->delivered];
     if (chosen.within_tolerance) ++f.ours_within;
-    if (!chosen.within_tolerance && chosen.voxels && std::getenv("LABELMESH_BENCH_LABELS") != nullptr)
+    if (!chosen.within_tolerance && chosen.voxels &&
+        std::getenv("LABELMESH_BENCH_LABELS") != nullptr)
       std::printf(
           "    label %d (%zu voxels) outside: %s, volume %+.1f %%, misclassified %.2f %%, "
           "farthest %.2f, Hausdorff %.2f voxels\n",
-          labels[i], size_t(label->voxels), ours->stage.c_str(),
-          100 * chosen.voxels->volume_change, 100 * chosen.voxels->misclassified_fraction(),
+          labels[i], size_t(label->voxels), ours->stage.c_str(), 100 * chosen.voxels->volume_change,
+          100 * chosen.voxels->misclassified_fraction(),
           chosen.voxels->farthest_misclassified_voxels, chosen.voxels->hausdorff_voxels);
     if (!chosen.within_tolerance && std::getenv("LABELMESH_BENCH_ATTEMPTS") != nullptr)
       for (const auto& a : ours->fidelity->attempts)
-        std::printf("      attempt: error '%s', misclassified %.2f %%, farthest %.2f, volume %+.2f %%\n",
-                    a.error.c_str(), a.voxels ? 100 * a.voxels->misclassified_fraction() : -1.0,
-                    a.voxels ? a.voxels->farthest_misclassified_voxels : -1.0,
-                    a.voxels ? 100 * a.voxels->volume_change : -1.0);
+        std::printf(
+            "      attempt: error '%s', misclassified %.2f %%, farthest %.2f, volume %+.2f %%\n",
+            a.error.c_str(), a.voxels ? 100 * a.voxels->misclassified_fraction() : -1.0,
+            a.voxels ? a.voxels->farthest_misclassified_voxels : -1.0,
+            a.voxels ? 100 * a.voxels->volume_change : -1.0);
     if (ours->stage.rfind("poisson", 0) == 0) ++f.ours_poisson;
     f.ours_min_angle = std::min(f.ours_min_angle, ours->statistics.min_angle_deg);
     if (const char* out = std::getenv("LABELMESH_BENCH_OUT")) {
@@ -408,7 +410,8 @@ int bench_volume(const std::string& path, int rounds) {
           mc && mc->axis_aligned_share ? 100 * *mc->axis_aligned_share : -1.0,
           100 * slicer_voxels->axis_aligned_share, 100 * our_share,
           100 * slicer_voxels->misclassified_fraction(),
-          chosen.voxels ? 100 * chosen.voxels->misclassified_fraction() : -1.0, ours->stage.c_str());
+          chosen.voxels ? 100 * chosen.voxels->misclassified_fraction() : -1.0,
+          ours->stage.c_str());
   }
   std::printf(
       "  labels %d: within the voxel tolerance ours %d, Slicer-like %d; ours by Poisson %d; "

@@ -16,7 +16,6 @@
 #include "core/pipeline/pipeline.h"
 #include "core/surface/crossing_triangles.h"
 #include "core/util/vec3.h"
-#include "core/volume/label_statistics.h"
 #include "core/volume/phantom_grid.h"
 #include "core/volume/read_label_volume.h"
 #include "support/label_volumes.h"
@@ -54,20 +53,6 @@ volume::LabelVolume ball_with_a_cube_across_its_gap(int64_t edge) {
     for (int64_t j = first; j < first + edge; ++j)
       for (int64_t i = first; i < first + edge; ++i) labels[(k * d[1] + j) * d[0] + i] = 3;
   return volume;
-}
-
-// The crossing pairs of `net` whose triangles share no label but the
-// outside.
-size_t crossings_between_labels(const conforming::InterfaceSurface& net,
-                                const surface::TrianglePairs& crossings) {
-  size_t between = 0;
-  for (const auto& [a, b] : crossings) {
-    bool share = false;
-    for (const int32_t x : net.sides[a])
-      for (const int32_t y : net.sides[b]) share = share || (x == y && x != conforming::kOutside);
-    between += share ? 0 : 1;
-  }
-  return between;
 }
 
 // The normal of the oblique gap in ball_with_a_cube_across_its_gap.
@@ -225,9 +210,7 @@ TEST(JunctionBands, PartedFacesThatCrossAreJoinedAgain) {
   if (!std::filesystem::exists(path)) GTEST_SKIP() << "missing " << path;
   const auto volume = volume::read_label_volume(path, {}, {});
   ASSERT_THAT(volume, testing::IsOk());
-  std::vector<int32_t> labels;
-  for (const auto& label : volume::compute_label_statistics(*volume).labels)
-    labels.push_back(label.label);
+  const auto labels = testing::label_values(*volume);
   conforming::InterfaceFigures figures;
   auto parted =
       conforming::label_interfaces(*volume, labels, net_interface_params(NetOptions{}), figures);

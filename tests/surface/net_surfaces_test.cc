@@ -593,12 +593,9 @@ TEST(NetSurfacesRealData, CrossingMovesAreTakenBack) {
   if (!std::filesystem::exists(path)) GTEST_SKIP() << "missing " << path;
   const auto volume = volume::read_label_volume(path, {}, {});
   ASSERT_THAT(volume, testing::IsOk());
-  std::vector<int32_t> labels;
-  for (const auto& label : volume::compute_label_statistics(*volume).labels)
-    labels.push_back(label.label);
   conforming::InterfaceFigures figures;
-  auto net =
-      conforming::label_interfaces(*volume, labels, net_interface_params(NetOptions{}), figures);
+  auto net = conforming::label_interfaces(*volume, testing::label_values(*volume),
+                                          net_interface_params(NetOptions{}), figures);
   const size_t moved = net.widened.size();
   EXPECT_EQ(moved, figures.widened_points);
   ASSERT_GT(moved, 100u);
