@@ -181,13 +181,32 @@ std::array<int64_t, 3> cube_around(std::array<int64_t, 3> p, int axis, std::arra
 
 constexpr std::array<std::array<int, 2>, 4> kQuadOffsets{{{1, 1}, {0, 1}, {0, 0}, {1, 0}}};
 
+// Whether a corner of padded cube (a, b, c) is one of `joined` (sorted
+// linear indices into the volume of `dims`).
+bool touches_joined(const PaddedLabels& labels, const std::array<int64_t, 3>& dims,
+                    const std::vector<uint64_t>& joined, int64_t a, int64_t b, int64_t c) {
+  if (joined.empty()) return false;
+  for (int k = 0; k < 8; ++k) {
+    const std::array<int64_t, 3> v{a + (k & 1) + labels.first[0],
+                                   b + ((k >> 1) & 1) + labels.first[1],
+                                   c + (k >> 2) + labels.first[2]};
+    if (v[0] < 0 || v[1] < 0 || v[2] < 0 || v[0] >= dims[0] || v[1] >= dims[1] || v[2] >= dims[2])
+      continue;
+    const auto index = static_cast<uint64_t>((v[2] * dims[1] + v[1]) * dims[0] + v[0]);
+    if (std::binary_search(joined.begin(), joined.end(), index)) return true;
+  }
+  return false;
+}
+
 // The net's points, one per cube whose corners hold more than one label,
 // numbered in cube index order.
-// With `split`, a point per sheet through the cube (cube_sheets.h), and
-// `small` (sorted) marks the points next to small labels.
+// With `split`, a point per sheet through the cube (cube_sheets.h), but one
+// in cubes with a corner among `joined` (touches_joined), and `small`
+// (sorted) marks the points next to small labels.
 Net net_points(const PaddedLabels& labels, const std::array<double, 3>& spacing,
                const std::vector<VoxelPair>& pairs, MarkedCubes& cubes, bool split,
-               const std::vector<int32_t>& small) {
+               const std::vector<int32_t>& small, const std::array<int64_t, 3>& dims,
+               const std::vector<uint64_t>& joined) {
   // A cube's corners hold more than one label exactly when one of its edges
   // joins two different labels, and every such edge's quad uses the four
   // cubes around it: mark those, then number them in index order.
@@ -215,7 +234,16 @@ Net net_points(const PaddedLabels& labels, const std::array<double, 3>& spacing,
       return;
     }
     net.first_point.push_back(static_cast<uint32_t>(net.centre.size()));
-    const CubeSheets sheets = cube_sheets(corners(labels, a, b, c));
+    const auto corner = corners(labels, a, b, c);
+    if (touches_joined(labels, dims, joined, a, b, c)) {
+      net.centre.push_back(centre);
+      net.label_count.push_back(distinct_labels(labels, a, b, c));
+      net.near_small.push_back(std::any_of(corner.begin(), corner.end(), [&](int32_t label) {
+        return std::binary_search(small.begin(), small.end(), label);
+      }));
+      return;
+    }
+    const CubeSheets sheets = cube_sheets(corner);
     for (int g = 0; g < sheets.sheet_count; ++g) {
       net.centre.push_back(centre);
       net.label_count.push_back(sheets.labels[g]);
@@ -701,7 +729,8 @@ InterfaceSurface label_interfaces(const volume::LabelVolume& volume,
     };
     const bool split = params.split_sheets && params.drawn_axis < 0;
     net = net_points(padded, geometry.spacing, pairs, cubes, split,
-                     split ? find_small() : std::vector<int32_t>{});
+                     split ? find_small() : std::vector<int32_t>{}, geometry.dims,
+                     params.joined_voxels);
     // On one point per cube the quads and the smoothing stencil only read
     // the numbered cubes and write apart: they are made side by side. The
     // quads' arrays are reserved here, so that they belong to this thread's

@@ -62,6 +62,9 @@ struct InterfaceParams {
   // A point per sheet through a cube (cube_sheets.h), so that two faces a
   // voxel apart can part; not on a grid cut into thinner slices.
   bool split_sheets = false;
+  // With split_sheets: voxels (linear indices into the volume, x fastest,
+  // sorted) whose cubes keep one point, where parted faces crossed.
+  std::vector<uint64_t> joined_voxels;
 };
 
 struct InterfaceFigures {

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <iterator>
 #include <memory>
 #include <optional>
 
@@ -11,6 +12,7 @@
 #include "absl/synchronization/mutex.h"
 #include "core/conforming/label_interfaces.h"
 #include "core/conforming/net_label_surface.h"
+#include "core/conforming/parted_crossings.h"
 #include "core/conforming/thick_slices.h"
 #include "core/conforming/widen_small_angles.h"
 #include "core/pipeline/label_surfaces.h"
@@ -102,7 +104,8 @@ struct LayerNet {
 absl::StatusOr<LayerNet> layer_net(const volume::LabelVolume& layer,
                                    const std::vector<int32_t>& here, const NetOptions& options,
                                    bool with_staircase, const RunContext& context,
-                                   std::vector<StageTiming>& stages, bool split_sheets = true) {
+                                   std::vector<StageTiming>& stages, bool split_sheets = true,
+                                   std::vector<uint64_t> joined_voxels = {}) {
   LayerNet made;
   conforming::InterfaceFigures figures;
   const auto cut = thick_slices(layer.geometry, options);
@@ -110,6 +113,7 @@ absl::StatusOr<LayerNet> layer_net(const volume::LabelVolume& layer,
     made.geometry = layer.geometry;
     auto params = interface_params(options);
     params.split_sheets = params.split_sheets && split_sheets;
+    params.joined_voxels = std::move(joined_voxels);
     made.net = conforming::label_interfaces(layer, here, params, figures);
     return made;
   }
@@ -473,24 +477,39 @@ void find_net_crossings(LabelNets& built, std::vector<StageTiming>& stages) {
     built.crossings[layer] = conforming::crossings_after_taking_back_slides(built.nets[layer]);
 }
 
-// Makes the nets whose parted faces cross again with one point per cube,
-// where faces a voxel apart share their points and cannot cross.
+// Makes the nets whose parted faces cross again with one point in the cubes
+// around the crossings, where faces a voxel apart share their points and
+// cannot cross; each round joins a wider neighbourhood. Where crossings
+// are left after the last round, the whole net keeps one point per cube.
 absl::Status join_crossing_faces(const std::vector<volume::LabelVolume>& layers,
                                  const MeshParams& params, const RunContext& context,
                                  LabelNets& built, std::vector<StageTiming>& stages) {
+  constexpr int kJoinRounds = 3;
   for (size_t layer = 0; layer < built.nets.size(); ++layer) {
-    if (crossings_between_labels(built.nets[layer], built.crossings[layer]) == 0) continue;
-    absl::StatusOr<LayerNet> made;
-    {
-      StageTimer timer(stages, "surface_net");
-      made = layer_net(layers[layer], built.layer_labels[layer], params.net,
-                       /*with_staircase=*/true, context, stages, /*split_sheets=*/false);
+    std::vector<uint64_t> joined;
+    for (int round = 0; round <= kJoinRounds; ++round) {
+      if (crossings_between_labels(built.nets[layer], built.crossings[layer]) == 0) break;
+      const bool split = round < kJoinRounds;
+      if (split) {
+        auto more = conforming::voxels_near_parted_crossings(
+            built.nets[layer], built.crossings[layer], layers[layer].geometry.dims, round + 1);
+        std::vector<uint64_t> all;
+        std::set_union(joined.begin(), joined.end(), more.begin(), more.end(),
+                       std::back_inserter(all));
+        joined = std::move(all);
+      }
+      absl::StatusOr<LayerNet> made;
+      {
+        StageTimer timer(stages, "surface_net");
+        made = layer_net(layers[layer], built.layer_labels[layer], params.net,
+                         /*with_staircase=*/true, context, stages, split, joined);
+      }
+      if (!made.ok()) return made.status();
+      built.nets[layer] = std::move(made->net);
+      built.staircases[layer] = std::move(made->staircase);
+      StageTimer timer(stages, "self_intersections");
+      built.crossings[layer] = conforming::crossings_after_taking_back_slides(built.nets[layer]);
     }
-    if (!made.ok()) return made.status();
-    built.nets[layer] = std::move(made->net);
-    built.staircases[layer] = std::move(made->staircase);
-    StageTimer timer(stages, "self_intersections");
-    built.crossings[layer] = conforming::crossings_after_taking_back_slides(built.nets[layer]);
   }
   return absl::OkStatus();
 }
@@ -499,14 +518,10 @@ absl::Status join_crossing_faces(const std::vector<volume::LabelVolume>& layers,
 
 size_t crossings_between_labels(const conforming::InterfaceSurface& net,
                                 const surface::TrianglePairs& crossings) {
-  size_t between = 0;
-  for (const auto& [a, b] : crossings) {
-    bool share = false;
-    for (const int32_t x : net.sides[a])
-      for (const int32_t y : net.sides[b]) share = share || (x == y && x != conforming::kOutside);
-    between += share ? 0 : 1;
-  }
-  return between;
+  return static_cast<size_t>(
+      std::count_if(crossings.begin(), crossings.end(), [&](const auto& pair) {
+        return conforming::shares_only_outside(net, pair.first, pair.second);
+      }));
 }
 
 absl::StatusOr<LabelNets> build_label_nets(const std::vector<volume::LabelVolume>& layers,

@@ -54,7 +54,8 @@ conforming::InterfaceParams net_interface_params(const NetOptions& options);
 // the outside: faces of two labels parted across a gap a voxel wide
 // (conforming/cube_sheets.h) that passed through each other, which no
 // label's own check sees. build_label_nets makes a net with such pairs
-// again with one point per cube.
+// again with one point in the cubes around them (one per cube everywhere
+// if pairs are still left).
 size_t crossings_between_labels(const conforming::InterfaceSurface& net,
                                 const surface::TrianglePairs& crossings);
 

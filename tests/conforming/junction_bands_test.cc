@@ -15,10 +15,12 @@
 #include "core/pipeline/label_net_surfaces.h"
 #include "core/pipeline/pipeline.h"
 #include "core/surface/crossing_triangles.h"
+#include "core/surface/surface_statistics.h"
 #include "core/util/vec3.h"
 #include "core/volume/phantom_grid.h"
 #include "core/volume/read_label_volume.h"
 #include "support/label_volumes.h"
+#include "support/mesh_results.h"
 #include "support/status_matchers.h"
 #include "support/test_files.h"
 
@@ -27,11 +29,7 @@ namespace {
 
 using geometry::Vec3;
 
-const SurfaceResult* output_of(const MeshResult& result, int32_t label) {
-  for (const auto& s : result.surfaces)
-    if (s.label == label && s.is_output) return &s;
-  return nullptr;
-}
+using testing::output_of;
 
 // A ball of radius 12 voxels on 3 mm voxels cut by an oblique gap one voxel
 // wide into labels 1 and 2, with a cube of label 3, `edge` voxels along each
@@ -201,9 +199,41 @@ TEST(JunctionBands, TouchingOrgansOnThreeMillimetresAreSmoothWhereTheyMeet) {
   EXPECT_TRUE(conforming::crossings_after_taking_back_slides(net).empty());
 }
 
+// Cubes with a corner among the joined voxels keep one point: all joined,
+// the net is the one with one point per cube; half joined, the gap's faces
+// part only in the other half, and stay closed surfaces there too.
+TEST(JunctionBands, JoinedVoxelsKeepOnePointInTheirCubes) {
+  const auto volume = ball_with_a_cube_across_its_gap(0);
+  auto params = net_interface_params(NetOptions{});
+  conforming::InterfaceFigures figures;
+  const size_t parted = conforming::label_interfaces(volume, {}, params, figures).points.size();
+  params.split_sheets = false;
+  const size_t one_per_cube =
+      conforming::label_interfaces(volume, {}, params, figures).points.size();
+  params.split_sheets = true;
+  const auto& d = volume.geometry.dims;
+  for (uint64_t i = 0; i < uint64_t(d[0] * d[1] * d[2]); ++i) params.joined_voxels.push_back(i);
+  EXPECT_EQ(conforming::label_interfaces(volume, {}, params, figures).points.size(), one_per_cube);
+  params.joined_voxels.clear();
+  for (int64_t z = 0; z < d[2] / 2; ++z)
+    for (int64_t y = 0; y < d[1]; ++y)
+      for (int64_t x = 0; x < d[0]; ++x) params.joined_voxels.push_back((z * d[1] + y) * d[0] + x);
+  const auto half = conforming::label_interfaces(volume, {}, params, figures);
+  EXPECT_GT(half.points.size(), one_per_cube + (parted - one_per_cube) / 4);
+  EXPECT_LT(half.points.size(), parted - (parted - one_per_cube) / 4);
+  EXPECT_TRUE(surface::crossing_triangles(half.points, half.triangles).empty());
+  for (const int32_t label : {1, 2}) {
+    const auto statistics = surface::compute_surface_statistics(
+        conforming::net_label_surface(half, label, volume.geometry).mesh);
+    EXPECT_TRUE(statistics.closed) << label;
+    EXPECT_TRUE(statistics.manifold) << label;
+  }
+}
+
 // On the frog a few faces parted across gaps pass through each other after
 // smoothing, which no label's own check would see: its net is made again
-// with one point per cube, where they cannot.
+// with one point in the cubes around them, where they cannot, and keeps its
+// parted points elsewhere.
 TEST(JunctionBands, PartedFacesThatCrossAreJoinedAgain) {
   LABELMESH_SKIP_WITHOUT_SHARED_DATA();
   const auto path = testing::shared_data("frogtissue.mhd");
@@ -212,15 +242,23 @@ TEST(JunctionBands, PartedFacesThatCrossAreJoinedAgain) {
   ASSERT_THAT(volume, testing::IsOk());
   const auto labels = testing::label_values(*volume);
   conforming::InterfaceFigures figures;
-  auto parted =
-      conforming::label_interfaces(*volume, labels, net_interface_params(NetOptions{}), figures);
+  auto params = net_interface_params(NetOptions{});
+  auto parted = conforming::label_interfaces(*volume, labels, params, figures);
   EXPECT_GT(
       crossings_between_labels(parted, conforming::crossings_after_taking_back_slides(parted)), 0u);
+  params.split_sheets = false;
+  const size_t one_per_cube =
+      conforming::label_interfaces(*volume, labels, params, figures).points.size();
+  ASSERT_GT(parted.points.size(), one_per_cube + 1000);
   std::vector<StageTiming> stages;
   auto nets = build_label_nets({*volume}, std::vector<size_t>(labels.size(), 0), labels,
                                MeshParams{}, {}, stages);
   ASSERT_THAT(nets, testing::IsOk());
   EXPECT_EQ(crossings_between_labels(nets->nets[0], nets->crossings[0]), 0u);
+  // Nearly all the parted points are kept.
+  const size_t kept = nets->nets[0].points.size() - one_per_cube;
+  EXPECT_GT(kept, 0.95 * double(parted.points.size() - one_per_cube))
+      << kept << " of " << parted.points.size() - one_per_cube;
 }
 
 }  // namespace

@@ -21,6 +21,7 @@
 #include "core/volume/phantom.h"
 #include "core/volume/thin_shapes.h"
 #include "core/volume/write_label_volume.h"
+#include "support/mesh_results.h"
 #include "support/status_matchers.h"
 #include "support/test_files.h"
 
@@ -43,12 +44,7 @@ std::string phantom_file(PhantomShape shape, const std::string& name) {
   return path;
 }
 
-const SurfaceResult* output_of(const MeshResult& result, int32_t label) {
-  for (const auto& s : result.surfaces) {
-    if (s.label == label && s.is_output) return &s;
-  }
-  return nullptr;
-}
+using testing::output_of;
 
 const LabelWarning* warning_for(const MeshResult& result, int32_t label) {
   for (const auto& w : result.warnings) {

@@ -17,6 +17,7 @@
 #include "core/surface/voxel_fidelity.h"
 #include "core/volume/read_label_volume.h"
 #include "support/analytic_shapes.h"
+#include "support/mesh_results.h"
 #include "support/status_matchers.h"
 #include "support/test_files.h"
 
@@ -55,11 +56,7 @@ volume::LabelVolume finer_pixels(const volume::LabelVolume& drawn, double pitch)
   return fine;
 }
 
-const SurfaceResult* output_of(const MeshResult& result, int32_t label) {
-  for (const auto& s : result.surfaces)
-    if (s.label == label && s.is_output) return &s;
-  return nullptr;
-}
+using testing::output_of;
 
 TEST(DrawnGridPipeline, AnEllipsoidDrawnOnThreeMillimetresIsSmoothOnFinerPixels) {
   const auto shape = testing::ellipsoid_shape(24, 17, 13);

@@ -31,6 +31,7 @@
 #include "support/analytic_shapes.h"
 #include "support/label_grid.h"
 #include "support/label_volumes.h"
+#include "support/mesh_results.h"
 #include "support/organs_on_slices.h"
 #include "support/slicer_like.h"
 #include "support/status_matchers.h"
@@ -161,11 +162,7 @@ TEST(VoxelFidelity, AxisAlignedShareOfAStaircaseAndOfABall) {
   EXPECT_LT(surface::axis_aligned_share(net.mesh, v.geometry), 0.15);
 }
 
-const SurfaceResult* output_of(const MeshResult& result, int32_t label) {
-  for (const auto& s : result.surfaces)
-    if (s.label == label && s.is_output) return &s;
-  return nullptr;
-}
+using testing::output_of;
 
 // Label 1 of `v` by our default pipeline and by the Slicer-like one.
 struct BothSurfaces {
