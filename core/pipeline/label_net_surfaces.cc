@@ -485,11 +485,15 @@ absl::Status join_crossing_faces(const std::vector<volume::LabelVolume>& layers,
                                  const MeshParams& params, const RunContext& context,
                                  LabelNets& built, std::vector<StageTiming>& stages) {
   constexpr int kJoinRounds = 3;
+  // Beyond this many pairs the whole net is joined at once: the voxels
+  // around them would cost more memory than the parting is worth.
+  constexpr size_t kMostPairsJoinedLocally = 4096;
   for (size_t layer = 0; layer < built.nets.size(); ++layer) {
     std::vector<uint64_t> joined;
     for (int round = 0; round <= kJoinRounds; ++round) {
-      if (crossings_between_labels(built.nets[layer], built.crossings[layer]) == 0) break;
-      const bool split = round < kJoinRounds;
+      const size_t pairs = crossings_between_labels(built.nets[layer], built.crossings[layer]);
+      if (pairs == 0) break;
+      const bool split = round < kJoinRounds && pairs <= kMostPairsJoinedLocally;
       if (split) {
         auto more = conforming::voxels_near_parted_crossings(
             built.nets[layer], built.crossings[layer], layers[layer].geometry.dims, round + 1);
@@ -509,6 +513,7 @@ absl::Status join_crossing_faces(const std::vector<volume::LabelVolume>& layers,
       built.staircases[layer] = std::move(made->staircase);
       StageTimer timer(stages, "self_intersections");
       built.crossings[layer] = conforming::crossings_after_taking_back_slides(built.nets[layer]);
+      if (!split) break;
     }
   }
   return absl::OkStatus();
