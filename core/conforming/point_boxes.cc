@@ -21,6 +21,17 @@ Vec3 PointBoxes::hold(size_t point, const Vec3& centre, Vec3 p) const {
     p[k] = std::clamp(p[k], std::max(centre[k] - width[k], edge_low[k]),
                       std::min(centre[k] + width[k], edge_high[k]));
   }
+  // Across the drawn axis never past a drawn slice beyond the cube's own
+  // box: a point carried onto a drawn slice from a thin slice beside it
+  // brings that slice's contour, and the surface there then passes the
+  // drawn voxel centres it should keep to one side.
+  if (drawn_axis >= 0) {
+    const int a = drawn_axis;
+    const auto slices = [&](double place) { return (place - drawn_first) / drawn_spacing; };
+    const double below = drawn_first + std::floor(slices(centre[a] - thin_half)) * drawn_spacing;
+    const double above = drawn_first + std::ceil(slices(centre[a] + thin_half)) * drawn_spacing;
+    p[a] = std::clamp(p[a], below, above);
+  }
   return p;
 }
 
@@ -59,6 +70,7 @@ PointBoxes point_boxes(const volume::ImageGeometry& geometry, const InterfacePar
   // Thin slice j's centre lies at j times its spacing; drawn slice k's at
   // thin slice (k + 1/2) parts - 1/2.
   boxes.drawn_first = 0.5 * (boxes.drawn_spacing - spacing[a]);
+  boxes.thin_half = 0.5 * params.cube_fraction * spacing[a];
   for (int k = 0; k < 3; ++k)
     if (k != a) boxes.widening[k] = params.between_drawn_widening * spacing[k];
   return boxes;

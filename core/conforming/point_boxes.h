@@ -25,6 +25,7 @@ struct PointBoxes {
   int drawn_axis = -1;               // -1: every box is fixed
   double drawn_spacing = 0;          // mm between drawn slices
   double drawn_first = 0;            // a drawn slice's place along the axis, mm
+  double thin_half = 0;              // a thin cube's own half box across it, mm
   geometry::Vec3 widening{0, 0, 0};  // mm midway between drawn slices; 0 along the axis
   // Points whose boxes never widen (where three labels or more meet): a
   // junction curve held to its pixels keeps its points apart.

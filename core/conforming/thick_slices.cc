@@ -20,7 +20,7 @@ namespace {
 
 constexpr float kFar = std::numeric_limits<float>::max();
 // Rounds of tuning each label's bias to its volume.
-constexpr int kBiasRounds = 4;
+constexpr int kBiasRounds = 6;
 // The signed distances' clamp, in slices.
 constexpr float kBandSlices = 2;
 // Slice distances kept between rounds: at most 256 MiB of them.
@@ -144,7 +144,14 @@ class SliceInterpolator {
         // moves more than a slice's thickness from slice to slice) into
         // terraces half way, and a label's last slice into a plateau with a
         // step at its rim.
-        band_(static_cast<float>(kBandSlices * volume.geometry.spacing[cut.axis])) {
+        band_(static_cast<float>(kBandSlices * volume.geometry.spacing[cut.axis])),
+        // The contour runs between pixel centres, half a pixel from each:
+        // distances between centres less this are distances to the contour.
+        // Without it no distance lay within half a pixel of the contour, and
+        // between slices a wall stayed on each slice's contour for that much
+        // before moving on, a stair of the thick slices left in the slope.
+        edge_(static_cast<float>(0.5 * std::min(volume.geometry.spacing[(cut.axis + 1) % 3],
+                                                volume.geometry.spacing[(cut.axis + 2) % 3]))) {
     const auto all = selected_labels(volume, labels);
     present_ = all;
     std::sort(present_.begin(), present_.end());
@@ -361,7 +368,8 @@ class SliceInterpolator {
       const auto to_outside = distance_to(outside, nu, nv, su, sv);
       std::vector<float> d(inside.size());
       for (size_t p = 0; p < d.size(); ++p) {
-        d[p] = inside[p] ? std::min(to_outside[p], band_) : -std::min(to_inside[p], band_);
+        d[p] = inside[p] ? std::min(to_outside[p] - edge_, band_)
+                         : -std::min(to_inside[p] - edge_, band_);
       }
       distances.push_back(std::move(d));
     }
@@ -372,6 +380,7 @@ class SliceInterpolator {
   const ThickSlices cut_;
   const int a_, u_, v_;
   const float band_;
+  const float edge_;
   // The selected labels' box (crop_to_labels), and each of its voxels'
   // label as its place in present_, so the fill weighs labels by place.
   std::array<int64_t, 3> lo_{0, 0, 0}, dims_{0, 0, 0};
@@ -444,6 +453,14 @@ absl::StatusOr<volume::LabelVolume> interpolate_thick_slices(const volume::Label
   const double band = geometry.spacing[cut.axis];
   const double taper = interpolator.mean_taper();
   std::vector<double> bias(present.size(), 0), best_bias;
+  struct Tried {
+    bool tried = false;
+    double bias = 0;
+    uint64_t count = 0;
+  };
+  std::vector<Tried> short_of(present.size()), past(present.size());
+  std::vector<double> last_bias(present.size(), 0);
+  std::vector<uint64_t> last_counts(present.size(), 0);
   double best_error = std::numeric_limits<double>::infinity();
   std::vector<uint64_t> counts, boundary;
   for (int round = 0;; ++round) {
@@ -465,9 +482,31 @@ absl::StatusOr<volume::LabelVolume> interpolate_thick_slices(const volume::Label
     }
     for (size_t l = 0; l < present.size(); ++l) {
       const double missing = double(target[l]) - double(counts[l]);
-      const double change = boundary[l] > 0 ? missing * step / (taper * double(boundary[l]))
-                            : missing > 0   ? band / 2
-                                            : 0;
+      double change = boundary[l] > 0 ? missing * step / (taper * double(boundary[l]))
+                      : missing > 0   ? band / 2
+                                      : 0;
+      // The estimate above undershoots where the bias acts on few thin
+      // slices: after a first round, the voxels a millimetre of bias gained
+      // there say how far to go; once biases short of the volume and past
+      // it are known, the next lies between the nearest two, where a
+      // straight line through them meets the volume (thin voxels flip ring
+      // by ring, and a line through the last two may overshoot).
+      Tried& under = short_of[l];
+      Tried& over = past[l];
+      if (missing > 0 && (!under.tried || bias[l] > under.bias)) under = {true, bias[l], counts[l]};
+      if (missing < 0 && (!over.tried || bias[l] < over.bias)) over = {true, bias[l], counts[l]};
+      if (round > 0 && bias[l] != last_bias[l] && counts[l] != last_counts[l]) {
+        const double gained =
+            (double(counts[l]) - double(last_counts[l])) / (bias[l] - last_bias[l]);
+        if (gained > 0) change = missing / gained;
+      }
+      last_bias[l] = bias[l];
+      last_counts[l] = counts[l];
+      if (under.tried && over.tried && over.count > under.count) {
+        change = under.bias - bias[l] +
+                 (over.bias - under.bias) * (double(target[l]) - double(under.count)) /
+                     (double(over.count) - double(under.count));
+      }
       bias[l] = std::clamp(bias[l] + std::clamp(change, -band / 2, band / 2), -band, band);
     }
   }

@@ -60,6 +60,22 @@ TEST(PointBoxes, MidwayBetweenDrawnSlicesTheBoxIsWiderAcrossOnly) {
   EXPECT_DOUBLE_EQ(far_along[0], 5.475);
 }
 
+// Along the cut axis a point stays between the drawn slices around its
+// cube's own box: one carried onto a drawn slice from beside it would bring
+// another slice's contour there.
+TEST(PointBoxes, APointNeverCrossesADrawnSliceItsCubeDoesNotReach) {
+  auto boxes = thirds();
+  boxes.thin_half = 0.475;
+  // Cube centre z = 4.5, half a thin slice above the drawn slice z = 4: its
+  // box along z reaches 3.075, but it stops at 4; upwards it reaches 5.925.
+  EXPECT_DOUBLE_EQ(boxes.hold(0, {5, 5, 4.5}, {5, 5, 3.2})[2], 4.0);
+  EXPECT_DOUBLE_EQ(boxes.hold(0, {5, 5, 4.5}, {5, 5, 6.5})[2], 5.925);
+  // A cube centred on a drawn slice reaches it: its point may leave it
+  // either way, as far as its box.
+  EXPECT_DOUBLE_EQ(boxes.hold(0, {5, 5, 4}, {5, 5, 2})[2], 2.575);
+  EXPECT_DOUBLE_EQ(boxes.hold(0, {5, 5, 4}, {5, 5, 6})[2], 5.425);
+}
+
 TEST(PointBoxes, NarrowPointsNeverWiden) {
   auto boxes = thirds();
   boxes.narrow = {false, true};

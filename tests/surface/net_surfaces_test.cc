@@ -355,6 +355,9 @@ TEST(NetSurfaces, ThickSliceShapesAreTruerThanTheSlicerLikePipeline) {
     EXPECT_LT(mine.normal_p95_deg, theirs.normal_p95_deg) << shape.name;
     // Within a fifth of the largest spacing of the true surface.
     EXPECT_LT(mine.rms_mm, 0.2 * spacing[2]) << shape.name;
+    // On 4 mm slices the walls slope evenly between slices (their normals'
+    // 95th percentile was 14-17 degrees while the thin slices kept a stair).
+    if (spacing[2] == 4) EXPECT_LT(mine.normal_p95_deg, 11) << shape.name;
   }
 }
 
@@ -393,15 +396,14 @@ TEST(NetSurfaces, ThinRingsOnThickSlicesKeepTheNet) {
     std::array<double, 3> spacing;
     std::string stage;
   };
-  // The thin tube on 3 mm slices, and the thicker ring on 4 mm slices where
-  // its top and bottom skim the drawn slices, put 1-1.5 % of their boundary
-  // voxel centres, a hundredth of a voxel from the surface, on the wrong
-  // side with the full smoothing: the net smoothed half as much is
-  // delivered.
-  const std::vector<Case> cases{
-      {testing::torus_shape(25, 4.5, "thin tube"), {0.6, 0.6, 4}, "net"},
-      {testing::torus_shape(25, 9), {0.6, 0.6, 4}, "net_lighter"},
-      {testing::torus_shape(25, 4.5, "thin tube"), {1, 1, 3}, "net_lighter"}};
+  // Points held between the drawn slices around their cubes keep the drawn
+  // voxel centres on their side: the full smoothing is delivered (carried
+  // onto a drawn slice from beside it, points put 1-3 % of these rings'
+  // boundary voxel centres on the wrong side, and the net smoothed half as
+  // much, or the mask, was delivered).
+  const std::vector<Case> cases{{testing::torus_shape(25, 4.5, "thin tube"), {0.6, 0.6, 4}, "net"},
+                                {testing::torus_shape(25, 9), {0.6, 0.6, 4}, "net"},
+                                {testing::torus_shape(25, 4.5, "thin tube"), {1, 1, 3}, "net"}};
   for (const auto& [shape, spacing, stage] : cases) {
     const std::string name = shape.name + " on " + std::to_string(spacing[2]) + " mm";
     const auto both = both_surfaces(testing::sample_shape(shape, spacing));
@@ -492,16 +494,18 @@ TEST(NetSurfaces, OrgansOnThreeThickSlicesKeepTheirAngles) {
   EXPECT_EQ(within, 5u);
 }
 
-// A thin tube on an oblique grid of 3 mm slices: the full smoothing takes it
-// outside the voxel tolerance, and the guard tries the net smoothed half as
-// much before the meshed mask; that one is within the tolerance, closed, and
-// truer than the Slicer-like surface.
-TEST(NetSurfaces, AnObliqueThinTubeTakesTheLighterNet) {
-  const auto tube = testing::torus_shape(25, 4.5, "thin tube");
-  const auto both = both_surfaces(testing::sample_shape(tube, {1, 1, 3}, 25));
-  ASSERT_EQ(both.slicer.size(), 1u);
-  ASSERT_THAT(both.result, testing::IsOk());
-  const auto* ours = both.ours();
+// The guard's ladder when the full smoothing fails: with Taubin steps that
+// inflate more than they shrink, the net bulges past the voxels of a ring on
+// 1 x 1 x 3 mm slices, and the guard tries the net smoothed half as much
+// before the meshed mask; that one is within the tolerance and closed, and
+// the delivered attempt exceeds the tolerance least.
+TEST(NetSurfaces, ANetSmoothedPastTheVoxelsFallsBackToTheLighterNet) {
+  const auto ring = testing::torus_shape(25, 9);
+  MeshParams params;
+  params.net.inflate_step = -0.6;
+  auto result = run_pipeline_on_volume(testing::sample_shape(ring, {1, 1, 3}), params, {});
+  ASSERT_THAT(result, testing::IsOk());
+  const auto* ours = output_of(*result, 1);
   ASSERT_NE(ours, nullptr);
   const auto& fidelity = *ours->fidelity;
   ASSERT_GE(fidelity.attempts.size(), 2u);
@@ -516,9 +520,6 @@ TEST(NetSurfaces, AnObliqueThinTubeTakesTheLighterNet) {
   EXPECT_TRUE(ours->statistics.closed);
   EXPECT_TRUE(ours->statistics.manifold);
   EXPECT_EQ(ours->self_intersections, uint64_t{0});
-  const auto mine = testing::shape_error(ours->mesh, tube);
-  const auto theirs = testing::shape_error(both.slicer.front().mesh, tube);
-  EXPECT_LT(mine.rms_mm, theirs.rms_mm);
 }
 
 TEST(NetSurfaces, CoarseIsotropicSphereIsWithinAQuarterVoxel) {
