@@ -89,11 +89,12 @@ void smooth_in_boxes(const Stencil& stencil, const std::vector<Vec3>& centre,
           if (axes & (1u << k)) moved[k] = box[p][k];
       }
       Lanes width = half;
-      if (drawn >= 0 && point_boxes.widens(p)) {
+      if (drawn >= 0) {
         // Along the drawn axis first: the width across follows from there.
-        const float along =
-            std::clamp(moved[drawn], box[p][drawn] - half[drawn], box[p][drawn] + half[drawn]);
-        width += between_drawn(along, drawn_first, drawn_spacing) * widening;
+        const auto [low, high] = point_boxes.along_drawn(box[p][drawn]);
+        moved[drawn] = std::clamp(moved[drawn], low, high);
+        if (point_boxes.widens(p))
+          width += between_drawn(moved[drawn], drawn_first, drawn_spacing) * widening;
       }
       Lanes lo = box[p] - width, hi = box[p] + width;
       lo = lo < edge_low ? edge_low : lo;

@@ -11,26 +11,19 @@ Vec3 PointBoxes::hold(size_t point, const Vec3& centre, Vec3 p) const {
   for (int k = 0; k < 3; ++k)
     if (axes & (1u << k)) p[k] = centre[k];
   Vec3 width = half;
-  if (widens(point)) {
+  if (drawn_axis >= 0) {
+    // Along the drawn axis first: the width across follows from there.
     const int a = drawn_axis;
-    p[a] = std::clamp(p[a], centre[a] - half[a], centre[a] + half[a]);
-    const double between = between_drawn(p[a], drawn_first, drawn_spacing);
-    for (int k = 0; k < 3; ++k) width[k] += between * widening[k];
+    const auto [low, high] = along_drawn(centre[a]);
+    p[a] = std::clamp(p[a], low, high);
+    if (widens(point)) {
+      const double between = between_drawn(p[a], drawn_first, drawn_spacing);
+      for (int k = 0; k < 3; ++k) width[k] += between * widening[k];
+    }
   }
   for (int k = 0; k < 3; ++k) {
     p[k] = std::clamp(p[k], std::max(centre[k] - width[k], edge_low[k]),
                       std::min(centre[k] + width[k], edge_high[k]));
-  }
-  // Across the drawn axis never past a drawn slice beyond the cube's own
-  // box: a point carried onto a drawn slice from a thin slice beside it
-  // brings that slice's contour, and the surface there then passes the
-  // drawn voxel centres it should keep to one side.
-  if (drawn_axis >= 0) {
-    const int a = drawn_axis;
-    const auto slices = [&](double place) { return (place - drawn_first) / drawn_spacing; };
-    const double below = drawn_first + std::floor(slices(centre[a] - thin_half)) * drawn_spacing;
-    const double above = drawn_first + std::ceil(slices(centre[a] + thin_half)) * drawn_spacing;
-    p[a] = std::clamp(p[a], below, above);
   }
   return p;
 }
@@ -64,7 +57,7 @@ PointBoxes point_boxes(const volume::ImageGeometry& geometry, const InterfacePar
   for (int k = 0; k < 3; ++k)
     boxes.half[k] = 0.5 * params.cube_fraction * spacing[k] * params.box_scale[k];
   const int a = params.drawn_axis;
-  if (a < 0 || params.drawn_parts < 2 || params.between_drawn_widening <= 0) return boxes;
+  if (a < 0 || params.drawn_parts < 2) return boxes;
   boxes.drawn_axis = a;
   boxes.drawn_spacing = spacing[a] * params.drawn_parts;
   // Thin slice j's centre lies at j times its spacing; drawn slice k's at
@@ -72,7 +65,7 @@ PointBoxes point_boxes(const volume::ImageGeometry& geometry, const InterfacePar
   boxes.drawn_first = 0.5 * (boxes.drawn_spacing - spacing[a]);
   boxes.thin_half = 0.5 * params.cube_fraction * spacing[a];
   for (int k = 0; k < 3; ++k)
-    if (k != a) boxes.widening[k] = params.between_drawn_widening * spacing[k];
+    if (k != a) boxes.widening[k] = std::max(0.0, params.between_drawn_widening) * spacing[k];
   return boxes;
 }
 

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -19,13 +20,14 @@ namespace labelmesh::conforming {
 // Where each point may lie: within `half` of its centre along each axis,
 // and across a drawn axis up to `widening` more, growing with the point's
 // distance from the nearest drawn slice (between_drawn below;
-// InterfaceParams::between_drawn_widening).
+// InterfaceParams::between_drawn_widening). Along a drawn axis a point never
+// passes a drawn slice beyond its cube's own box (along_drawn).
 struct PointBoxes {
   geometry::Vec3 half{0, 0, 0};
   int drawn_axis = -1;               // -1: every box is fixed
   double drawn_spacing = 0;          // mm between drawn slices
   double drawn_first = 0;            // a drawn slice's place along the axis, mm
-  double thin_half = 0;              // a thin cube's own half box across it, mm
+  double thin_half = 0;              // a thin cube's own half box along it, mm
   geometry::Vec3 widening{0, 0, 0};  // mm midway between drawn slices; 0 along the axis
   // Points whose boxes never widen (where three labels or more meet): a
   // junction curve held to its pixels keeps its points apart.
@@ -38,6 +40,22 @@ struct PointBoxes {
   // past them, whatever its box.
   geometry::Vec3 edge_low{-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
   geometry::Vec3 edge_high{HUGE_VAL, HUGE_VAL, HUGE_VAL};
+
+  // Along the drawn axis, where a point whose cube's centre lies at
+  // `centre` (mm) may go: within its box, and never past a drawn slice
+  // beyond the cube's own box. Carried onto a drawn slice from a thin slice
+  // beside it, a point would bring that slice's contour past the drawn
+  // voxel centres there. Only with drawn_axis >= 0.
+  template <typename Real>
+  std::array<Real, 2> along_drawn(Real centre) const {
+    const auto spacing = static_cast<Real>(drawn_spacing);
+    const auto first = static_cast<Real>(drawn_first);
+    const auto own = static_cast<Real>(thin_half);
+    const auto box = static_cast<Real>(half[drawn_axis]);
+    const Real below = first + std::floor((centre - own - first) / spacing) * spacing;
+    const Real above = first + std::ceil((centre + own - first) / spacing) * spacing;
+    return {std::max(centre - box, below), std::min(centre + box, above)};
+  }
 
   bool widens(size_t point) const {
     return drawn_axis >= 0 && (point >= narrow.size() || !narrow[point]);

@@ -145,11 +145,12 @@ class SliceInterpolator {
         // terraces half way, and a label's last slice into a plateau with a
         // step at its rim.
         band_(static_cast<float>(kBandSlices * volume.geometry.spacing[cut.axis])),
-        // The contour runs between pixel centres, half a pixel from each:
-        // distances between centres less this are distances to the contour.
-        // Without it no distance lay within half a pixel of the contour, and
-        // between slices a wall stayed on each slice's contour for that much
-        // before moving on, a stair of the thick slices left in the slope.
+        // The contour runs between pixel centres, half a pixel from each
+        // (half the smaller spacing where pixels are not square): distances
+        // between centres less this are distances to the contour. Without
+        // it no distance would lie within half a pixel of the contour, and
+        // between slices a wall would stay on each slice's contour for that
+        // much before moving on, a stair of the thick slices in its slope.
         edge_(static_cast<float>(0.5 * std::min(volume.geometry.spacing[(cut.axis + 1) % 3],
                                                 volume.geometry.spacing[(cut.axis + 2) % 3]))) {
     const auto all = selected_labels(volume, labels);
@@ -502,7 +503,7 @@ absl::StatusOr<volume::LabelVolume> interpolate_thick_slices(const volume::Label
       }
       last_bias[l] = bias[l];
       last_counts[l] = counts[l];
-      if (under.tried && over.tried && over.count > under.count) {
+      if (missing != 0 && under.tried && over.tried && over.count > under.count) {
         change = under.bias - bias[l] +
                  (over.bias - under.bias) * (double(target[l]) - double(under.count)) /
                      (double(over.count) - double(under.count));

@@ -100,7 +100,9 @@ struct LayerNet {
   std::optional<conforming::InterfaceSurface> staircase;
 };
 
-// With `split_sheets` false, one point per cube throughout.
+// With `split_sheets` false, one point per cube throughout; with
+// `joined_voxels`, one in the cubes with a corner among them. A net made on
+// thinner slices always has one point per cube.
 absl::StatusOr<LayerNet> layer_net(const volume::LabelVolume& layer,
                                    const std::vector<int32_t>& here, const NetOptions& options,
                                    bool with_staircase, const RunContext& context,
@@ -151,7 +153,14 @@ struct LighterNet {
 // labels on other threads wait for it.
 class LighterNets {
  public:
-  explicit LighterNets(size_t layers) : built_(layers) {}
+  explicit LighterNets(size_t layers) : built_(layers), parting_(layers) {}
+
+  // The layer's lighter net parts its faces as its full net does: one point
+  // per cube when `split` is false, else one in the cubes around `joined`.
+  void part_as(size_t layer, bool split, std::vector<uint64_t> joined) {
+    absl::MutexLock lock(&mutex_);
+    parting_[layer] = {split, std::move(joined)};
+  }
 
   absl::StatusOr<const LighterNet*> get(size_t layer, const volume::LabelVolume& volume,
                                         const std::vector<int32_t>& here, NetOptions options,
@@ -164,7 +173,8 @@ class LighterNets {
     {
       StageTimer timer(stages, "surface_net");
       // The staircase is the full net's: the same voxels.
-      made = layer_net(volume, here, options, /*with_staircase=*/false, context, stages);
+      made = layer_net(volume, here, options, /*with_staircase=*/false, context, stages,
+                       parting_[layer].split, parting_[layer].joined);
     }
     if (!made.ok()) return made.status();
     auto lighter = std::make_unique<LighterNet>();
@@ -181,6 +191,11 @@ class LighterNets {
   // Held while a net is built: the labels that want it wait for it.
   absl::Mutex mutex_;
   std::vector<std::unique_ptr<LighterNet>> built_ ABSL_GUARDED_BY(mutex_);
+  struct Parting {
+    bool split = true;
+    std::vector<uint64_t> joined;
+  };
+  std::vector<Parting> parting_ ABSL_GUARDED_BY(mutex_);
 };
 
 namespace {
@@ -489,8 +504,11 @@ absl::Status join_crossing_faces(const std::vector<volume::LabelVolume>& layers,
   // around them would cost more memory than the parting is worth.
   constexpr size_t kMostPairsJoinedLocally = 4096;
   for (size_t layer = 0; layer < built.nets.size(); ++layer) {
+    // A net on thinner slices has no parted faces to join.
+    if (thick_slices(layers[layer].geometry, params.net).axis >= 0) continue;
     std::vector<uint64_t> joined;
     for (int round = 0; round <= kJoinRounds; ++round) {
+      LABELMESH_RETURN_IF_ERROR(context.check_stop());
       const size_t pairs = crossings_between_labels(built.nets[layer], built.crossings[layer]);
       if (pairs == 0) break;
       const bool split = round < kJoinRounds && pairs <= kMostPairsJoinedLocally;
@@ -513,6 +531,7 @@ absl::Status join_crossing_faces(const std::vector<volume::LabelVolume>& layers,
       built.staircases[layer] = std::move(made->staircase);
       StageTimer timer(stages, "self_intersections");
       built.crossings[layer] = conforming::crossings_after_taking_back_slides(built.nets[layer]);
+      built.lighter->part_as(layer, split, joined);
       if (!split) break;
     }
   }

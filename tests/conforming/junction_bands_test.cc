@@ -222,6 +222,20 @@ TEST(JunctionBands, JoinedVoxelsKeepOnePointInTheirCubes) {
   EXPECT_GT(half.points.size(), one_per_cube + (parted - one_per_cube) / 4);
   EXPECT_LT(half.points.size(), parted - (parted - one_per_cube) / 4);
   EXPECT_TRUE(surface::crossing_triangles(half.points, half.triangles).empty());
+  // The gap leans the same way along x and y, and another way along z:
+  // joining the quarter below along x or y gives as many points, along z
+  // not.
+  const auto joined_below = [&](int axis) {
+    params.joined_voxels.clear();
+    for (int64_t z = 0; z < d[2]; ++z)
+      for (int64_t y = 0; y < d[1]; ++y)
+        for (int64_t x = 0; x < d[0]; ++x)
+          if (std::array<int64_t, 3>{x, y, z}[axis] < d[axis] / 4)
+            params.joined_voxels.push_back((z * d[1] + y) * d[0] + x);
+    return conforming::label_interfaces(volume, {}, params, figures).points.size();
+  };
+  EXPECT_EQ(joined_below(0), joined_below(1));
+  EXPECT_NE(joined_below(0), joined_below(2));
   for (const int32_t label : {1, 2}) {
     const auto statistics = surface::compute_surface_statistics(
         conforming::net_label_surface(half, label, volume.geometry).mesh);

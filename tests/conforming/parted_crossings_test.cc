@@ -10,19 +10,20 @@ namespace labelmesh::conforming {
 namespace {
 
 // Three triangles in a padded box of 6 x 5 x 4 voxels starting at volume
-// index (-1, -1, -1): label 1 against the outside, label 2 against the
+// index (-1, 2, 0): label 1 against the outside, label 2 against the
 // outside, label 1 against label 2. Only their sides and side voxels matter.
 InterfaceSurface three_faces() {
   InterfaceSurface net;
   net.padded_dims = {6, 5, 4};
-  net.padded_first = {-1, -1, -1};
+  net.padded_first = {-1, 2, 0};
+  // Volume voxel (x, y, z) as a linear index into the padded box.
   const auto padded = [&](int64_t x, int64_t y, int64_t z) {
-    return static_cast<uint64_t>(((z + 1) * 5 + (y + 1)) * 6 + (x + 1));
+    return static_cast<uint64_t>((z * 5 + (y - 2)) * 6 + (x + 1));
   };
   net.sides = {{1, kOutside}, {kOutside, 2}, {1, 2}};
-  net.side_voxels = {{padded(1, 1, 1), padded(2, 1, 1)},
-                     {padded(2, 1, 1), padded(3, 1, 1)},
-                     {padded(0, 0, 0), padded(0, 0, 1)}};
+  net.side_voxels = {{padded(1, 3, 1), padded(2, 3, 1)},
+                     {padded(2, 3, 1), padded(2, 4, 2)},
+                     {padded(0, 2, 0), padded(0, 2, 1)}};
   return net;
 }
 
@@ -35,20 +36,26 @@ TEST(PartedCrossings, OnlyPairsSharingTheOutsideAloneCount) {
 
 TEST(PartedCrossings, VoxelsAroundTheCrossingFacesWithinTheVolume) {
   const auto net = three_faces();
-  const std::array<int64_t, 3> dims{4, 3, 2};
+  const std::array<int64_t, 3> dims{8, 7, 6};
   const auto index = [&](int64_t x, int64_t y, int64_t z) {
     return static_cast<uint64_t>((z * dims[1] + y) * dims[0] + x);
   };
   // Reach 0: the three distinct side voxels of triangles 0 and 1.
   EXPECT_EQ(voxels_near_parted_crossings(net, {{0, 1}}, dims, 0),
-            (std::vector<uint64_t>{index(1, 1, 1), index(2, 1, 1), index(3, 1, 1)}));
+            (std::vector<uint64_t>{index(1, 3, 1), index(2, 3, 1), index(2, 4, 2)}));
   // A pair that shares a label adds nothing.
   EXPECT_TRUE(voxels_near_parted_crossings(net, {{0, 2}}, dims, 1).empty());
-  // Reach 1 from x = 1..3 at y = 1, z = 1: x 0..3, y 0..2, z 0..1, clipped
-  // to the volume: all 24 of its voxels.
-  const auto around = voxels_near_parted_crossings(net, {{0, 1}}, dims, 1);
-  EXPECT_EQ(around.size(), 24u);
-  EXPECT_TRUE(std::is_sorted(around.begin(), around.end()));
+  // Reach 1: the voxels of the 3 x 3 x 3 cubes around those three.
+  std::vector<uint64_t> expected;
+  for (const auto& [x, y, z] : std::vector<std::array<int64_t, 3>>{{1, 3, 1}, {2, 3, 1}, {2, 4, 2}})
+    for (int64_t k = z - 1; k <= z + 1; ++k)
+      for (int64_t j = y - 1; j <= y + 1; ++j)
+        for (int64_t i = x - 1; i <= x + 1; ++i) expected.push_back(index(i, j, k));
+  std::sort(expected.begin(), expected.end());
+  expected.erase(std::unique(expected.begin(), expected.end()), expected.end());
+  EXPECT_EQ(voxels_near_parted_crossings(net, {{0, 1}}, dims, 1), expected);
+  // Clipped to a volume of 2 x 4 x 2 voxels: the 8 at x 0..1, y 2..3.
+  EXPECT_EQ(voxels_near_parted_crossings(net, {{0, 1}}, {2, 4, 2}, 1).size(), 2u * 2u * 2u);
 }
 
 }  // namespace

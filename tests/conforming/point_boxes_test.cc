@@ -21,6 +21,7 @@ PointBoxes thirds() {
   boxes.drawn_spacing = 3;
   boxes.drawn_first = 1;
   boxes.widening = {0.5, 0.5, 0};
+  boxes.thin_half = 0.475;
   return boxes;
 }
 
@@ -64,8 +65,7 @@ TEST(PointBoxes, MidwayBetweenDrawnSlicesTheBoxIsWiderAcrossOnly) {
 // cube's own box: one carried onto a drawn slice from beside it would bring
 // another slice's contour there.
 TEST(PointBoxes, APointNeverCrossesADrawnSliceItsCubeDoesNotReach) {
-  auto boxes = thirds();
-  boxes.thin_half = 0.475;
+  const auto boxes = thirds();
   // Cube centre z = 4.5, half a thin slice above the drawn slice z = 4: its
   // box along z reaches 3.075, but it stops at 4; upwards it reaches 5.925.
   EXPECT_DOUBLE_EQ(boxes.hold(0, {5, 5, 4.5}, {5, 5, 3.2})[2], 4.0);
@@ -74,6 +74,36 @@ TEST(PointBoxes, APointNeverCrossesADrawnSliceItsCubeDoesNotReach) {
   // either way, as far as its box.
   EXPECT_DOUBLE_EQ(boxes.hold(0, {5, 5, 4}, {5, 5, 2})[2], 2.575);
   EXPECT_DOUBLE_EQ(boxes.hold(0, {5, 5, 4}, {5, 5, 6})[2], 5.425);
+  // Stopped on the drawn slice, the point's box across is the drawn
+  // slice's, not the one where it was headed.
+  const Vec3 stopped = boxes.hold(0, {5, 5, 4.5}, {7, 3, 3.2});
+  EXPECT_DOUBLE_EQ(stopped[2], 4.0);
+  EXPECT_DOUBLE_EQ(stopped[0], 5.475);
+  EXPECT_DOUBLE_EQ(stopped[1], 4.525);
+}
+
+// The boxes on a grid of 1 mm pixels whose 3 mm slices were cut into thirds:
+// the thin cube's own box along the axis, and the drawn slices, also
+// without any widening between them.
+TEST(PointBoxes, ThinGridsKnowTheirDrawnSlicesWithOrWithoutWidening) {
+  volume::ImageGeometry geometry;
+  geometry.dims = {10, 10, 30};
+  geometry.spacing = {1, 1, 1};
+  InterfaceParams params;
+  params.cube_fraction = 0.95;
+  params.box_scale = {1, 1, 3};
+  params.drawn_axis = 2;
+  params.drawn_parts = 3;
+  for (const double widening : {0.5, 0.0}) {
+    params.between_drawn_widening = widening;
+    const auto boxes = point_boxes(geometry, params);
+    EXPECT_EQ(boxes.drawn_axis, 2) << widening;
+    EXPECT_DOUBLE_EQ(boxes.drawn_spacing, 3) << widening;
+    EXPECT_DOUBLE_EQ(boxes.drawn_first, 1) << widening;
+    EXPECT_DOUBLE_EQ(boxes.thin_half, 0.475) << widening;
+    EXPECT_DOUBLE_EQ(boxes.widening[0], widening) << widening;
+    EXPECT_DOUBLE_EQ(boxes.hold(0, {5, 5, 4.5}, {5, 5, 3.2})[2], 4.0) << widening;
+  }
 }
 
 TEST(PointBoxes, NarrowPointsNeverWiden) {
