@@ -19,8 +19,13 @@ namespace labelmesh::conforming {
 namespace {
 
 constexpr float kFar = std::numeric_limits<float>::max();
-// Rounds of tuning each label's bias to its volume.
+// Rounds of tuning each label's bias to its volume, and how near the volume
+// is near enough. The bias swells a label's walls between slices and not on
+// them, so it bends them: a label the interpolation keeps within 1 % of its
+// volume keeps its walls as interpolated (on 1 x 1 x 3 mm slices a sphere's
+// normals' 95th percentile is 7.9 degrees so, 9.8 biased to 0.1 %).
 constexpr int kBiasRounds = 6;
+constexpr double kBiasTolerance = 0.01;
 // The signed distances' clamp, in slices.
 constexpr float kBandSlices = 2;
 // Slice distances kept between rounds: at most 256 MiB of them.
@@ -442,7 +447,7 @@ absl::StatusOr<volume::LabelVolume> interpolate_thick_slices(const volume::Label
   // missing volume spread over its boundary (by half a band for a label that
   // vanished, which has none) and over the thin slices' mean taper, at most
   // half a band a round and a band in all, until every label has its
-  // voxels' volume to within a tenth of a percent or the rounds run out; the
+  // voxels' volume to within kBiasTolerance or the rounds run out; the
   // best round's biases are kept. The band here is one slice's thickness.
   std::fill(out, out + fine.geometry.voxel_count(), 0);
   const SliceInterpolator interpolator(volume, labels, cut);
@@ -477,7 +482,7 @@ absl::StatusOr<volume::LabelVolume> interpolate_thick_slices(const volume::Label
       best_error = error;
       best_bias = bias;
     }
-    if (error <= 1e-3 || round == kBiasRounds) {
+    if (error <= kBiasTolerance || round == kBiasRounds) {
       if (!best) interpolator.fill(best_bias, out, counts, boundary);
       break;
     }

@@ -49,7 +49,7 @@ ThickSlices find_thick_slices(const volume::ImageGeometry& geometry,
 // 0) on the thinner grid: the same extent and directions, `cut.parts` slices
 // for each slice along `cut.axis`, int32 voxels. Beyond the first and last
 // slice centres the labels do not change along the axis. Each label's
-// distances carry a bias that keeps its volume within 0.1 % of its voxels'
+// distances carry a bias that keeps its volume within 1 % of its voxels'
 // where a few rounds can. The bias fades to nothing at the thick slices'
 // centres: a thin slice through one holds its labels, and one near it may
 // differ from it at label edges.
