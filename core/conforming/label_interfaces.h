@@ -48,7 +48,8 @@ struct InterfaceParams {
   // box across the axis by up to this fraction of the voxel, more the
   // farther it lies from the nearest drawn slice (none on or near one, all
   // of it midway; point_boxes.h), so the interpolation's pixel steps do not
-  // stay as ridges.
+  // stay as ridges. Along the axis no point passes a drawn slice beyond its
+  // cube's own box.
   int drawn_axis = -1;
   int drawn_parts = 1;
   double between_drawn_widening = 0;

@@ -66,9 +66,10 @@ struct PointBoxes {
 };
 
 // Each point's box on `geometry` (cube_fraction of half a voxel along each
-// axis, times box_scale), wider between drawn slices when params name a
-// drawn axis cut into two parts or more. `narrow` and `pinned` are left
-// empty.
+// axis, times box_scale). When params name a drawn axis cut into two parts
+// or more, no point passes a drawn slice beyond its cube's own box, and
+// boxes widen across between drawn slices (when between_drawn_widening is
+// above 0). `narrow` and `pinned` are left empty.
 PointBoxes point_boxes(const volume::ImageGeometry& geometry, const InterfaceParams& params);
 
 // Pins the points at `centre` (cube centres in mm from voxel (0, 0, 0), as

@@ -513,6 +513,10 @@ absl::StatusOr<volume::LabelVolume> interpolate_thick_slices(const volume::Label
                  (over.bias - under.bias) * (double(target[l]) - double(under.count)) /
                      (double(over.count) - double(under.count));
       }
+      // A label within the tolerance keeps its bias (none, unless its
+      // neighbours' biases pushed it out before): the bias bends walls.
+      // The outside is always within it, counted against the whole box.
+      if (std::abs(missing) <= kBiasTolerance * std::max(1.0, double(target[l]))) continue;
       bias[l] = std::clamp(bias[l] + std::clamp(change, -band / 2, band / 2), -band, band);
     }
   }

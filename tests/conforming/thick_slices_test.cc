@@ -125,10 +125,10 @@ TEST(ThickSlices, KeepEachSliceAndEachLabelsVolume) {
   const auto thick_volumes = label_volumes(thick);
   const auto fine_volumes = label_volumes(fine);
   ASSERT_EQ(fine_volumes.size(), 2u);
-  // The shell within 0.5 %; the inner ball (8,600 thin voxels) within a ring
-  // of thin voxels, as it gains or loses them 60-70 at a time.
+  // Both within the 1 % the bias aims at (the inner ball, of 8,600 thin
+  // voxels, gains or loses them 60-70 at a time).
   EXPECT_NEAR(fine_volumes.at(1) / thick_volumes.at(1), 1.0, 0.01);
-  EXPECT_NEAR(fine_volumes.at(2) / thick_volumes.at(2), 1.0, 0.005);
+  EXPECT_NEAR(fine_volumes.at(2) / thick_volumes.at(2), 1.0, 0.01);
 }
 
 // Five organs that grow and meet from slice to slice: every thin voxel
@@ -289,6 +289,39 @@ TEST(ThickSlices, WallsSlopeEvenlyBetweenSlices) {
   EXPECT_LT(worst, 0.25) << "mm";
 }
 
+// A ball and a thin ring apart on 1 x 1 x 3 mm slices: interpolation thins
+// the ring, whose bias brings it back to within 1 % of its voxels' volume,
+// while the ball, which it leaves within 1 %, keeps its thin voxels as if the
+// ring were not there (the bias bends walls).
+TEST(ThickSlices, OnlyLabelsOffTheirVolumeAreBiased) {
+  const auto ball_and_ring = [](const std::array<double, 3>& p) {
+    const double ball = std::hypot(p[0] + 20, p[1], p[2]);
+    const double ring = std::hypot(std::hypot(p[0] - 20, p[1]) - 10, p[2]);
+    return ball < 12 ? 1 : ring < 2.5 ? 2 : 0;
+  };
+  const auto thick = volume::rasterise(
+      volume::centred_grid({81, 41, 15}, {1, 1, 3}, testing::kIdentityDirection, {0, 0, 0}),
+      ball_and_ring);
+  const ThickSlices cut{2, 3};
+  const auto both = interpolated(thick, cut);
+  auto ball_alone = interpolate_thick_slices(thick, {1}, cut, RunContext{});
+  ASSERT_THAT(ball_alone, testing::IsOk());
+  const auto with_ring = labels_of(both);
+  const auto without = labels_of(*ball_alone);
+  ASSERT_EQ(with_ring.size(), without.size());
+  size_t ball = 0, differ = 0;
+  for (size_t i = 0; i < with_ring.size(); ++i) {
+    ball += without[i] == 1;
+    differ += (with_ring[i] == 1) != (without[i] == 1);
+  }
+  EXPECT_GT(ball, 5'000u);
+  EXPECT_EQ(differ, 0u);
+  const auto thick_volumes = label_volumes(thick);
+  const auto fine_volumes = label_volumes(both);
+  EXPECT_NEAR(fine_volumes.at(1) / thick_volumes.at(1), 1.0, 0.01);
+  EXPECT_NEAR(fine_volumes.at(2) / thick_volumes.at(2), 1.0, 0.01);
+}
+
 TEST(ThickSlices, AnyAxisCanBeThick) {
   const auto thick = thick_nested_balls(0);
   const ThickSlices cut = find_thick_slices(thick.geometry, {});
@@ -297,7 +330,7 @@ TEST(ThickSlices, AnyAxisCanBeThick) {
   const auto thick_volumes = label_volumes(thick);
   const auto fine_volumes = label_volumes(fine);
   EXPECT_NEAR(fine_volumes.at(1) / thick_volumes.at(1), 1.0, 0.01);
-  EXPECT_NEAR(fine_volumes.at(2) / thick_volumes.at(2), 1.0, 0.005);
+  EXPECT_NEAR(fine_volumes.at(2) / thick_volumes.at(2), 1.0, 0.01);
 }
 
 TEST(ThickSlices, GiveAConformingMeshOfFiniteElementQuality) {
