@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <array>
 #include <barrier>
+#include <cmath>
 #include <utility>
 
 #include "core/util/side_by_side.h"
@@ -55,6 +56,18 @@ void smooth_in_boxes(const Stencil& stencil, const std::vector<Vec3>& centre,
   const Lanes widening = to_lanes(point_boxes.widening);
   const Lanes edge_low = to_lanes(point_boxes.edge_low);
   const Lanes edge_high = to_lanes(point_boxes.edge_high);
+  // Along a drawn axis each point's limits (PointBoxes::along_drawn), found
+  // once in double precision and rounded towards the centre, so that the
+  // steps pick the same drawn slices as the final hold.
+  std::vector<std::array<float, 2>> along;
+  if (drawn >= 0) {
+    along.resize(n);
+    for (size_t p = 0; p < n; ++p) {
+      const auto [low, high] = point_boxes.along_drawn(centre[p][drawn]);
+      along[p] = {std::nextafter(static_cast<float>(low), static_cast<float>(centre[p][drawn])),
+                  std::nextafter(static_cast<float>(high), static_cast<float>(centre[p][drawn]))};
+    }
+  }
   const std::array<Lanes*, 2> places{now.data(), next.data()};
   const auto step_range = [&](int step, size_t begin, size_t end) {
     const auto factor =
@@ -91,8 +104,7 @@ void smooth_in_boxes(const Stencil& stencil, const std::vector<Vec3>& centre,
       Lanes width = half;
       if (drawn >= 0) {
         // Along the drawn axis first: the width across follows from there.
-        const auto [low, high] = point_boxes.along_drawn(box[p][drawn]);
-        moved[drawn] = std::clamp(moved[drawn], low, high);
+        moved[drawn] = std::clamp(moved[drawn], along[p][0], along[p][1]);
         if (point_boxes.widens(p))
           width += between_drawn(moved[drawn], drawn_first, drawn_spacing) * widening;
       }

@@ -6,6 +6,8 @@
 
 #include <gtest/gtest.h>
 
+#include "core/conforming/constrained_smoothing.h"
+
 namespace labelmesh::conforming {
 namespace {
 
@@ -104,6 +106,28 @@ TEST(PointBoxes, ThinGridsKnowTheirDrawnSlicesWithOrWithoutWidening) {
     EXPECT_DOUBLE_EQ(boxes.widening[0], widening) << widening;
     EXPECT_DOUBLE_EQ(boxes.hold(0, {5, 5, 4.5}, {5, 5, 3.2})[2], 4.0) << widening;
   }
+}
+
+// The smoothing steps keep the rule too, not only the final hold: point B,
+// in the cube above the drawn slice z = 4, is pulled down towards a fixed
+// point A at z = 2, and point C, in the cube below, follows B. Held at the
+// drawn slice through the steps, B leaves C near it; let past it during the
+// steps and held only at the end, B would have drawn C down to z = 3.1.
+TEST(PointBoxes, SmoothingStepsKeepPointsOffDrawnSlices) {
+  const auto boxes = thirds();
+  Stencil stencil;
+  stencil.start = {0, 0, 1, 2};  // A: none; B: A; C: B
+  stencil.neighbours = {0, 1};
+  stencil.along_curve.assign(3, false);
+  const std::vector<Vec3> centre{{5, 5, 2.5}, {5, 5, 4.5}, {5, 5, 3.5}};
+  std::vector<Vec3> points{{5, 5, 2}, {5, 5, 4.5}, {5, 5, 3.5}};
+  InterfaceParams params;
+  params.smoothing_rounds = 100;
+  params.inflate_step = params.shrink_step;  // plain averaging: no overshoot to read
+  smooth_in_boxes(stencil, centre, boxes, params, points);
+  EXPECT_DOUBLE_EQ(points[0][2], 2.0);
+  EXPECT_NEAR(points[1][2], 4.0, 1e-5);
+  EXPECT_GT(points[2][2], 3.9);
 }
 
 TEST(PointBoxes, NarrowPointsNeverWiden) {
