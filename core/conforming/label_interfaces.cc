@@ -127,10 +127,10 @@ std::array<int32_t, 8> corners(const PaddedLabels& labels, int64_t a, int64_t b,
   return corner;
 }
 
-uint8_t distinct_labels(const PaddedLabels& labels, int64_t a, int64_t b, int64_t c) {
+uint8_t distinct_labels(const std::array<int32_t, 8>& corner) {
   std::array<int32_t, 8> seen{};
   uint8_t count = 0;
-  for (const int32_t label : corners(labels, a, b, c))
+  for (const int32_t label : corner)
     if (std::find(seen.begin(), seen.begin() + count, label) == seen.begin() + count)
       seen[count++] = label;
   return count;
@@ -181,6 +181,13 @@ std::array<int64_t, 3> cube_around(std::array<int64_t, 3> p, int axis, std::arra
 
 constexpr std::array<std::array<int, 2>, 4> kQuadOffsets{{{1, 1}, {0, 1}, {0, 0}, {1, 0}}};
 
+// Whether any of a cube's corners holds a label in `small` (sorted).
+bool holds_small(const std::array<int32_t, 8>& corner, const std::vector<int32_t>& small) {
+  return std::any_of(corner.begin(), corner.end(), [&](int32_t label) {
+    return std::binary_search(small.begin(), small.end(), label);
+  });
+}
+
 // Whether a corner of padded cube (a, b, c) is one of `joined` (sorted
 // linear indices into the volume of `dims`).
 bool touches_joined(const PaddedLabels& labels, const std::array<int64_t, 3>& dims,
@@ -228,19 +235,17 @@ Net net_points(const PaddedLabels& labels, const std::array<double, 3>& spacing,
     const auto& f = labels.first;
     const Vec3 centre{(double(a + f[0]) + 0.5) * spacing[0], (double(b + f[1]) + 0.5) * spacing[1],
                       (double(c + f[2]) + 0.5) * spacing[2]};
+    const auto corner = corners(labels, a, b, c);
     if (!split) {
       net.centre.push_back(centre);
-      net.label_count.push_back(distinct_labels(labels, a, b, c));
+      net.label_count.push_back(distinct_labels(corner));
       return;
     }
     net.first_point.push_back(static_cast<uint32_t>(net.centre.size()));
-    const auto corner = corners(labels, a, b, c);
     if (touches_joined(labels, dims, joined, a, b, c)) {
       net.centre.push_back(centre);
-      net.label_count.push_back(distinct_labels(labels, a, b, c));
-      net.near_small.push_back(std::any_of(corner.begin(), corner.end(), [&](int32_t label) {
-        return std::binary_search(small.begin(), small.end(), label);
-      }));
+      net.label_count.push_back(distinct_labels(corner));
+      net.near_small.push_back(holds_small(corner, small));
       return;
     }
     const CubeSheets sheets = cube_sheets(corner);
@@ -359,10 +364,7 @@ Stencil smoothing_stencil(const Net& net, const PaddedLabels& labels, const Mark
   stencil.neighbours.reserve(4 * n);
   stencil.along_curve.assign(n, false);
   const auto next_to_small = [&](const std::array<int64_t, 3>& cube) {
-    const auto corner = corners(labels, cube[0], cube[1], cube[2]);
-    return std::any_of(corner.begin(), corner.end(), [&](int32_t label) {
-      return std::binary_search(small.begin(), small.end(), label);
-    });
+    return holds_small(corners(labels, cube[0], cube[1], cube[2]), small);
   };
   cubes.for_each_point([&](size_t i, uint32_t p) {
     stencil.start[p] = static_cast<uint32_t>(stencil.neighbours.size());
