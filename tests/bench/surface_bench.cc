@@ -41,6 +41,7 @@
 #include "core/volume/read_label_volume.h"
 #include "core/volume/write_label_volume.h"
 #include "support/analytic_shapes.h"
+#include "support/label_overlap.h"
 #include "support/organs_on_slices.h"
 #include "support/slicer_like.h"
 
@@ -261,6 +262,36 @@ void our_surfaces_alone(const std::string& path) {
   side_by_side(cut, cut);
 }
 
+// Nodes of one label's surface more than 0.1 of the smallest spacing inside
+// another label's, ours (shared interfaces) against the Slicer-like surfaces
+// (each label smoothed on its own).
+void print_overlap(const MeshResult& result, const std::vector<int32_t>& labels,
+                   const std::vector<surface::LabelSurface>& slicer,
+                   const volume::LabelVolume& volume) {
+  std::vector<const surface::TriangleMesh*> ours_meshes, slicer_meshes;
+  std::vector<int32_t> meshed;
+  for (size_t i = 0; i < labels.size() && i < slicer.size(); ++i) {
+    for (const auto& s : result.surfaces) {
+      if (labels[i] == 0 || s.label != labels[i] || !s.is_output || s.mesh.triangles.empty())
+        continue;
+      ours_meshes.push_back(&s.mesh);
+      slicer_meshes.push_back(&slicer[i].mesh);
+      meshed.push_back(labels[i]);
+    }
+  }
+  const auto& spacing = volume.geometry.spacing;
+  const double depth = 0.1 * *std::min_element(spacing.begin(), spacing.end());
+  const auto ours_overlap = testing::nodes_inside_others(ours_meshes, meshed, volume, depth);
+  const auto slicer_overlap = testing::nodes_inside_others(slicer_meshes, meshed, volume, depth);
+  std::printf(
+      "  nodes more than %.2f mm inside another label's surface: ours %zu of %zu (%zu labels), "
+      "Slicer-like %zu of %zu (%.1f %%, %zu labels)\n",
+      depth, ours_overlap.inside, ours_overlap.nodes, ours_overlap.labels_entering,
+      slicer_overlap.inside, slicer_overlap.nodes,
+      100.0 * double(slicer_overlap.inside) / double(std::max<size_t>(1, slicer_overlap.nodes)),
+      slicer_overlap.labels_entering);
+}
+
 int bench_volume(const std::string& path, int rounds) {
   std::printf("\n%s\n", path.c_str());
   // Time: both pipelines from the file to every label's surface, and our
@@ -426,6 +457,10 @@ int bench_volume(const std::string& path, int rounds) {
       "Slicer-like %.1f %%, ours %.1f %%; ours within Slicer-like + 5 points: %d\n",
       f.ours_share.size(), 100 * median(f.mc_share), 100 * median(f.slicer_share),
       100 * median(f.ours_share), f.ours_within_slicer_plus5);
+  // LABELMESH_BENCH_OVERLAP=1: how far the labels' surfaces enter each
+  // other (minutes on the brain and the frog).
+  if (std::getenv("LABELMESH_BENCH_OVERLAP") != nullptr)
+    print_overlap(*result, labels, slicer, volume);
   if (drawn) {
     const auto& g = drawn->geometry;
     std::printf(

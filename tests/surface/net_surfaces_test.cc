@@ -30,6 +30,7 @@
 #include "core/volume/read_label_volume.h"
 #include "support/analytic_shapes.h"
 #include "support/label_grid.h"
+#include "support/label_overlap.h"
 #include "support/label_volumes.h"
 #include "support/mesh_results.h"
 #include "support/organs_on_slices.h"
@@ -576,6 +577,43 @@ TEST(NetSurfacesRealData, MrLabelsAreFaithfulAndSmooth) {
   MeshParams strict;
   strict.guard.strict = true;
   EXPECT_THAT(run_pipeline(path, strict, {}), testing::IsOk());
+}
+
+// Touching MR organs share their interfaces: no node of one label's surface
+// lies inside another's by more than a tenth of a voxel, where the same
+// labels smoothed each on its own (the Slicer-like surfaces) enter each
+// other with one node in a hundred or more.
+TEST(NetSurfacesRealData, MrLabelsDoNotEnterEachOther) {
+  LABELMESH_SKIP_WITHOUT_SHARED_DATA();
+  const auto path = testing::shared_data("totalseg_example_seg_mr.nii.gz");
+  if (!std::filesystem::exists(path)) GTEST_SKIP() << "missing " << path;
+  auto result = run_pipeline(path, MeshParams{}, {});
+  ASSERT_THAT(result, testing::IsOk());
+  auto volume = volume::read_label_volume(path, {}, RunContext{});
+  ASSERT_THAT(volume, testing::IsOk());
+  const auto statistics = volume::compute_label_statistics(*volume);
+  std::vector<int32_t> labels;
+  std::vector<const surface::TriangleMesh*> ours;
+  for (const auto& l : statistics.labels) {
+    if (l.label == 0) continue;
+    const auto* s = output_of(*result, l.label);
+    ASSERT_NE(s, nullptr) << l.label;
+    labels.push_back(l.label);
+    ours.push_back(&s->mesh);
+  }
+  ASSERT_GE(labels.size(), 20u);
+  const auto slicer = testing::slicer_like_surfaces(*volume, statistics, labels);
+  ASSERT_EQ(slicer.size(), labels.size());
+  std::vector<const surface::TriangleMesh*> separate;
+  for (const auto& s : slicer) separate.push_back(&s.mesh);
+  const auto& spacing = volume->geometry.spacing;
+  const double depth = 0.1 * *std::min_element(spacing.begin(), spacing.end());
+  const auto shared = testing::nodes_inside_others(ours, labels, *volume, depth);
+  const auto apart = testing::nodes_inside_others(separate, labels, *volume, depth);
+  EXPECT_GT(shared.nodes, 20000u);
+  EXPECT_EQ(shared.inside, 0u);
+  EXPECT_GT(apart.inside, apart.nodes / 100);
+  EXPECT_GE(apart.labels_entering, 5u);
 }
 
 // The whole-brain segmentation's 40 labels touch one another in every way
