@@ -19,6 +19,7 @@
 #include "core/pipeline/label_net_surfaces.h"
 #include "core/pipeline/label_queue.h"
 #include "core/pipeline/label_surfaces.h"
+#include "core/pipeline/labels_crossing.h"
 #include "core/pipeline/volume_layers.h"
 #include "core/surface/extract_surfaces.h"
 #include "core/surface/voxel_fidelity.h"
@@ -558,6 +559,15 @@ absl::StatusOr<MeshResult> run_on_volume(const std::string& path,
   }
   for (auto& surface : quality_surfaces) result.surfaces.push_back(std::move(surface));
   result.warnings = collect_warnings(result.surfaces, params);
+  // Labels made apart from the shared net may enter their neighbours'
+  // surfaces; per-label methods asked for by name and layers of segments
+  // that overlap in the voxels are made apart anyway.
+  if (params.surface == SurfaceMethod::kNet && layers.size() == 1)
+    for (const auto& c : labels_crossing(result.surfaces))
+      result.warnings.push_back(
+          {c.label, cat("surface crosses label ", c.other, "'s: ", c.triangle_pairs,
+                        " pair(s) of triangles pass through each other (made apart from the "
+                        "shared surface net)")});
   // Refused before the volume meshes, which would take long for nothing.
   LABELMESH_RETURN_IF_ERROR(refuse_warnings_if_strict(path, result, params));
 

@@ -1,0 +1,30 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// Labels cut from the shared surface net never pass through each other: they
+// share their interfaces. A label delivered another way (the lighter net,
+// Poisson, the meshed mask) is made apart from its neighbours, and its
+// surface can enter theirs, across the gap between the labels or where they
+// touch, which no label's own check sees. This finds where it does.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "core/pipeline/mesh_result.h"
+
+namespace labelmesh {
+
+// A delivered surface made apart from the shared net that crosses the
+// delivered surface of `other`.
+struct LabelsCrossing {
+  int32_t label = 0;
+  int32_t other = 0;
+  size_t triangle_pairs = 0;  // triangles of `label` and of `other` that cross
+};
+
+// For every delivered surface (is_output) of `surfaces` whose stage is not
+// "net", the other delivered surfaces it crosses, in the order of
+// `surfaces`. Surfaces that are all "net" give none.
+std::vector<LabelsCrossing> labels_crossing(const std::vector<SurfaceResult>& surfaces);
+
+}  // namespace labelmesh

@@ -1,0 +1,96 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+#include "core/pipeline/labels_crossing.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "core/pipeline/pipeline.h"
+#include "core/volume/phantom.h"
+#include "support/status_matchers.h"
+
+namespace labelmesh {
+namespace {
+
+// A closed cube of side 2 * half around `centre`, wound outward, as a
+// label's delivered surface made by `stage`.
+SurfaceResult cube_surface(int32_t label, const std::string& stage,
+                           const std::array<double, 3>& centre, double half) {
+  SurfaceResult s;
+  s.label = label;
+  s.stage = stage;
+  s.is_output = true;
+  for (int i = 0; i < 8; ++i)
+    s.mesh.points.push_back({centre[0] + ((i & 1) ? half : -half),
+                             centre[1] + ((i & 2) ? half : -half),
+                             centre[2] + ((i & 4) ? half : -half)});
+  s.mesh.triangles = {{0, 2, 1}, {1, 2, 3}, {4, 5, 6}, {5, 7, 6}, {0, 1, 4}, {1, 5, 4},
+                      {2, 6, 3}, {3, 6, 7}, {0, 4, 2}, {2, 4, 6}, {1, 3, 5}, {3, 7, 5}};
+  return s;
+}
+
+TEST(LabelsCrossing, ASurfaceMadeApartThatEntersANeighbourIsFound) {
+  std::vector<SurfaceResult> surfaces{cube_surface(1, "net", {0, 0, 0}, 5),
+                                      cube_surface(2, "net_lighter", {8, 1, 1}, 4)};
+  const auto found = labels_crossing(surfaces);
+  ASSERT_EQ(found.size(), 1u);
+  EXPECT_EQ(found[0].label, 2);
+  EXPECT_EQ(found[0].other, 1);
+  EXPECT_GE(found[0].triangle_pairs, 4u);
+}
+
+TEST(LabelsCrossing, SurfacesApartOrAllFromTheNetGiveNone) {
+  // A voxel's gap between them: no crossing.
+  EXPECT_TRUE(labels_crossing({cube_surface(1, "net", {0, 0, 0}, 5),
+                               cube_surface(2, "poisson", {10.5, 0, 0}, 5)})
+                  .empty());
+  // Both cut from the shared net: not looked at (they share interfaces).
+  EXPECT_TRUE(
+      labels_crossing({cube_surface(1, "net", {0, 0, 0}, 5), cube_surface(2, "net", {8, 1, 1}, 4)})
+          .empty());
+  // Stages that are not delivered do not count.
+  auto stage = cube_surface(2, "repaired", {8, 1, 1}, 4);
+  stage.is_output = false;
+  EXPECT_TRUE(labels_crossing({cube_surface(1, "net", {0, 0, 0}, 5), stage}).empty());
+}
+
+TEST(LabelsCrossing, EachOtherLabelIsNamedWithItsOwnPairs) {
+  std::vector<SurfaceResult> surfaces{cube_surface(1, "net", {0, 0, 0}, 5),
+                                      cube_surface(3, "net", {0, 20, 0}, 5),
+                                      cube_surface(2, "mask", {0, 10, 0}, 6)};
+  const auto found = labels_crossing(surfaces);
+  ASSERT_EQ(found.size(), 2u);
+  EXPECT_EQ(found[0].label, 2);
+  EXPECT_EQ(found[0].other, 1);
+  EXPECT_EQ(found[1].label, 2);
+  EXPECT_EQ(found[1].other, 3);
+  EXPECT_GT(found[0].triangle_pairs, 0u);
+  EXPECT_EQ(found[0].triangle_pairs, found[1].triangle_pairs);
+}
+
+// On the thin shapes on 0.75 x 0.75 x 3 mm voxels some labels fall back to
+// the meshed mask, made apart from their neighbours; where such a surface
+// enters another label's, the run says so for that label (and --strict
+// refuses the run, as for any warning).
+TEST(LabelsCrossing, ARunWarnsOfEachCrossing) {
+  auto volume = volume::make_phantom(volume::PhantomShape::kThinShapesAnisotropic).volume;
+  auto result = run_pipeline_on_volume(std::move(volume), MeshParams{}, {});
+  ASSERT_THAT(result, testing::IsOk());
+  const auto found = labels_crossing(result->surfaces);
+  ASSERT_FALSE(found.empty());
+  for (const auto& c : found) {
+    const std::string named = "surface crosses label " + std::to_string(c.other) +
+                              "'s: " + std::to_string(c.triangle_pairs) + " pair(s)";
+    EXPECT_TRUE(std::any_of(
+        result->warnings.begin(), result->warnings.end(),
+        [&](const LabelWarning& w) { return w.label == c.label && w.reason.find(named) == 0; }))
+        << c.label << " crossing " << c.other;
+  }
+}
+
+}  // namespace
+}  // namespace labelmesh
