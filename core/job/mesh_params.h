@@ -54,6 +54,12 @@ struct NetOptions {
   // farther it lies from the nearest drawn slice: the interpolated slices'
   // pixel steps would otherwise stay as ridges. At most 0.5.
   double between_drawn_widening = 0.5;
+  // A net on thinner slices is smoothed this many times smoothing_rounds:
+  // its terraces are a thick slice long, several thin voxels, and the
+  // smoothing's reach grows only as the square root of its rounds (the
+  // sphere on 1 x 1 x 3 mm slices: normals' 95th percentile 7.9 degrees at
+  // 150 rounds, 5.7 at 600).
+  int thin_grid_rounds_factor = 4;
   // At most this many voxels on the thinner grid (fewer parts otherwise).
   int64_t max_thin_voxels = 48'000'000;
   // Poisson is tried first on labels touching no other selected label, at

@@ -49,6 +49,9 @@ absl::Status check_net_options(const NetOptions& options) {
   if (!(options.shrink_step > 0 && options.shrink_step < 1 && options.inflate_step < 0 &&
         -options.inflate_step < 1))
     return absl::InvalidArgumentError("net smoothing steps: shrink in (0, 1), inflate in (-1, 0)");
+  if (options.thin_grid_rounds_factor < 1 || options.thin_grid_rounds_factor > 8)
+    return absl::InvalidArgumentError(
+        cat("net thin-grid rounds factor: ", options.thin_grid_rounds_factor, " is outside 1..8"));
   if (!(options.thick_ratio >= 0 && options.thin_ratio > 0))
     return absl::InvalidArgumentError("net thick slices: ratios must be positive");
   if (!(options.cube_fraction > 0 && options.cube_fraction < 1))
@@ -132,6 +135,7 @@ absl::StatusOr<LayerNet> layer_net(const volume::LabelVolume& layer,
   thin_params.drawn_axis = cut.axis;
   thin_params.drawn_parts = cut.parts;
   thin_params.between_drawn_widening = options.between_drawn_widening;
+  thin_params.smoothing_rounds = options.smoothing_rounds * options.thin_grid_rounds_factor;
   made.net = conforming::label_interfaces(*thin, here, thin_params, figures);
   if (!with_staircase) return made;
   conforming::InterfaceParams flat = interface_params(options);

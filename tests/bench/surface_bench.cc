@@ -69,12 +69,15 @@ double median(std::vector<double> v) {
   return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
-// Default options, or the net's from LABELMESH_NET_ROUNDS, _INFLATE, _CUBE,
-// _THICK and _WIDEN, and with LABELMESH_NET_ONLY the net alone (for tuning).
+// Default options, or the net's from LABELMESH_NET_ROUNDS, _THIN_FACTOR,
+// _INFLATE, _CUBE, _THICK and _WIDEN, and with LABELMESH_NET_ONLY the net
+// alone (for tuning).
 MeshParams our_params() {
   MeshParams params;
   if (const char* v = std::getenv("LABELMESH_NET_ROUNDS"))
     params.net.smoothing_rounds = std::atoi(v);
+  if (const char* v = std::getenv("LABELMESH_NET_THIN_FACTOR"))
+    params.net.thin_grid_rounds_factor = std::atoi(v);
   if (const char* v = std::getenv("LABELMESH_NET_INFLATE")) params.net.inflate_step = std::atof(v);
   if (std::getenv("LABELMESH_NET_ONLY")) {
     params.net.poisson_max_anisotropy = 0;
@@ -197,6 +200,10 @@ int bench_shares() {
         continue;
       }
       const auto& g = made->volume.geometry;
+      if (const char* out = std::getenv("LABELMESH_BENCH_OUT"))
+        (void)volume::write_label_volume(
+            made->volume, std::string(out) + "/" + shape.name + "-share-" +
+                              std::to_string(static_cast<int>(10 * grid.spacing[2])) + ".nii.gz");
       std::printf("%-10s %-18s | %5.1f %5.1f %5.1f %5.1f (%s)\n", shape.name.c_str(), grid.name,
                   100 * surface::axis_aligned_share(made->ours, g, shape.normal),
                   100 * surface::axis_aligned_share(made->marching_cubes, g),

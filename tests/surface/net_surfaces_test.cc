@@ -354,19 +354,49 @@ TEST(NetSurfaces, ThickSliceShapesAreTruerThanTheSlicerLikePipeline) {
     EXPECT_LT(mine.normal_p95_deg, theirs.normal_p95_deg) << shape.name;
     // Within a fifth of the largest spacing of the true surface.
     EXPECT_LT(mine.rms_mm, 0.2 * spacing[2]) << shape.name;
-    // On 4 mm slices the walls slope evenly between slices (their normals'
-    // 95th percentile was 14-17 degrees while the thin slices kept a stair).
-    if (spacing[2] == 4) {
-      EXPECT_LT(mine.normal_p95_deg, 11) << shape.name;
+    // On thick slices the walls slope evenly between slices (on 4 mm slices
+    // their normals' 95th percentile was 14-17 degrees while the thin slices
+    // kept a stair), and the thinner grid's net is smoothed long enough to
+    // round the ellipsoid on 1 x 1 x 3 mm slices (11.4 degrees at the
+    // isotropic grids' rounds).
+    if (spacing[2] > spacing[0]) {
+      EXPECT_LT(mine.normal_p95_deg, 10) << shape.name << " " << spacing[2];
     }
   }
 }
 
+// The share of a column's wall area (triangles facing within 25 degrees of
+// the horizontal) that faces within 10 degrees of a voxel axis although the
+// true wall there faces more than 10 degrees away from every axis: in-plane
+// pixel steps left standing.
+double stepped_wall_share(const surface::TriangleMesh& mesh, const testing::AnalyticShape& column) {
+  const double near_axis = std::cos(surface::kAxisAlignedDeg * M_PI / 180);
+  double stepped = 0, away = 0;
+  for (const auto& t : mesh.triangles) {
+    const auto &a = mesh.points[t[0]], &b = mesh.points[t[1]], &c = mesh.points[t[2]];
+    const auto n = geometry::cross(geometry::sub(b, a), geometry::sub(c, a));
+    const double area = 0.5 * geometry::norm(n);
+    if (area == 0) continue;
+    const auto unit = geometry::scale(n, 0.5 / area);
+    if (std::abs(unit[2]) > std::sin(25 * M_PI / 180)) continue;
+    const auto truth =
+        column.normal(geometry::scale(geometry::add(a, geometry::add(b, c)), 1.0 / 3));
+    if (std::max(std::abs(truth[0]), std::abs(truth[1])) > near_axis) continue;
+    away += area;
+    if (std::max({std::abs(unit[0]), std::abs(unit[1]), std::abs(unit[2])}) > near_axis)
+      stepped += area;
+  }
+  return away > 0 ? stepped / away : 0;
+}
+
 // A column's walls, cut by the volume's edges as organs are by a CT slab:
-// a quarter of a round wall faces within 10 degrees of a voxel axis, and the
-// net keeps that share. The Slicer-like surface leans its walls off the axes
-// on 4 mm slices, below the true shape's share.
-TEST(NetSurfaces, ColumnWallsKeepTheTrueAxisAlignedShare) {
+// the net's walls face their true directions, with the pixels' steps gone
+// where the wall turns away from the axes (on 4 mm slices, smoothed at the
+// isotropic grids' rounds, 12 % of that area still faced an axis, which
+// made up for walls near the axes that face a little off them, so the
+// whole share looked true). The Slicer-like surface leans its walls off the
+// axes on 4 mm slices, below the true shape's share.
+TEST(NetSurfaces, ColumnWallsFaceTheirTrueDirections) {
   const auto column = testing::column_shape(20);
   for (const std::array<double, 3>& spacing :
        {std::array<double, 3>{0.6, 0.6, 4}, std::array<double, 3>{0.976562, 0.976562, 2}}) {
@@ -380,7 +410,10 @@ TEST(NetSurfaces, ColumnWallsKeepTheTrueAxisAlignedShare) {
     const double truth = surface::axis_aligned_share(ours->mesh, v.geometry, column.normal);
     EXPECT_GT(truth, 0.18) << spacing[2];
     EXPECT_LT(truth, 0.25) << spacing[2];
-    EXPECT_NEAR(surface::axis_aligned_share(ours->mesh, v.geometry), truth, 0.03) << spacing[2];
+    EXPECT_LT(stepped_wall_share(ours->mesh, column), 0.03) << spacing[2];
+    const auto mine = testing::shape_error(ours->mesh, column);
+    const auto theirs = testing::shape_error(both.slicer.front().mesh, column);
+    EXPECT_LT(mine.normal_p95_deg, theirs.normal_p95_deg) << spacing[2];
     if (spacing[2] == 4) {
       EXPECT_LT(surface::axis_aligned_share(both.slicer.front().mesh, v.geometry), truth - 0.05);
     }
@@ -504,6 +537,9 @@ TEST(NetSurfaces, ANetSmoothedPastTheVoxelsFallsBackToTheLighterNet) {
   const auto ring = testing::torus_shape(25, 9);
   MeshParams params;
   params.net.inflate_step = -0.6;
+  // At the isotropic grids' rounds: four times as many take the lighter net
+  // past the voxels too.
+  params.net.thin_grid_rounds_factor = 1;
   auto result = run_pipeline_on_volume(testing::sample_shape(ring, {1, 1, 3}), params, {});
   ASSERT_THAT(result, testing::IsOk());
   const auto* ours = output_of(*result, 1);
