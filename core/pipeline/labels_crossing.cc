@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cstdint>
 #include <map>
 
 #include "core/surface/crossing_triangles.h"
@@ -41,16 +42,26 @@ std::map<int32_t, size_t> crossings_with(const SurfaceResult& apart,
   const auto own = static_cast<uint32_t>(triangles.size());
   std::vector<uint32_t> among(own);
   for (uint32_t t = 0; t < own; ++t) among[t] = t;
-  // The label each added triangle belongs to.
+  // The label each added triangle belongs to; only the points of the
+  // triangles kept are added (a large neighbour meets most boxes).
   std::vector<int32_t> owner;
+  std::vector<uint32_t> added;
   for (const auto* other : others) {
-    const auto offset = static_cast<uint32_t>(points.size());
-    points.insert(points.end(), other->mesh.points.begin(), other->mesh.points.end());
+    added.assign(other->mesh.points.size(), UINT32_MAX);
     for (const auto& t : other->mesh.triangles) {
       Box box;
       for (const uint32_t v : t) box.add(other->mesh.points[v]);
       if (!reach.meets(box)) continue;
-      triangles.push_back({t[0] + offset, t[1] + offset, t[2] + offset});
+      std::array<uint32_t, 3> kept{};
+      for (int k = 0; k < 3; ++k) {
+        auto& at = added[t[k]];
+        if (at == UINT32_MAX) {
+          at = static_cast<uint32_t>(points.size());
+          points.push_back(other->mesh.points[t[k]]);
+        }
+        kept[k] = at;
+      }
+      triangles.push_back(kept);
       owner.push_back(other->label);
     }
   }
@@ -75,9 +86,11 @@ std::vector<LabelsCrossing> labels_crossing(const std::vector<SurfaceResult>& su
   for (size_t i = 0; i < delivered.size(); ++i) {
     const auto* s = delivered[i];
     if (s->stage == "net") continue;
+    // Two labels made apart are tested once, from the first.
     std::vector<const SurfaceResult*> near;
     for (size_t j = 0; j < delivered.size(); ++j)
-      if (j != i && delivered[j]->label != s->label && boxes[i].meets(boxes[j]))
+      if (j != i && delivered[j]->label != s->label && boxes[i].meets(boxes[j]) &&
+          (j > i || delivered[j]->stage == "net"))
         near.push_back(delivered[j]);
     if (near.empty()) continue;
     for (const auto& [other, pairs] : crossings_with(*s, near))

@@ -23,8 +23,11 @@ struct LabelsCrossing {
 };
 
 // For every delivered surface (is_output) of `surfaces` whose stage is not
-// "net", the other delivered surfaces it crosses, in the order of
-// `surfaces`. Surfaces that are all "net" give none.
+// "net", the other delivered surfaces it crosses: in the order of
+// `surfaces`, each one's crossings by the other label's number. Two labels
+// made apart that cross are listed once, under the first. A surface wholly
+// inside another crosses none of its triangles and is not seen. Surfaces
+// that are all "net" give none.
 std::vector<LabelsCrossing> labels_crossing(const std::vector<SurfaceResult>& surfaces);
 
 }  // namespace labelmesh

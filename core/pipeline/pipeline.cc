@@ -427,15 +427,21 @@ absl::StatusOr<MeshResult> run_stages(const std::string& path, const MeshParams&
 }
 
 // Under --strict, any warning (a label outside tolerance, a surface or a
-// volume mesh not delivered) fails the run.
+// volume mesh not delivered, a surface made apart entering another label's)
+// fails the run.
 absl::Status refuse_warnings_if_strict(const std::string& path, const MeshResult& result,
                                        const MeshParams& params) {
   if (!params.guard.strict || result.warnings.empty()) return absl::OkStatus();
+  std::vector<int32_t> warned;
+  for (const auto& w : result.warnings) warned.push_back(w.label);
+  std::sort(warned.begin(), warned.end());
+  warned.erase(std::unique(warned.begin(), warned.end()), warned.end());
   const auto& first = result.warnings.front();
   return absl::FailedPreconditionError(
-      cat(path, ": strict: ", result.warnings.size(),
-          " label(s) delivered outside tolerance or not at all; first, label ", first.label, ": ",
-          first.reason));
+      cat(path, ": strict: ", warned.size(),
+          " label(s) delivered outside tolerance, not at all, or into another label's surface; "
+          "first, label ",
+          first.label, ": ", first.reason));
 }
 
 // The stages after reading; `path` names the input in messages.
@@ -560,8 +566,8 @@ absl::StatusOr<MeshResult> run_on_volume(const std::string& path,
   for (auto& surface : quality_surfaces) result.surfaces.push_back(std::move(surface));
   result.warnings = collect_warnings(result.surfaces, params);
   // Labels made apart from the shared net may enter their neighbours'
-  // surfaces; per-label methods asked for by name and layers of segments
-  // that overlap in the voxels are made apart anyway.
+  // surfaces; per-label methods asked for by name, and volumes whose
+  // segments overlap in the voxels (several layers), are made apart anyway.
   if (params.surface == SurfaceMethod::kNet && layers.size() == 1)
     for (const auto& c : labels_crossing(result.surfaces))
       result.warnings.push_back(

@@ -58,6 +58,23 @@ TEST(LabelsCrossing, SurfacesApartOrAllFromTheNetGiveNone) {
   EXPECT_TRUE(labels_crossing({cube_surface(1, "net", {0, 0, 0}, 5), stage}).empty());
 }
 
+// Boxes that meet with no triangles crossing: a surface wholly inside
+// another, which a crossing test cannot see.
+TEST(LabelsCrossing, ASurfaceWhollyInsideAnotherCrossesNone) {
+  EXPECT_TRUE(
+      labels_crossing({cube_surface(1, "net", {0, 0, 0}, 5), cube_surface(2, "mask", {1, 1, 1}, 2)})
+          .empty());
+}
+
+TEST(LabelsCrossing, TwoLabelsMadeApartThatCrossAreListedOnce) {
+  const auto found = labels_crossing(
+      {cube_surface(1, "poisson", {0, 0, 0}, 5), cube_surface(2, "mask", {8, 1, 1}, 4)});
+  ASSERT_EQ(found.size(), 1u);
+  EXPECT_EQ(found[0].label, 1);
+  EXPECT_EQ(found[0].other, 2);
+  EXPECT_GE(found[0].triangle_pairs, 4u);
+}
+
 TEST(LabelsCrossing, EachOtherLabelIsNamedWithItsOwnPairs) {
   std::vector<SurfaceResult> surfaces{cube_surface(1, "net", {0, 0, 0}, 5),
                                       cube_surface(3, "net", {0, 20, 0}, 5),
