@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-// The labels a run delivered outside tolerance or not at all, printed on
-// stderr so they are seen even when stdout goes to a file or a pipe.
+// The labels a run delivered outside tolerance, not at all, or into another
+// label's surface, printed on stderr so they are seen even when stdout goes
+// to a file or a pipe.
 #pragma once
 
 #include <string_view>

@@ -85,7 +85,8 @@ void add_pipeline_flags(CLI::App& command, PipelineFlags& flags) {
                    "neighbour from a coarser one (by default they are meshed and judged on the "
                    "coarser grid they were drawn on)");
   command.add_flag("--strict", guard.strict,
-                   "Fail (exit 4) when any label is delivered outside tolerance or not at all");
+                   "Fail (exit 4) when any label is delivered outside tolerance, not at all, "
+                   "or into another label's surface");
   command.add_flag("--keep-strands", flags.keep_strands,
                    "Keep strands one voxel thick (repaired, poisson); by default they are pruned");
   command
