@@ -86,9 +86,13 @@ inline AnalyticShape column_shape(double r) {
 }
 
 // A grid of `spacing` voxels whose axes are rotated by `degrees` about
-// (1, 1, 1) (0: axis-aligned), covering the shape, centred at the origin.
+// (1, 1, 1) (0: axis-aligned), covering the shape, centred at the origin,
+// or `shift_slices` of a slice off it along the third axis (a shape whose
+// top lies exactly on a slice centre, where the voxels cannot place it,
+// then ends between two).
 inline volume::LabelVolume sample_shape(const AnalyticShape& shape,
-                                        const std::array<double, 3>& spacing, double degrees = 0) {
+                                        const std::array<double, 3>& spacing, double degrees = 0,
+                                        double shift_slices = 0) {
   volume::LabelVolume v;
   auto& g = v.geometry;
   g.spacing = spacing;
@@ -104,6 +108,7 @@ inline volume::LabelVolume sample_shape(const AnalyticShape& shape,
   // Index (dims - 1) / 2 sits at the origin.
   std::array<double, 3> offset{};
   for (int a = 0; a < 3; ++a) offset[a] = -0.5 * double(g.dims[a] - 1) * spacing[a];
+  offset[2] += shift_slices * spacing[2];
   for (int r = 0; r < 3; ++r)
     g.origin[r] = g.direction[3 * r] * offset[0] + g.direction[3 * r + 1] * offset[1] +
                   g.direction[3 * r + 2] * offset[2];
