@@ -33,10 +33,9 @@ Box box_of(const surface::TriangleMesh& mesh) {
 }
 
 // The crossing pairs between `apart` and the triangles of `others` within
-// its box, per other label.
-std::map<int32_t, size_t> crossings_with(const SurfaceResult& apart,
+// its box `reach`, per other label.
+std::map<int32_t, size_t> crossings_with(const SurfaceResult& apart, const Box& reach,
                                          const std::vector<const SurfaceResult*>& others) {
-  const Box reach = box_of(apart.mesh);
   std::vector<std::array<double, 3>> points = apart.mesh.points;
   std::vector<std::array<uint32_t, 3>> triangles = apart.mesh.triangles;
   const auto own = static_cast<uint32_t>(triangles.size());
@@ -93,7 +92,7 @@ std::vector<LabelsCrossing> labels_crossing(const std::vector<SurfaceResult>& su
           (j > i || delivered[j]->stage == "net"))
         near.push_back(delivered[j]);
     if (near.empty()) continue;
-    for (const auto& [other, pairs] : crossings_with(*s, near))
+    for (const auto& [other, pairs] : crossings_with(*s, boxes[i], near))
       found.push_back({s->label, other, pairs});
   }
   return found;

@@ -23,7 +23,6 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <cstring>
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -136,6 +135,14 @@ std::optional<PhantomSurfaces> phantom_surfaces(const AnalyticShape& shape, cons
   return made;
 }
 
+// Where LABELMESH_BENCH_OUT=`out` keeps a phantom's files: its shape and
+// grid, spaces as underscores.
+std::string phantom_stem(const char* out, const AnalyticShape& shape, const Grid& grid) {
+  std::string name = shape.name + "-" + grid.name;
+  std::replace(name.begin(), name.end(), ' ', '_');
+  return std::string(out) + "/" + name;
+}
+
 int bench_phantoms() {
   const std::vector<Grid> grids{{"3 mm", {3, 3, 3}, 0},
                                 {"1x1x3 mm", {1, 1, 3}, 0},
@@ -162,8 +169,7 @@ int bench_phantoms() {
       // LABELMESH_BENCH_OUT=DIR keeps the three surfaces as STL, to look at,
       // and the phantom's volume, to mesh again.
       if (const char* out = std::getenv("LABELMESH_BENCH_OUT")) {
-        std::string stem = std::string(out) + "/" + shape.name + "-" + grid.name;
-        std::replace(stem.begin() + static_cast<long>(std::strlen(out)), stem.end(), ' ', '_');
+        const std::string stem = phantom_stem(out, shape, grid);
         (void)surface::write_surface(made->marching_cubes, stem + "-mc.stl",
                                      surface::SurfaceFormat::kStl);
         (void)surface::write_surface(made->slicer, stem + "-slicer.stl",
@@ -206,9 +212,7 @@ int bench_shares() {
       }
       const auto& g = made->volume.geometry;
       if (const char* out = std::getenv("LABELMESH_BENCH_OUT"))
-        (void)volume::write_label_volume(
-            made->volume, std::string(out) + "/" + shape.name + "-share-" +
-                              std::to_string(static_cast<int>(10 * grid.spacing[2])) + ".nii.gz");
+        (void)volume::write_label_volume(made->volume, phantom_stem(out, shape, grid) + ".nii.gz");
       std::printf("%-10s %-18s | %5.1f %5.1f %5.1f %5.1f (%s)\n", shape.name.c_str(), grid.name,
                   100 * surface::axis_aligned_share(made->ours, g, shape.normal),
                   100 * surface::axis_aligned_share(made->marching_cubes, g),
