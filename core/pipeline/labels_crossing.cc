@@ -5,6 +5,7 @@
 #include <array>
 #include <cstdint>
 #include <map>
+#include <utility>
 
 #include "core/surface/crossing_triangles.h"
 
@@ -73,13 +74,22 @@ std::map<int32_t, size_t> crossings_with(const SurfaceResult& apart, const Box& 
 
 }  // namespace
 
-std::vector<LabelsCrossing> labels_crossing(const std::vector<SurfaceResult>& surfaces) {
+std::vector<LabelsCrossing> labels_crossing(
+    const std::vector<SurfaceResult>& surfaces,
+    const std::vector<std::pair<int32_t, size_t>>& layer_of) {
+  const auto layer = [&](int32_t label) -> size_t {
+    const auto it =
+        std::lower_bound(layer_of.begin(), layer_of.end(), std::make_pair(label, size_t{0}));
+    return it != layer_of.end() && it->first == label ? it->second : 0;
+  };
   std::vector<const SurfaceResult*> delivered;
   std::vector<Box> boxes;
+  std::vector<size_t> layers;
   for (const auto& s : surfaces)
     if (s.is_output && !s.mesh.triangles.empty()) {
       delivered.push_back(&s);
       boxes.push_back(box_of(s.mesh));
+      layers.push_back(layer(s.label));
     }
   std::vector<LabelsCrossing> found;
   for (size_t i = 0; i < delivered.size(); ++i) {
@@ -88,8 +98,8 @@ std::vector<LabelsCrossing> labels_crossing(const std::vector<SurfaceResult>& su
     // Two labels made apart are tested once, from the first.
     std::vector<const SurfaceResult*> near;
     for (size_t j = 0; j < delivered.size(); ++j)
-      if (j != i && delivered[j]->label != s->label && boxes[i].meets(boxes[j]) &&
-          (j > i || delivered[j]->stage == "net"))
+      if (j != i && delivered[j]->label != s->label && layers[j] == layers[i] &&
+          boxes[i].meets(boxes[j]) && (j > i || delivered[j]->stage == "net"))
         near.push_back(delivered[j]);
     if (near.empty()) continue;
     for (const auto& [other, pairs] : crossings_with(*s, boxes[i], near))

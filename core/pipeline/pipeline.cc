@@ -282,6 +282,15 @@ std::vector<size_t> layer_of_labels(const std::vector<volume::LabelVolume>& laye
   return layer_of;
 }
 
+// Each label with its layer, sorted by label.
+std::vector<std::pair<int32_t, size_t>> label_layers(const std::vector<int32_t>& labels,
+                                                     const std::vector<size_t>& layer_of) {
+  std::vector<std::pair<int32_t, size_t>> pairs;
+  for (size_t i = 0; i < labels.size(); ++i) pairs.push_back({labels[i], layer_of[i]});
+  std::sort(pairs.begin(), pairs.end());
+  return pairs;
+}
+
 // Marching Cubes of each label from its own layer, in the order of `labels`.
 absl::StatusOr<std::vector<surface::LabelSurface>> extract_layer_surfaces(
     const std::vector<volume::LabelVolume>& layers, const std::vector<size_t>& layer_of,
@@ -566,10 +575,10 @@ absl::StatusOr<MeshResult> run_on_volume(const std::string& path,
   for (auto& surface : quality_surfaces) result.surfaces.push_back(std::move(surface));
   result.warnings = collect_warnings(result.surfaces, params);
   // Labels made apart from the shared net may enter their neighbours'
-  // surfaces; per-label methods asked for by name, and volumes whose
-  // segments overlap in the voxels (several layers), are made apart anyway.
-  if (params.surface == SurfaceMethod::kNet && layers.size() == 1)
-    for (const auto& c : labels_crossing(result.surfaces))
+  // surfaces; per-label methods asked for by name are made apart anyway,
+  // and so are segments of different layers (they overlap in the voxels).
+  if (params.surface == SurfaceMethod::kNet)
+    for (const auto& c : labels_crossing(result.surfaces, label_layers(labels, layer_of)))
       result.warnings.push_back(
           {c.label, cat("surface crosses label ", c.other, "'s: ", c.triangle_pairs,
                         " pair(s) of triangles pass through each other (made apart from the "

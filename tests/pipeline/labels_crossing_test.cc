@@ -9,6 +9,10 @@
 #include <utility>
 #include <vector>
 
+#include <vtkDataArray.h>
+#include <vtkImageData.h>
+#include <vtkPointData.h>
+
 #include "core/pipeline/pipeline.h"
 #include "core/volume/phantom.h"
 #include "support/status_matchers.h"
@@ -89,6 +93,16 @@ TEST(LabelsCrossing, EachOtherLabelIsNamedWithItsOwnPairs) {
   EXPECT_EQ(found[0].triangle_pairs, found[1].triangle_pairs);
 }
 
+TEST(LabelsCrossing, OnlyLabelsOfOneLayerAreTestedAgainstEachOther) {
+  const std::vector<SurfaceResult> surfaces{cube_surface(1, "net", {0, 0, 0}, 5),
+                                            cube_surface(2, "mask", {8, 1, 1}, 4)};
+  EXPECT_TRUE(labels_crossing(surfaces, {{1, 0}, {2, 1}}).empty());
+  const auto found = labels_crossing(surfaces, {{1, 1}, {2, 1}});
+  ASSERT_EQ(found.size(), 1u);
+  EXPECT_EQ(found[0].label, 2);
+  EXPECT_EQ(found[0].other, 1);
+}
+
 // On the thin shapes on 0.75 x 0.75 x 3 mm voxels some labels fall back to
 // the meshed mask, made apart from their neighbours; where such a surface
 // enters another label's, the run says so for that label (and --strict
@@ -107,6 +121,33 @@ TEST(LabelsCrossing, ARunWarnsOfEachCrossing) {
         [&](const LabelWarning& w) { return w.label == c.label && w.reason.find(named) == 0; }))
         << c.label << " crossing " << c.other;
   }
+}
+
+// The same thin shapes twice, as two layers of overlapping segments (the
+// second's labels 100 higher): labels made apart are tested against their
+// own layer's, where they cross as in one layer, and not against the other
+// layer's copies of the same voxels, which they cross everywhere.
+TEST(LabelsCrossing, ARunOfSeveralLayersWarnsWithinEachLayer) {
+  auto volume = volume::make_phantom(volume::PhantomShape::kThinShapesAnisotropic).volume;
+  auto copy = vtkSmartPointer<vtkImageData>::New();
+  copy->DeepCopy(volume.voxels);
+  auto* scalars = copy->GetPointData()->GetScalars();
+  for (vtkIdType i = 0; i < scalars->GetNumberOfTuples(); ++i)
+    if (scalars->GetTuple1(i) != 0) scalars->SetTuple1(i, scalars->GetTuple1(i) + 100);
+  volume.more_layers.push_back(copy);
+  auto result = run_pipeline_on_volume(std::move(volume), MeshParams{}, {});
+  ASSERT_THAT(result, testing::IsOk());
+  size_t crossing_warnings = 0, in_first_layer = 0;
+  for (const auto& w : result->warnings) {
+    const auto at = w.reason.find("surface crosses label ");
+    if (at != 0) continue;
+    ++crossing_warnings;
+    const int other = std::stoi(w.reason.substr(std::string("surface crosses label ").size()));
+    EXPECT_EQ(w.label >= 100, other >= 100) << w.label << " crossing " << other;
+    in_first_layer += w.label < 100;
+  }
+  EXPECT_GT(in_first_layer, 0u);
+  EXPECT_GT(crossing_warnings, in_first_layer);
 }
 
 }  // namespace
