@@ -28,6 +28,10 @@ constexpr int kBiasRounds = 6;
 constexpr double kBiasTolerance = 0.01;
 // The signed distances' clamp, in slices.
 constexpr float kBandSlices = 2;
+// The largest bias, in slices: below the distances' clamp, so that half
+// way between slices the interpolated distances still shape a biased label.
+constexpr double kMostBiasSlices = 1.5;
+static_assert(kMostBiasSlices < kBandSlices);
 // Slice distances kept between rounds: at most 256 MiB of them.
 constexpr size_t kCacheFloats = size_t{64} << 20;
 
@@ -446,11 +450,12 @@ absl::StatusOr<volume::LabelVolume> interpolate_thick_slices(const volume::Label
   // Interpolation thins narrow shapes; each label's bias is raised by its
   // missing volume spread over its boundary (by half a band for a label that
   // vanished, which has none) and over the thin slices' mean taper, at most
-  // half a band a round and two bands in all, until every label has its
-  // voxels' volume to within kBiasTolerance or the rounds run out; the
-  // best round's biases are kept. The band here is one slice's thickness:
-  // a tube whose last drawn slices just hold it rounds off a whole slice
-  // short of the next, and takes more than a band to get its volume back.
+  // half a band a round and kMostBiasSlices bands in all, until every label
+  // has its voxels' volume to within kBiasTolerance or the rounds run out;
+  // the best round's biases are kept. The band here is one slice's
+  // thickness: a tube whose last drawn slices just hold it rounds off a
+  // whole slice short of the next, and takes more than a band to get its
+  // volume back.
   std::fill(out, out + fine.geometry.voxel_count(), 0);
   const SliceInterpolator interpolator(volume, labels, cut);
   const auto& present = interpolator.present();
@@ -519,7 +524,8 @@ absl::StatusOr<volume::LabelVolume> interpolate_thick_slices(const volume::Label
       // neighbours' biases pushed it out before): the bias bends walls.
       // The outside is always within it, counted against the whole box.
       if (std::abs(missing) <= kBiasTolerance * std::max(1.0, double(target[l]))) continue;
-      bias[l] = std::clamp(bias[l] + std::clamp(change, -band / 2, band / 2), -2 * band, 2 * band);
+      bias[l] = std::clamp(bias[l] + std::clamp(change, -band / 2, band / 2),
+                           -kMostBiasSlices * band, kMostBiasSlices * band);
     }
   }
   return fine;

@@ -250,9 +250,23 @@ TEST(ThickSlices, ATubeTwoSlicesThickKeepsItsVolume) {
   }
   ASSERT_EQ(holding.size(), 2u);
   EXPECT_NEAR(grid.to_physical({0, 0, double(holding[0])})[2], -1.5, 1e-9);
-  const auto fine_volumes = label_volumes(interpolated(thick, cut));
+  const auto fine = interpolated(thick, cut);
+  const auto fine_volumes = label_volumes(fine);
   // Within the 1 % the bias aims at.
   EXPECT_NEAR(fine_volumes.at(1) / thick_volumes.at(1), 1.0, 0.01);
+  // From its middle out, no thin slice holds more of the tube than the one
+  // inside it, and none holds it beyond the drawn voxels' reach: the six
+  // thin slices between their outer faces hold it (with this bias each
+  // holds the drawn slices' whole cross-section, a block the net rounds).
+  const auto thin = labels_of(fine);
+  const int64_t slices = fine.geometry.dims[2];
+  std::vector<int64_t> area(static_cast<size_t>(slices), 0);
+  for (int64_t z = 0; z < slices; ++z)
+    area[z] = std::count(thin.begin() + z * plane, thin.begin() + (z + 1) * plane, 1);
+  const auto widest = std::max_element(area.begin(), area.end()) - area.begin();
+  for (int64_t z = widest + 1; z < slices; ++z) EXPECT_LE(area[z], area[z - 1]) << "slice " << z;
+  for (int64_t z = widest - 1; z >= 0; --z) EXPECT_LE(area[z], area[z + 1]) << "slice " << z;
+  EXPECT_EQ(std::count_if(area.begin(), area.end(), [](int64_t a) { return a > 0; }), 6);
 }
 
 // A sphere of radius 25 mm on 1 x 1 x 3 mm slices, where its walls lean
