@@ -77,10 +77,12 @@ std::map<int32_t, size_t> crossings_with(const SurfaceResult& apart, const Box& 
 std::vector<LabelsCrossing> labels_crossing(
     const std::vector<SurfaceResult>& surfaces,
     const std::vector<std::pair<int32_t, size_t>>& layer_of) {
+  auto sorted = layer_of;
+  std::sort(sorted.begin(), sorted.end());
   const auto layer = [&](int32_t label) -> size_t {
     const auto it =
-        std::lower_bound(layer_of.begin(), layer_of.end(), std::make_pair(label, size_t{0}));
-    return it != layer_of.end() && it->first == label ? it->second : 0;
+        std::lower_bound(sorted.begin(), sorted.end(), std::make_pair(label, size_t{0}));
+    return it != sorted.end() && it->first == label ? it->second : 0;
   };
   std::vector<const SurfaceResult*> delivered;
   std::vector<Box> boxes;

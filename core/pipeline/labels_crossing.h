@@ -28,9 +28,11 @@ struct LabelsCrossing {
 // `surfaces`, each one's crossings by the other label's number. Two labels
 // made apart that cross are listed once, under the first. A surface wholly
 // inside another crosses none of its triangles and is not seen. Surfaces
-// that are all "net" give none. With `layer_of` (label, layer), sorted by
-// label, only labels of one layer are tested against each other: segments
-// of different layers overlap in the voxels, and so may their surfaces.
+// that are all "net" give none. With `layer_of` (label, layer pairs; a
+// label not listed is in layer 0), only labels of one layer are tested
+// against each other: a layer's segments overlap some of the other layers'
+// in the voxels, and so may their surfaces. Two segments of different
+// layers that do not overlap are not tested either.
 std::vector<LabelsCrossing> labels_crossing(
     const std::vector<SurfaceResult>& surfaces,
     const std::vector<std::pair<int32_t, size_t>>& layer_of = {});

@@ -282,12 +282,11 @@ std::vector<size_t> layer_of_labels(const std::vector<volume::LabelVolume>& laye
   return layer_of;
 }
 
-// Each label with its layer, sorted by label.
+// Each label with its layer.
 std::vector<std::pair<int32_t, size_t>> label_layers(const std::vector<int32_t>& labels,
                                                      const std::vector<size_t>& layer_of) {
   std::vector<std::pair<int32_t, size_t>> pairs;
   for (size_t i = 0; i < labels.size(); ++i) pairs.push_back({labels[i], layer_of[i]});
-  std::sort(pairs.begin(), pairs.end());
   return pairs;
 }
 
