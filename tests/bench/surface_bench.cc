@@ -233,6 +233,10 @@ struct VolumeFigures {
   int labels = 0, ours_within = 0, slicer_within = 0, ours_within_slicer_plus5 = 0;
   double ours_min_angle = 180;
   int ours_poisson = 0;
+  // Nodes over all labels, ours and Marching Cubes', and the labels whose
+  // surface has more than Marching Cubes' plus two per component.
+  uint64_t ours_nodes = 0, mc_nodes = 0;
+  int labels_above_mc_nodes = 0;
 };
 
 // A volume file read, with its labels (every one, in statistics order).
@@ -404,6 +408,12 @@ int bench_volume(const std::string& path, int rounds) {
             a.voxels ? 100 * a.voxels->volume_change : -1.0);
     if (ours->stage.rfind("poisson", 0) == 0) ++f.ours_poisson;
     f.ours_min_angle = std::min(f.ours_min_angle, ours->statistics.min_angle_deg);
+    if (mc != nullptr) {
+      f.ours_nodes += ours->statistics.nodes;
+      f.mc_nodes += mc->statistics.nodes;
+      if (ours->statistics.nodes > mc->statistics.nodes + 2 * mc->statistics.components)
+        ++f.labels_above_mc_nodes;
+    }
     if (const char* out = std::getenv("LABELMESH_BENCH_OUT")) {
       const std::string stem = std::string(out) + "/label" + std::to_string(labels[i]);
       (void)surface::write_surface(slicer[i].mesh, stem + "-slicer.stl",
@@ -464,6 +474,11 @@ int bench_volume(const std::string& path, int rounds) {
       "  labels %d: within the voxel tolerance ours %d, Slicer-like %d; ours by Poisson %d; "
       "ours min angle %.1f deg\n",
       f.labels, f.ours_within, f.slicer_within, f.ours_poisson, f.ours_min_angle);
+  std::printf(
+      "  nodes over all labels: ours %llu, Marching Cubes %llu (ratio %.2f); labels above "
+      "Marching Cubes' count plus two per component: %d\n",
+      static_cast<unsigned long long>(f.ours_nodes), static_cast<unsigned long long>(f.mc_nodes),
+      double(f.ours_nodes) / double(std::max<uint64_t>(1, f.mc_nodes)), f.labels_above_mc_nodes);
   std::printf(
       "  Slicer-like against the voxels, median over labels: misclassified %.2f %% of boundary "
       "voxels, Hausdorff %.2f voxels, |volume change| %.2f %%\n",
