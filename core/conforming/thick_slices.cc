@@ -99,17 +99,61 @@ std::vector<float> distance_to(const std::vector<uint8_t>& inside, int64_t nu, i
   return d;
 }
 
-// The volume's labels as int32, unselected ones 0.
-std::vector<int32_t> selected_labels(const volume::LabelVolume& volume,
-                                     std::vector<int32_t> selected) {
+// The box the interpolation covers around the selected labels' `box`: two
+// slices more along the cut axis (the cubic reads two on either side), and
+// in the slices the distances' clamp and two voxels more: every pixel
+// within the clamp of a label is then in it, so each label's clamped
+// distance is the whole volume's (a margin of a voxel or two would do
+// nearly as well, at a fraction of a pixel's error where a label's nearest
+// outside pixel lies beyond it). A thin voxel takes only labels drawn at
+// its pixel, so outside it every thinner voxel is 0, as it would be from
+// the whole volume. With no label, a voxel's box.
+struct CoveredBox {
+  std::array<int64_t, 3> lo{0, 0, 0}, dims{0, 0, 0};
+};
+CoveredBox covered_box(volume::VoxelBox box, const volume::ImageGeometry& geometry, int axis) {
+  if (box.empty()) box.last = box.first;
+  const double band = kBandSlices * geometry.spacing[axis];
+  CoveredBox covered;
+  for (int k = 0; k < 3; ++k) {
+    const auto margin =
+        k == axis ? int64_t{2} : static_cast<int64_t>(std::ceil(band / geometry.spacing[k])) + 2;
+    covered.lo[k] = std::max<int64_t>(0, box.first[k] - margin);
+    covered.dims[k] = std::min(geometry.dims[k] - 1, box.last[k] + margin) - covered.lo[k] + 1;
+  }
+  return covered;
+}
+
+// The labels of `volume` in the box the interpolation covers (cut along
+// `axis`), x fastest: `selected` ones (every non-zero one when empty), the
+// others 0. Beyond the box every voxel is 0.
+struct BoxLabels {
+  CoveredBox box;
+  std::vector<int32_t> labels;
+};
+BoxLabels selected_in_box(const volume::LabelVolume& volume, std::vector<int32_t> selected,
+                          int axis) {
   std::sort(selected.begin(), selected.end());
-  std::vector<int32_t> out(static_cast<size_t>(volume.geometry.voxel_count()), 0);
-  volume::visit_voxels(volume.voxels, [&](const auto* voxels, size_t count) {
-    for (size_t i = 0; i < std::min(count, out.size()); ++i) {
-      const auto label = static_cast<int32_t>(voxels[i]);
-      if (selected.empty() || std::binary_search(selected.begin(), selected.end(), label))
-        out[i] = label;
-    }
+  const auto keep = [&](auto voxel) {
+    const auto label = static_cast<int32_t>(voxel);
+    return label != 0 &&
+                   (selected.empty() || std::binary_search(selected.begin(), selected.end(), label))
+               ? label
+               : 0;
+  };
+  BoxLabels out;
+  const auto& dims = volume.geometry.dims;
+  volume::visit_voxels(volume.voxels, [&](const auto* voxels, size_t) {
+    out.box = covered_box(volume::voxel_box(voxels, dims, [&](auto v) { return keep(v) != 0; }),
+                          volume.geometry, axis);
+    const auto& lo = out.box.lo;
+    const auto& d = out.box.dims;
+    out.labels.resize(static_cast<size_t>(d[0] * d[1] * d[2]));
+    size_t o = 0;
+    for (int64_t z = lo[2]; z < lo[2] + d[2]; ++z)
+      for (int64_t y = lo[1]; y < lo[1] + d[1]; ++y)
+        for (int64_t x = lo[0]; x < lo[0] + d[0]; ++x)
+          out.labels[o++] = keep(voxels[static_cast<size_t>((z * dims[1] + y) * dims[0] + x)]);
   });
   return out;
 }
@@ -162,15 +206,24 @@ class SliceInterpolator {
         // much before moving on, a stair of the thick slices in its slope.
         edge_(static_cast<float>(0.5 * std::min(volume.geometry.spacing[(cut.axis + 1) % 3],
                                                 volume.geometry.spacing[(cut.axis + 2) % 3]))) {
-    const auto all = selected_labels(volume, labels);
-    present_ = all;
+    const auto in_box = selected_in_box(volume, labels, a_);
+    lo_ = in_box.box.lo;
+    dims_ = in_box.box.dims;
+    present_ = in_box.labels;
+    // Beyond a box smaller than the volume every voxel is 0.
+    if (dims_ != geometry_.dims) present_.push_back(0);
     std::sort(present_.begin(), present_.end());
     present_.erase(std::unique(present_.begin(), present_.end()), present_.end());
-    crop_to_labels(all);
+    source_slots_.reserve(in_box.labels.size());
+    for (const int32_t label : in_box.labels)
+      source_slots_.push_back(static_cast<uint32_t>(at(label)));
     cache_.resize(static_cast<size_t>(dims_[a_]));
   }
 
   const std::vector<int32_t>& present() const { return present_; }
+  // The box covered, on the drawn grid.
+  const std::array<int64_t, 3>& box_first() const { return lo_; }
+  const std::array<int64_t, 3>& box_dims() const { return dims_; }
 
   // The bias taper's mean over the thin slices of one thick slice. Beyond
   // the first and last slice centres the fill's place is clamped there and
@@ -193,21 +246,18 @@ class SliceInterpolator {
     return counts;
   }
 
-  // Fills `out` (the thinner grid, x fastest) with `bias[l]` added to label
+  // Fills `out` (the covered box on the thinner grid, x fastest) with `bias[l]` added to label
   // l's distances; returns each label's voxels and how many of them touch
   // another label across a face.
-  // `out` outside the labels' box must hold 0 already.
   void fill(const std::vector<double>& bias, int32_t* out, std::vector<uint64_t>& counts,
             std::vector<uint64_t>& boundary) const {
     const int64_t na = geometry_.dims[a_], nu = dims_[u_], nv = dims_[v_];
-    std::array<int64_t, 3> fine_dims = geometry_.dims;
-    fine_dims[a_] *= cut_.parts;
-    const std::array<int64_t, 3> stride{1, fine_dims[0], fine_dims[0] * fine_dims[1]};
-    // The box on the thinner grid, and its first voxel's index there.
+    // The box on the thinner grid: where its first thin slice lies, and its
+    // size, which `out` has.
     std::array<int64_t, 3> fine_lo = lo_, fine_box = dims_;
     fine_lo[a_] *= cut_.parts;
     fine_box[a_] *= cut_.parts;
-    const int64_t corner = fine_lo[0] * stride[0] + fine_lo[1] * stride[1] + fine_lo[2] * stride[2];
+    const std::array<int64_t, 3> stride{1, fine_box[0], fine_box[0] * fine_box[1]};
     // The four slices around each thin one: before, below, above, after.
     // Slices beyond the box hold no selected label, as its edge slices do.
     int64_t held = -1;
@@ -260,25 +310,26 @@ class SliceInterpolator {
               best = l;
             }
           }
-          out[corner + j * stride[a_] + pu * stride[u_] + pv * stride[v_]] = present_[best];
+          out[j * stride[a_] + pu * stride[u_] + pv * stride[v_]] = present_[best];
         }
       }
     }
     counts.assign(present_.size(), 0);
     boundary.assign(present_.size(), 0);
     add_outside_box(counts, cut_.parts);
-    for (int64_t z = fine_lo[2]; z < fine_lo[2] + fine_box[2]; ++z) {
-      for (int64_t y = fine_lo[1]; y < fine_lo[1] + fine_box[1]; ++y) {
-        for (int64_t x = fine_lo[0]; x < fine_lo[0] + fine_box[0]; ++x) {
+    // Only 0 lies at the box's faces, but where they are the volume's own.
+    for (int64_t z = 0; z < fine_box[2]; ++z) {
+      for (int64_t y = 0; y < fine_box[1]; ++y) {
+        for (int64_t x = 0; x < fine_box[0]; ++x) {
           const int64_t i = x + y * stride[1] + z * stride[2];
           const size_t l = at(out[i]);
           ++counts[l];
           const bool touches = (x > 0 && out[i - 1] != out[i]) ||
-                               (x + 1 < fine_dims[0] && out[i + 1] != out[i]) ||
+                               (x + 1 < fine_box[0] && out[i + 1] != out[i]) ||
                                (y > 0 && out[i - stride[1]] != out[i]) ||
-                               (y + 1 < fine_dims[1] && out[i + stride[1]] != out[i]) ||
+                               (y + 1 < fine_box[1] && out[i + stride[1]] != out[i]) ||
                                (z > 0 && out[i - stride[2]] != out[i]) ||
-                               (z + 1 < fine_dims[2] && out[i + stride[2]] != out[i]);
+                               (z + 1 < fine_box[2] && out[i + stride[2]] != out[i]);
           boundary[l] += touches;
         }
       }
@@ -289,37 +340,6 @@ class SliceInterpolator {
   size_t at(int32_t label) const {
     return static_cast<size_t>(std::lower_bound(present_.begin(), present_.end(), label) -
                                present_.begin());
-  }
-
-  // The selected labels' box with a margin: two slices along the thick axis
-  // (the cubic reads two on either side), and in the slices the distances'
-  // clamp and two voxels: every pixel within the clamp of a label is then
-  // in the box, so each label's clamped distance is the whole volume's
-  // (a margin of a voxel or two would do nearly as well, at a fraction of
-  // a pixel's error where a label's nearest outside pixel lies beyond it).
-  // A thin voxel takes only labels drawn at its pixel, so outside the box
-  // every thinner voxel is 0, as it would be from the whole volume.
-  // present_ must hold every label of `all` already.
-  void crop_to_labels(const std::vector<int32_t>& all) {
-    const auto& dims = geometry_.dims;
-    auto box = volume::voxel_box(all.data(), dims, [](int32_t label) { return label != 0; });
-    // With no label, a voxel's box: margins as around one.
-    if (box.empty()) box.last = box.first;
-    const auto& first = box.first;
-    const auto& last = box.last;
-    for (int k = 0; k < 3; ++k) {
-      const auto margin =
-          k == a_ ? int64_t{2} : static_cast<int64_t>(std::ceil(band_ / geometry_.spacing[k])) + 2;
-      lo_[k] = std::max<int64_t>(0, first[k] - margin);
-      dims_[k] = std::min(dims[k] - 1, last[k] + margin) - lo_[k] + 1;
-    }
-    source_slots_.resize(static_cast<size_t>(dims_[0] * dims_[1] * dims_[2]));
-    size_t o = 0;
-    for (int64_t z = lo_[2]; z < lo_[2] + dims_[2]; ++z)
-      for (int64_t y = lo_[1]; y < lo_[1] + dims_[1]; ++y)
-        for (int64_t x = lo_[0]; x < lo_[0] + dims_[0]; ++x)
-          source_slots_[o++] =
-              static_cast<uint32_t>(at(all[static_cast<size_t>((z * dims[1] + y) * dims[0] + x)]));
   }
 
   // Adds the voxels outside the box, `parts` per thick one, to label 0's
@@ -391,7 +411,7 @@ class SliceInterpolator {
   const int a_, u_, v_;
   const float band_;
   const float edge_;
-  // The selected labels' box (crop_to_labels), and each of its voxels'
+  // The box covered (selected_in_box), and each of its voxels'
   // label as its place in present_, so the fill weighs labels by place.
   std::array<int64_t, 3> lo_{0, 0, 0}, dims_{0, 0, 0};
   std::vector<uint32_t> source_slots_;
@@ -417,6 +437,17 @@ ThickSlices find_thick_slices(const volume::ImageGeometry& geometry,
   return parts >= 2 ? ThickSlices{axis, parts} : ThickSlices{};
 }
 
+ThickSlices find_thick_slices(const volume::LabelVolume& volume, const std::vector<int32_t>& labels,
+                              const ThickSliceParams& params) {
+  ThickSliceParams uncapped = params;
+  uncapped.max_voxels = std::numeric_limits<int64_t>::max();
+  const ThickSlices axis = find_thick_slices(volume.geometry, uncapped);
+  if (axis.axis < 0) return {};
+  volume::ImageGeometry covered = volume.geometry;
+  covered.dims = selected_in_box(volume, labels, axis.axis).box.dims;
+  return find_thick_slices(covered, params);
+}
+
 absl::StatusOr<volume::LabelVolume> interpolate_thick_slices(const volume::LabelVolume& volume,
                                                              const std::vector<int32_t>& labels,
                                                              const ThickSlices& cut,
@@ -426,15 +457,20 @@ absl::StatusOr<volume::LabelVolume> interpolate_thick_slices(const volume::Label
     return absl::InvalidArgumentError(
         cat("thick slices: cannot cut axis ", cut.axis, " into ", cut.parts, " parts"));
   }
+  const SliceInterpolator interpolator(volume, labels, cut);
+  // The thinner grid covers the labels' box (covered_box): the same
+  // directions, `cut.parts` slices for each drawn one.
   volume::LabelVolume fine;
   fine.format = volume.format;
   fine.file_voxel_type = volume.file_voxel_type;
   fine.descriptions = volume.descriptions;
   fine.geometry = geometry;
+  fine.geometry.dims = interpolator.box_dims();
   fine.geometry.dims[cut.axis] *= cut.parts;
   fine.geometry.spacing[cut.axis] /= cut.parts;
   std::array<double, 3> first{0, 0, 0};
-  first[cut.axis] = -0.5 + 0.5 / cut.parts;
+  for (int k = 0; k < 3; ++k) first[k] = double(interpolator.box_first()[k]);
+  first[cut.axis] += -0.5 + 0.5 / cut.parts;
   fine.geometry.origin = geometry.to_physical(first);
   fine.voxels = vtkSmartPointer<vtkImageData>::New();
   fine.voxels->SetDimensions(static_cast<int>(fine.geometry.dims[0]),
@@ -456,8 +492,6 @@ absl::StatusOr<volume::LabelVolume> interpolate_thick_slices(const volume::Label
   // thickness: a tube whose last drawn slices just hold it rounds off a
   // whole slice short of the next, and takes more than a band to get its
   // volume back.
-  std::fill(out, out + fine.geometry.voxel_count(), 0);
-  const SliceInterpolator interpolator(volume, labels, cut);
   const auto& present = interpolator.present();
   std::vector<uint64_t> target = interpolator.source_counts();
   for (auto& count : target) count *= cut.parts;

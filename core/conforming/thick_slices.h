@@ -45,9 +45,18 @@ struct ThickSlices {
 ThickSlices find_thick_slices(const volume::ImageGeometry& geometry,
                               const ThickSliceParams& params);
 
+// As above, with the thinner voxels counted over the part of `volume` that
+// interpolate_thick_slices covers for `labels` (their box and the margins
+// it reads), not over the whole field of view.
+ThickSlices find_thick_slices(const volume::LabelVolume& volume, const std::vector<int32_t>& labels,
+                              const ThickSliceParams& params);
+
 // The volume of `labels` (every non-zero label when empty; the others become
-// 0) on the thinner grid: the same extent and directions, `cut.parts` slices
-// for each slice along `cut.axis`, int32 voxels. Beyond the first and last
+// 0) on the thinner grid: the same directions, `cut.parts` slices for each
+// slice along `cut.axis`, int32 voxels, over the labels' box with two
+// drawn slices more along the axis and the distances' clamp and two voxels
+// more across it (clipped to the volume): outside it every thinner voxel
+// would be 0. Beyond the first and last
 // slice centres the labels do not change along the axis. Each label's
 // distances carry a bias that keeps its volume within 1 % of its voxels'
 // where a few rounds can. The bias fades to nothing at the thick slices'

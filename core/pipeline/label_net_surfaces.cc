@@ -78,15 +78,16 @@ std::vector<int32_t> touching_labels(const conforming::InterfaceSurface& net) {
   return touching;
 }
 
-// Which axis of `geometry` is cut into thinner slices for the net, if any.
-conforming::ThickSlices thick_slices(const volume::ImageGeometry& geometry,
-                                     const NetOptions& options) {
+// Which axis of `layer` is cut into thinner slices for the net of `here`,
+// if any.
+conforming::ThickSlices thick_slices(const volume::LabelVolume& layer,
+                                     const std::vector<int32_t>& here, const NetOptions& options) {
   if (options.thick_ratio <= 0) return {};
   conforming::ThickSliceParams params;
   params.min_ratio = options.thick_ratio;
   params.thin_ratio = options.thin_ratio;
   params.max_voxels = options.max_thin_voxels;
-  return conforming::find_thick_slices(geometry, params);
+  return conforming::find_thick_slices(layer, here, params);
 }
 
 double anisotropy(const volume::ImageGeometry& geometry) {
@@ -113,7 +114,7 @@ absl::StatusOr<LayerNet> layer_net(const volume::LabelVolume& layer,
                                    std::vector<uint64_t> joined_voxels = {}) {
   LayerNet made;
   conforming::InterfaceFigures figures;
-  const auto cut = thick_slices(layer.geometry, options);
+  const auto cut = thick_slices(layer, here, options);
   if (cut.axis < 0) {
     made.geometry = layer.geometry;
     auto params = interface_params(options);
@@ -509,7 +510,7 @@ absl::Status join_crossing_faces(const std::vector<volume::LabelVolume>& layers,
   constexpr size_t kMostPairsJoinedLocally = 4096;
   for (size_t layer = 0; layer < built.nets.size(); ++layer) {
     // A net on thinner slices has no parted faces to join.
-    if (thick_slices(layers[layer].geometry, params.net).axis >= 0) continue;
+    if (thick_slices(layers[layer], built.layer_labels[layer], params.net).axis >= 0) continue;
     std::vector<uint64_t> joined;
     for (int round = 0; round <= kJoinRounds; ++round) {
       LABELMESH_RETURN_IF_ERROR(context.check_stop());
