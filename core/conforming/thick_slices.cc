@@ -124,6 +124,30 @@ CoveredBox covered_box(volume::VoxelBox box, const volume::ImageGeometry& geomet
   return covered;
 }
 
+// Whether `voxel` holds one of `selected` (sorted; every non-zero label
+// when empty): its label if so, else 0.
+template <typename T>
+int32_t selected_label(T voxel, const std::vector<int32_t>& selected) {
+  const auto label = static_cast<int32_t>(voxel);
+  return label != 0 &&
+                 (selected.empty() || std::binary_search(selected.begin(), selected.end(), label))
+             ? label
+             : 0;
+}
+
+// The box the interpolation covers for `selected` (sorted) along `axis`. A
+// scalar array shorter than the grid (readers refuse those) counts as empty.
+CoveredBox selected_box(const volume::LabelVolume& volume, const std::vector<int32_t>& selected,
+                        int axis) {
+  volume::VoxelBox box;
+  const auto& dims = volume.geometry.dims;
+  volume::visit_voxels(volume.voxels, [&](const auto* voxels, size_t count) {
+    if (count < static_cast<size_t>(volume.geometry.voxel_count())) return;
+    box = volume::voxel_box(voxels, dims, [&](auto v) { return selected_label(v, selected) != 0; });
+  });
+  return covered_box(box, volume.geometry, axis);
+}
+
 // The labels of `volume` in the box the interpolation covers (cut along
 // `axis`), x fastest: `selected` ones (every non-zero one when empty), the
 // others 0. Beyond the box every voxel is 0.
@@ -134,26 +158,20 @@ struct BoxLabels {
 BoxLabels selected_in_box(const volume::LabelVolume& volume, std::vector<int32_t> selected,
                           int axis) {
   std::sort(selected.begin(), selected.end());
-  const auto keep = [&](auto voxel) {
-    const auto label = static_cast<int32_t>(voxel);
-    return label != 0 &&
-                   (selected.empty() || std::binary_search(selected.begin(), selected.end(), label))
-               ? label
-               : 0;
-  };
   BoxLabels out;
+  out.box = selected_box(volume, selected, axis);
+  const auto& lo = out.box.lo;
+  const auto& d = out.box.dims;
   const auto& dims = volume.geometry.dims;
-  volume::visit_voxels(volume.voxels, [&](const auto* voxels, size_t) {
-    out.box = covered_box(volume::voxel_box(voxels, dims, [&](auto v) { return keep(v) != 0; }),
-                          volume.geometry, axis);
-    const auto& lo = out.box.lo;
-    const auto& d = out.box.dims;
-    out.labels.resize(static_cast<size_t>(d[0] * d[1] * d[2]));
+  out.labels.assign(static_cast<size_t>(d[0] * d[1] * d[2]), 0);
+  volume::visit_voxels(volume.voxels, [&](const auto* voxels, size_t count) {
+    if (count < static_cast<size_t>(volume.geometry.voxel_count())) return;
     size_t o = 0;
     for (int64_t z = lo[2]; z < lo[2] + d[2]; ++z)
       for (int64_t y = lo[1]; y < lo[1] + d[1]; ++y)
         for (int64_t x = lo[0]; x < lo[0] + d[0]; ++x)
-          out.labels[o++] = keep(voxels[static_cast<size_t>((z * dims[1] + y) * dims[0] + x)]);
+          out.labels[o++] = selected_label(
+              voxels[static_cast<size_t>((z * dims[1] + y) * dims[0] + x)], selected);
   });
   return out;
 }
@@ -443,8 +461,10 @@ ThickSlices find_thick_slices(const volume::LabelVolume& volume, const std::vect
   uncapped.max_voxels = std::numeric_limits<int64_t>::max();
   const ThickSlices axis = find_thick_slices(volume.geometry, uncapped);
   if (axis.axis < 0) return {};
+  auto selected = labels;
+  std::sort(selected.begin(), selected.end());
   volume::ImageGeometry covered = volume.geometry;
-  covered.dims = selected_in_box(volume, labels, axis.axis).box.dims;
+  covered.dims = selected_box(volume, selected, axis.axis).dims;
   return find_thick_slices(covered, params);
 }
 

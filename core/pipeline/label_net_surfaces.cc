@@ -509,8 +509,9 @@ absl::Status join_crossing_faces(const std::vector<volume::LabelVolume>& layers,
   // around them would cost more memory than the parting is worth.
   constexpr size_t kMostPairsJoinedLocally = 4096;
   for (size_t layer = 0; layer < built.nets.size(); ++layer) {
-    // A net on thinner slices has no parted faces to join.
-    if (thick_slices(layers[layer], built.layer_labels[layer], params.net).axis >= 0) continue;
+    // A net on thinner slices (the one with a staircase of its own) has no
+    // parted faces to join.
+    if (built.staircases[layer]) continue;
     std::vector<uint64_t> joined;
     for (int round = 0; round <= kJoinRounds; ++round) {
       LABELMESH_RETURN_IF_ERROR(context.check_stop());
