@@ -264,9 +264,9 @@ class SliceInterpolator {
     return counts;
   }
 
-  // Fills `out` (the covered box on the thinner grid, x fastest) with `bias[l]` added to label
-  // l's distances; returns each label's voxels and how many of them touch
-  // another label across a face.
+  // Fills `out` (the covered box on the thinner grid, x fastest) with
+  // `bias[l]` added to label l's distances; returns each label's voxels and
+  // how many of them touch another label across a face.
   void fill(const std::vector<double>& bias, int32_t* out, std::vector<uint64_t>& counts,
             std::vector<uint64_t>& boundary) const {
     const int64_t na = geometry_.dims[a_], nu = dims_[u_], nv = dims_[v_];
