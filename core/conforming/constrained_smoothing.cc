@@ -22,7 +22,9 @@ constexpr size_t kThreadedSmoothingPoints = 20'000;
 // Single precision holds a place 500 mm from the origin to 0.00003 mm; after
 // all the rounds the points lie within 0.001 mm of the double-precision
 // ones on the DICOM slab. A box centre's spare is 1 where the box widens
-// between drawn slices (PointBoxes::widens), read with the centre.
+// between drawn slices (PointBoxes::widens) and 0 elsewhere, so the flag is
+// loaded with the centre; the clamps' spares are 0, so a place's spare stays
+// 0 and is never read.
 using Lanes = float __attribute__((vector_size(16)));
 
 Lanes to_lanes(const Vec3& v) {
@@ -30,28 +32,28 @@ Lanes to_lanes(const Vec3& v) {
 }
 
 // between_drawn (point_boxes.h) in single precision, its divisions made
-// multiplications: it runs for every point at every step on thinner slices,
-// where with a division and a look-up of the narrow points the steps took a
-// quarter longer.
+// multiplications by reciprocals taken once: it runs for every point at
+// every step on thinner slices.
 class BetweenDrawn {
  public:
   BetweenDrawn(double first, double spacing)
       : first_(static_cast<float>(first)),
         spacing_(static_cast<float>(spacing)),
         per_spacing_(spacing > 0 ? static_cast<float>(1 / spacing) : 0.0f),
-        per_half_(spacing > 0 ? static_cast<float>(2 / spacing) : 0.0f),
-        per_rest_(static_cast<float>(1 / (1 - kNarrowNearDrawn))) {}
+        per_half_spacing_(spacing > 0 ? static_cast<float>(2 / spacing) : 0.0f) {}
 
   float operator()(float place) const {
     const float offset = place - first_;
     const float into = offset - std::floor(offset * per_spacing_) * spacing_;
-    const float between = std::min(into, spacing_ - into) * per_half_;
-    return std::clamp((between - kNarrow) * per_rest_, 0.0f, 1.0f);
+    const float between = std::min(into, spacing_ - into) * per_half_spacing_;
+    return std::clamp((between - kNarrow) * kPerWideningSpan, 0.0f, 1.0f);
   }
 
  private:
   static constexpr auto kNarrow = static_cast<float>(kNarrowNearDrawn);
-  float first_, spacing_, per_spacing_, per_half_, per_rest_;
+  // Over the part of the way to the middle where boxes widen.
+  static constexpr auto kPerWideningSpan = static_cast<float>(1 / (1 - kNarrowNearDrawn));
+  float first_, spacing_, per_spacing_, per_half_spacing_;
 };
 
 }  // namespace
