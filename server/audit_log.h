@@ -15,19 +15,20 @@
 
 namespace labelmesh::server {
 
+// One event. Every field starts empty, so an entry names only those it has.
 struct AuditEntry {
   // accepted, refused, deleted, expired, unauthenticated.
-  std::string event;
-  std::string job_id;
-  std::string identity;
+  std::string event{};
+  std::string job_id{};
+  std::string identity{};
   // The client host, e.g. "ipv4:10.0.0.7".
-  std::string peer;
+  std::string peer{};
   // The RPC, e.g. "Submit".
-  std::string call;
+  std::string call{};
   // A gRPC status code name when refused, e.g. "INVALID_ARGUMENT".
-  std::string code;
+  std::string code{};
   // A short reason code, e.g. "bad_volume", "queue_full".
-  std::string reason;
+  std::string reason{};
 };
 
 // One line of JSON (no newline) for `entry`, stamped `time_utc`.
