@@ -105,9 +105,10 @@ class CrossingTest {
 // The triangles' boxes in a grid whose cells are at least as wide as any
 // box along each axis, each box filed under the cell of its low corner. Two
 // boxes that meet then have their low corners in the same or neighbouring
-// cells, so each triangle's candidates are those of 27 cells. (CGAL's
-// general box intersection spends its time scanning long sorted runs on a
-// surface of many small boxes of one size.)
+// cells, so each triangle's candidates are those of 27 cells, and all the
+// meeting pairs are those of each cell with itself and 13 of its neighbours.
+// (CGAL's general box intersection spends its time scanning long sorted runs
+// on a surface of many small boxes of one size.)
 class BoxGrid {
  public:
   BoxGrid(const CrossingTest& test, size_t count) : boxes_(count) {
@@ -134,6 +135,46 @@ class BoxGrid {
       auto& range = cells_[filed[i].first];
       if (range.second == 0) range.first = static_cast<uint32_t>(i);
       range.second = static_cast<uint32_t>(i + 1);
+      if (i == 0 || filed[i].first != filed[i - 1].first)
+        filled_.push_back({filed[i].first, static_cast<uint32_t>(i), 0});
+      filled_.back().end = static_cast<uint32_t>(i + 1);
+    }
+  }
+
+  // The cells holding a box, numbered in key order: how many, and the first
+  // one with at least `filed` triangles filed in the cells before it.
+  size_t cell_count() const { return filled_.size(); }
+  size_t first_cell_after(uint32_t filed) const {
+    return static_cast<size_t>(
+        std::partition_point(filled_.begin(), filled_.end(),
+                             [&](const FilledCell& cell) { return cell.begin < filed; }) -
+        filled_.begin());
+  }
+
+  // Calls visit(t, u) for every pair of triangles whose boxes meet and whose
+  // first is filed in cells first_cell .. last_cell - 1 (of cell_count), each
+  // pair over all cells once: within a cell, and with the 13 neighbouring
+  // cells after it. A cell's neighbours are looked up once for all its
+  // triangles.
+  template <typename Visit>
+  void for_each_meeting_pair(size_t first_cell, size_t last_cell, Visit visit) const {
+    for (size_t c = first_cell; c < last_cell; ++c) {
+      const auto [cell_key, begin, end] = filled_[c];
+      for (uint32_t i = begin; i < end; ++i)
+        for (uint32_t j = i + 1; j < end; ++j)
+          if (CGAL::do_overlap(boxes_[order_[i]], boxes_[order_[j]])) visit(order_[i], order_[j]);
+      const auto at = cell_at(cell_key);
+      for (int64_t dz = 0; dz <= 1; ++dz)
+        for (int64_t dy = dz == 0 ? 0 : -1; dy <= 1; ++dy)
+          for (int64_t dx = (dz == 0 && dy == 0) ? 1 : -1; dx <= 1; ++dx) {
+            const auto found = cells_.find(key({at[0] + dx, at[1] + dy, at[2] + dz}));
+            if (found == cells_.end()) continue;
+            const auto [other_begin, other_end] = found->second;
+            for (uint32_t i = begin; i < end; ++i)
+              for (uint32_t j = other_begin; j < other_end; ++j)
+                if (CGAL::do_overlap(boxes_[order_[i]], boxes_[order_[j]]))
+                  visit(order_[i], order_[j]);
+          }
     }
   }
 
@@ -144,22 +185,6 @@ class BoxGrid {
     for (int64_t dz = -1; dz <= 1; ++dz)
       for (int64_t dy = -1; dy <= 1; ++dy)
         for (int64_t dx = -1; dx <= 1; ++dx)
-          visit_cell(t, {c[0] + dx, c[1] + dy, c[2] + dz}, visit);
-  }
-
-  // Calls visit(u) for the triangles u whose box meets t's, such that over
-  // all t each meeting pair comes once: u later in t's own cell, or in one of
-  // the 13 neighbouring cells that come after it (half the work of visiting
-  // both ways).
-  template <typename Visit>
-  void for_each_meeting_once(uint32_t t, Visit visit) const {
-    const auto c = cell_of(t);
-    visit_cell(t, c, [&](uint32_t u) {
-      if (u > t) visit(u);
-    });
-    for (int64_t dz = 0; dz <= 1; ++dz)
-      for (int64_t dy = dz == 0 ? 0 : -1; dy <= 1; ++dy)
-        for (int64_t dx = (dz == 0 && dy == 0) ? 1 : -1; dx <= 1; ++dx)
           visit_cell(t, {c[0] + dx, c[1] + dy, c[2] + dz}, visit);
   }
 
@@ -184,10 +209,20 @@ class BoxGrid {
   static uint64_t key(const std::array<int64_t, 3>& c) {
     return uint64_t(c[0] + 1) | uint64_t(c[1] + 1) << 21 | uint64_t(c[2] + 1) << 42;
   }
+  static std::array<int64_t, 3> cell_at(uint64_t key) {
+    constexpr uint64_t kMask = (uint64_t{1} << 21) - 1;
+    return {int64_t(key & kMask) - 1, int64_t((key >> 21) & kMask) - 1,
+            int64_t((key >> 42) & kMask) - 1};
+  }
 
   std::vector<CGAL::Bbox_3> boxes_;
   std::array<double, 3> low_{0, 0, 0}, cell_{1, 1, 1};
   std::vector<uint32_t> order_;
+  struct FilledCell {
+    uint64_t key;
+    uint32_t begin, end;  // its triangles in order_
+  };
+  std::vector<FilledCell> filled_;
   absl::flat_hash_map<uint64_t, std::pair<uint32_t, uint32_t>> cells_;
 };
 
@@ -197,25 +232,36 @@ class BoxGrid {
 // out of its box test, are paired with themselves instead.
 template <typename Keep>
 TrianglePairs crossings_from(const CrossingTest& test, const BoxGrid& grid,
-                             const std::vector<uint32_t>& degenerate, uint32_t begin, uint32_t end,
-                             const std::vector<uint32_t>* from, Keep keep) {
+                             const std::vector<uint32_t>& degenerate,
+                             const std::vector<uint32_t>& from, Keep keep) {
   TrianglePairs pairs;
-  for (uint32_t i = begin; i < end; ++i) {
-    const uint32_t s = from != nullptr ? (*from)[i] : i;
+  for (const uint32_t s : from) {
     if (std::binary_search(degenerate.begin(), degenerate.end(), s)) {
       pairs.emplace_back(s, s);
       continue;
     }
-    const auto visit = [&](uint32_t t) {
+    grid.for_each_meeting(s, [&](uint32_t t) {
       if (!keep(s, t) || std::binary_search(degenerate.begin(), degenerate.end(), t)) return;
       if (test.cross(s, t)) pairs.emplace_back(std::min(s, t), std::max(s, t));
-    };
-    if (from == nullptr) {
-      grid.for_each_meeting_once(s, visit);
-    } else {
-      grid.for_each_meeting(s, visit);
-    }
+    });
   }
+  return pairs;
+}
+
+// The crossing pairs among the triangles filed in cells first_cell ..
+// last_cell - 1 of `grid` and their neighbours after them; degenerate
+// triangles are left out (crossing_triangles pairs them with themselves).
+TrianglePairs crossings_in_cells(const CrossingTest& test, const BoxGrid& grid,
+                                 const std::vector<uint32_t>& degenerate, size_t first_cell,
+                                 size_t last_cell) {
+  TrianglePairs pairs;
+  const auto is_degenerate = [&](uint32_t t) {
+    return std::binary_search(degenerate.begin(), degenerate.end(), t);
+  };
+  grid.for_each_meeting_pair(first_cell, last_cell, [&](uint32_t s, uint32_t t) {
+    if (!degenerate.empty() && (is_degenerate(s) || is_degenerate(t))) return;
+    if (test.cross(s, t)) pairs.emplace_back(std::min(s, t), std::max(s, t));
+  });
   return pairs;
 }
 
@@ -239,13 +285,14 @@ TrianglePairs crossing_triangles(const std::vector<std::array<double, 3>>& point
   const uint32_t count = static_cast<uint32_t>(triangles.size());
   const std::vector<uint32_t> degenerate = degenerate_triangles(test, count);
   const BoxGrid grid(test, count);
-  // Two halves on two threads; the grid gives each meeting pair once.
-  const auto every = [](uint32_t, uint32_t) { return true; };
+  // The cells in two runs of about as many triangles, on two threads.
+  const size_t middle = grid.first_cell_after(count / 2);
   TrianglePairs low, high;
   side_by_side(
-      [&] { low = crossings_from(test, grid, degenerate, 0, count / 2, nullptr, every); },
-      [&] { high = crossings_from(test, grid, degenerate, count / 2, count, nullptr, every); });
+      [&] { low = crossings_in_cells(test, grid, degenerate, 0, middle); },
+      [&] { high = crossings_in_cells(test, grid, degenerate, middle, grid.cell_count()); });
   low.insert(low.end(), high.begin(), high.end());
+  for (const uint32_t t : degenerate) low.emplace_back(t, t);
   sort_pairs(low);
   return low;
 }
@@ -261,9 +308,8 @@ TrianglePairs crossing_triangles_near(const std::vector<std::array<double, 3>>& 
   const std::vector<uint32_t> degenerate = degenerate_triangles(test, count);
   const BoxGrid grid(test, count);
   // A pair inside `among` comes twice, once from each side: keep one.
-  TrianglePairs pairs =
-      crossings_from(test, grid, degenerate, 0, static_cast<uint32_t>(among.size()), &among,
-                     [&](uint32_t s, uint32_t t) { return !in_among[t] || s < t; });
+  TrianglePairs pairs = crossings_from(
+      test, grid, degenerate, among, [&](uint32_t s, uint32_t t) { return !in_among[t] || s < t; });
   sort_pairs(pairs);
   return pairs;
 }
