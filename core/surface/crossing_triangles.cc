@@ -142,20 +142,20 @@ class BoxGrid {
   }
 
   // The cells holding a box, numbered in key order: how many, and the first
-  // one with at least `filed` triangles filed in the cells before it.
+  // one with at least `position` triangles filed in the cells before it.
   size_t cell_count() const { return filled_.size(); }
-  size_t first_cell_after(uint32_t filed) const {
+  size_t first_cell_from(uint32_t position) const {
     return static_cast<size_t>(
         std::partition_point(filled_.begin(), filled_.end(),
-                             [&](const FilledCell& cell) { return cell.begin < filed; }) -
+                             [&](const FilledCell& cell) { return cell.begin < position; }) -
         filled_.begin());
   }
 
   // Calls visit(t, u) for every pair of triangles whose boxes meet and whose
   // first is filed in cells first_cell .. last_cell - 1 (of cell_count), each
   // pair over all cells once: within a cell, and with the 13 neighbouring
-  // cells after it. A cell's neighbours are looked up once for all its
-  // triangles.
+  // cells after it (with larger keys: z is the key's highest field). A cell's
+  // neighbours are looked up once for all its triangles.
   template <typename Visit>
   void for_each_meeting_pair(size_t first_cell, size_t last_cell, Visit visit) const {
     for (size_t c = first_cell; c < last_cell; ++c) {
@@ -228,7 +228,7 @@ class BoxGrid {
 
 // The crossing pairs of each triangle of `from` with the triangles whose
 // boxes meet it, for which keep(from's, other) holds (each unordered pair
-// must be kept once over all calls). Degenerate triangles, which CGAL leaves
+// must be kept once over all of `from`). Degenerate triangles, which CGAL leaves
 // out of its box test, are paired with themselves instead.
 template <typename Keep>
 TrianglePairs crossings_from(const CrossingTest& test, const BoxGrid& grid,
@@ -248,9 +248,10 @@ TrianglePairs crossings_from(const CrossingTest& test, const BoxGrid& grid,
   return pairs;
 }
 
-// The crossing pairs among the triangles filed in cells first_cell ..
-// last_cell - 1 of `grid` and their neighbours after them; degenerate
-// triangles are left out (crossing_triangles pairs them with themselves).
+// The crossing pairs with one triangle filed in cells first_cell ..
+// last_cell - 1 of `grid` and the other in the same cell or one of the 13
+// neighbouring cells after it; degenerate triangles are left out
+// (crossing_triangles pairs them with themselves).
 TrianglePairs crossings_in_cells(const CrossingTest& test, const BoxGrid& grid,
                                  const std::vector<uint32_t>& degenerate, size_t first_cell,
                                  size_t last_cell) {
@@ -285,8 +286,9 @@ TrianglePairs crossing_triangles(const std::vector<std::array<double, 3>>& point
   const uint32_t count = static_cast<uint32_t>(triangles.size());
   const std::vector<uint32_t> degenerate = degenerate_triangles(test, count);
   const BoxGrid grid(test, count);
-  // The cells in two runs of about as many triangles, on two threads.
-  const size_t middle = grid.first_cell_after(count / 2);
+  // The cells in two runs holding about half the triangles each, one per
+  // thread.
+  const size_t middle = grid.first_cell_from(count / 2);
   TrianglePairs low, high;
   side_by_side(
       [&] { low = crossings_in_cells(test, grid, degenerate, 0, middle); },
