@@ -42,6 +42,7 @@
 #include "support/analytic_shapes.h"
 #include "support/label_overlap.h"
 #include "support/organs_on_slices.h"
+#include "support/sharp_points.h"
 #include "support/slicer_like.h"
 
 using namespace labelmesh;
@@ -223,6 +224,11 @@ int bench_shares() {
   return failures;
 }
 
+// Points whose triangles' angles miss a full turn by more than this, or pass
+// it, count as sharp: the spikes and pinches a render shows (an octahedron's
+// corners miss it by 2.09).
+constexpr double kSharpDeficitRad = 2.0;
+
 struct VolumeFigures {
   std::vector<double> ours_share, slicer_share, mc_share;  // labels >= 1000 voxels
   // The Slicer-like surfaces against the voxels, per label.
@@ -237,6 +243,8 @@ struct VolumeFigures {
   // surface has more than Marching Cubes' plus two per component.
   uint64_t ours_nodes = 0, mc_nodes = 0;
   int labels_above_mc_nodes = 0;
+  // Points sharper than kSharpDeficitRad (sharp_points.h), over all labels.
+  testing::SharpPoints ours_sharp, slicer_sharp;
 };
 
 // A volume file read, with its labels (every one, in statistics order).
@@ -414,6 +422,13 @@ int bench_volume(const std::string& path, int rounds) {
       if (ours->statistics.nodes > mc->statistics.nodes + 2 * mc->statistics.components)
         ++f.labels_above_mc_nodes;
     }
+    const auto add_sharp = [](const surface::TriangleMesh& mesh, testing::SharpPoints& sum) {
+      const testing::SharpPoints counted = testing::sharp_points(mesh, kSharpDeficitRad);
+      sum.points += counted.points;
+      sum.sharp += counted.sharp;
+    };
+    add_sharp(ours->mesh, f.ours_sharp);
+    add_sharp(slicer[i].mesh, f.slicer_sharp);
     if (const char* out = std::getenv("LABELMESH_BENCH_OUT")) {
       const std::string stem = std::string(out) + "/label" + std::to_string(labels[i]);
       (void)surface::write_surface(slicer[i].mesh, stem + "-slicer.stl",
@@ -479,6 +494,13 @@ int bench_volume(const std::string& path, int rounds) {
       "Marching Cubes' count plus two per component: %d\n",
       static_cast<unsigned long long>(f.ours_nodes), static_cast<unsigned long long>(f.mc_nodes),
       double(f.ours_nodes) / double(std::max<uint64_t>(1, f.mc_nodes)), f.labels_above_mc_nodes);
+  std::printf(
+      "  sharp points (angles around them more than %.0f rad short of a turn or over it): "
+      "ours %zu of %zu (%.2f %%), Slicer-like %zu of %zu (%.2f %%)\n",
+      kSharpDeficitRad, f.ours_sharp.sharp, f.ours_sharp.points,
+      100.0 * double(f.ours_sharp.sharp) / double(std::max<size_t>(1, f.ours_sharp.points)),
+      f.slicer_sharp.sharp, f.slicer_sharp.points,
+      100.0 * double(f.slicer_sharp.sharp) / double(std::max<size_t>(1, f.slicer_sharp.points)));
   std::printf(
       "  Slicer-like against the voxels, median over labels: misclassified %.2f %% of boundary "
       "voxels, Hausdorff %.2f voxels, |volume change| %.2f %%\n",
