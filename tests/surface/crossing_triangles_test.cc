@@ -10,36 +10,13 @@
 
 #include "core/surface/surface_checks.h"
 #include "core/surface/triangle_mesh.h"
+#include "support/lat_long_sphere.h"
 
 namespace labelmesh::surface {
 namespace {
 
-// A closed sphere of radius 10 from a longitude-latitude grid.
-TriangleMesh sphere(int rings, int segments) {
-  TriangleMesh m;
-  m.points.push_back({0, 0, 10});
-  for (int r = 1; r < rings; ++r)
-    for (int s = 0; s < segments; ++s) {
-      const double theta = M_PI * r / rings, phi = 2 * M_PI * s / segments;
-      m.points.push_back({10 * std::sin(theta) * std::cos(phi),
-                          10 * std::sin(theta) * std::sin(phi), 10 * std::cos(theta)});
-    }
-  m.points.push_back({0, 0, -10});
-  const auto at = [&](int r, int s) { return uint32_t(1 + (r - 1) * segments + s % segments); };
-  const uint32_t south = uint32_t(m.points.size() - 1);
-  for (int s = 0; s < segments; ++s) {
-    m.triangles.push_back({0, at(1, s), at(1, s + 1)});
-    for (int r = 1; r + 1 < rings; ++r) {
-      m.triangles.push_back({at(r, s), at(r + 1, s), at(r + 1, s + 1)});
-      m.triangles.push_back({at(r, s), at(r + 1, s + 1), at(r, s + 1)});
-    }
-    m.triangles.push_back({at(rings - 1, s), south, at(rings - 1, s + 1)});
-  }
-  return m;
-}
-
 TEST(CrossingTriangles, AgreesWithCgalOnAShakenSphere) {
-  TriangleMesh m = sphere(24, 48);
+  TriangleMesh m = testing::lat_long_sphere(24, 48);
   EXPECT_TRUE(crossing_triangles(m.points, m.triangles).empty());
   ASSERT_EQ(count_self_intersections(m), uint64_t{0});
   // Shake every point by up to 0.6 mm (edges are about 1.3 mm): folds and
@@ -57,7 +34,7 @@ TEST(CrossingTriangles, AgreesWithCgalOnAShakenSphere) {
 }
 
 TEST(CrossingTriangles, NearFindsThePairsOfTheGivenTriangles) {
-  TriangleMesh m = sphere(24, 48);
+  TriangleMesh m = testing::lat_long_sphere(24, 48);
   std::mt19937 random(11);
   std::uniform_real_distribution<double> shake(-0.6, 0.6);
   for (auto& p : m.points)
