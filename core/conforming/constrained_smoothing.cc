@@ -31,31 +31,6 @@ Lanes to_lanes(const Vec3& v) {
   return Lanes{static_cast<float>(v[0]), static_cast<float>(v[1]), static_cast<float>(v[2]), 0};
 }
 
-// between_drawn (point_boxes.h) in single precision, its divisions made
-// multiplications by reciprocals taken once: it runs for every point at
-// every step on thinner slices.
-class BetweenDrawn {
- public:
-  BetweenDrawn(double first, double spacing)
-      : first_(static_cast<float>(first)),
-        spacing_(static_cast<float>(spacing)),
-        per_spacing_(spacing > 0 ? static_cast<float>(1 / spacing) : 0.0f),
-        per_half_spacing_(spacing > 0 ? static_cast<float>(2 / spacing) : 0.0f) {}
-
-  float operator()(float place) const {
-    const float offset = place - first_;
-    const float into = offset - std::floor(offset * per_spacing_) * spacing_;
-    const float between = std::min(into, spacing_ - into) * per_half_spacing_;
-    return std::clamp((between - kNarrow) * kPerWideningSpan, 0.0f, 1.0f);
-  }
-
- private:
-  static constexpr auto kNarrow = static_cast<float>(kNarrowNearDrawn);
-  // Over the part of the way to the middle where boxes widen.
-  static constexpr auto kPerWideningSpan = static_cast<float>(1 / (1 - kNarrowNearDrawn));
-  float first_, spacing_, per_spacing_, per_half_spacing_;
-};
-
 }  // namespace
 
 void smooth_in_boxes(const Stencil& stencil, const std::vector<Vec3>& centre,
@@ -80,7 +55,8 @@ void smooth_in_boxes(const Stencil& stencil, const std::vector<Vec3>& centre,
   std::vector<Vec3>().swap(points);
   const Lanes half = to_lanes(half_box);
   const int drawn = point_boxes.drawn_axis;
-  const BetweenDrawn between_drawn_slices(point_boxes.drawn_first, point_boxes.drawn_spacing);
+  const BetweenDrawn<float> between_drawn_slices(point_boxes.drawn_first,
+                                                 point_boxes.drawn_spacing);
   const Lanes widening = to_lanes(point_boxes.widening);
   const Lanes edge_low = to_lanes(point_boxes.edge_low);
   const Lanes edge_high = to_lanes(point_boxes.edge_high);

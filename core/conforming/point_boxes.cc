@@ -17,7 +17,7 @@ Vec3 PointBoxes::hold(size_t point, const Vec3& centre, Vec3 p) const {
     const auto [low, high] = along_drawn(centre[a]);
     p[a] = std::clamp(p[a], low, high);
     if (widens(point)) {
-      const double between = between_drawn(p[a], drawn_first, drawn_spacing);
+      const double between = BetweenDrawn<double>(drawn_first, drawn_spacing)(p[a]);
       for (int k = 0; k < 3; ++k) width[k] += between * widening[k];
     }
   }

@@ -19,7 +19,7 @@ namespace labelmesh::conforming {
 
 // Where each point may lie: within `half` of its centre along each axis,
 // and across a drawn axis up to `widening` more, growing with the point's
-// distance from the nearest drawn slice (between_drawn below;
+// distance from the nearest drawn slice (BetweenDrawn below;
 // InterfaceParams::between_drawn_widening). Along a drawn axis a point never
 // passes a drawn slice beyond its cube's own box (along_drawn).
 struct PointBoxes {
@@ -84,15 +84,31 @@ void hold_at_edges(const std::vector<geometry::Vec3>& centre, const volume::Imag
 // voxel centres there.
 inline constexpr double kNarrowNearDrawn = 0.2;
 
-// How far between two drawn slices `place` lies along their axis, for the
-// widening: 0 on or near one (kNarrowNearDrawn), 1 midway.
+// How far between two drawn slices (the first at `first`, `spacing` apart) a
+// place lies along their axis, for the widening: 0 on or near one
+// (kNarrowNearDrawn), 1 midway. The reciprocals are taken once: the net's
+// smoothing asks at every point and step.
 template <typename Real>
-Real between_drawn(Real place, Real first, Real spacing) {
-  const Real offset = place - first;
-  const Real into = offset - std::floor(offset / spacing) * spacing;
-  const Real between = std::min(into, spacing - into) / (Real{0.5} * spacing);
-  const auto narrow = static_cast<Real>(kNarrowNearDrawn);
-  return std::clamp((between - narrow) / (Real{1} - narrow), Real{0}, Real{1});
-}
+class BetweenDrawn {
+ public:
+  BetweenDrawn(double first, double spacing)
+      : first_(static_cast<Real>(first)),
+        spacing_(static_cast<Real>(spacing)),
+        per_spacing_(spacing > 0 ? static_cast<Real>(1 / spacing) : Real{0}),
+        per_half_spacing_(spacing > 0 ? static_cast<Real>(2 / spacing) : Real{0}) {}
+
+  Real operator()(Real place) const {
+    const Real offset = place - first_;
+    const Real into = offset - std::floor(offset * per_spacing_) * spacing_;
+    const Real between = std::min(into, spacing_ - into) * per_half_spacing_;
+    return std::clamp((between - kNarrow) * kPerWideningSpan, Real{0}, Real{1});
+  }
+
+ private:
+  static constexpr auto kNarrow = static_cast<Real>(kNarrowNearDrawn);
+  // Over the part of the way to the middle where boxes widen.
+  static constexpr auto kPerWideningSpan = static_cast<Real>(1 / (1 - kNarrowNearDrawn));
+  Real first_, spacing_, per_spacing_, per_half_spacing_;
+};
 
 }  // namespace labelmesh::conforming

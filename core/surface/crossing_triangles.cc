@@ -132,11 +132,10 @@ class BoxGrid {
     order_.resize(count);
     for (size_t i = 0; i < count; ++i) {
       order_[i] = filed[i].second;
-      auto& range = cells_[filed[i].first];
-      if (range.second == 0) range.first = static_cast<uint32_t>(i);
-      range.second = static_cast<uint32_t>(i + 1);
-      if (i == 0 || filed[i].first != filed[i - 1].first)
+      if (i == 0 || filed[i].first != filed[i - 1].first) {
+        cells_[filed[i].first] = static_cast<uint32_t>(filled_.size());
         filled_.push_back({filed[i].first, static_cast<uint32_t>(i), 0});
+      }
       filled_.back().end = static_cast<uint32_t>(i + 1);
     }
   }
@@ -169,9 +168,9 @@ class BoxGrid {
           for (int64_t dx = (dz == 0 && dy == 0) ? 1 : -1; dx <= 1; ++dx) {
             const auto found = cells_.find(key({at[0] + dx, at[1] + dy, at[2] + dz}));
             if (found == cells_.end()) continue;
-            const auto [other_begin, other_end] = found->second;
+            const FilledCell& other = filled_[found->second];
             for (uint32_t i = begin; i < end; ++i)
-              for (uint32_t j = other_begin; j < other_end; ++j)
+              for (uint32_t j = other.begin; j < other.end; ++j)
                 if (CGAL::do_overlap(boxes_[order_[i]], boxes_[order_[j]]))
                   visit(order_[i], order_[j]);
           }
@@ -194,7 +193,8 @@ class BoxGrid {
     const auto found = cells_.find(key(cell));
     if (found == cells_.end()) return;
     const CGAL::Bbox_3& box = boxes_[t];
-    for (uint32_t i = found->second.first; i < found->second.second; ++i) {
+    const FilledCell& filled = filled_[found->second];
+    for (uint32_t i = filled.begin; i < filled.end; ++i) {
       const uint32_t u = order_[i];
       if (u != t && CGAL::do_overlap(box, boxes_[u])) visit(u);
     }
@@ -223,7 +223,8 @@ class BoxGrid {
     uint32_t begin, end;  // its triangles in order_
   };
   std::vector<FilledCell> filled_;
-  absl::flat_hash_map<uint64_t, std::pair<uint32_t, uint32_t>> cells_;
+  // Each filled cell's place in filled_, by key.
+  absl::flat_hash_map<uint64_t, uint32_t> cells_;
 };
 
 // The crossing pairs of each triangle of `from` with the triangles whose
