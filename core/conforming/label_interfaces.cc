@@ -790,8 +790,10 @@ InterfaceSurface label_interfaces(const volume::LabelVolume& volume,
     // triangle at its rim (they still stay within the edges).
     PointBoxes sliding = boxes;
     std::vector<uint8_t>().swap(sliding.pinned);
-    const auto widened = widen_small_angles(net.quads, net.quad_sides, slides, net.centre, sliding,
-                                            across, params.widen_angles_below_deg, points);
+    const auto widened = widen_small_angles(
+        net.quads, net.quad_sides, slides, net.centre, sliding, across,
+        {.below_deg = params.widen_angles_below_deg, .far_below_deg = params.widen_far_below_deg},
+        points);
     figures.widened_points = widened.points_moved;
   }
   if (params.subdivide_thick_quads) subdivide_quads(geometry.spacing, net, points, net.centre);

@@ -96,10 +96,12 @@ QuadSplit best_quad_split(const std::array<uint32_t, 4>& quad, const std::vector
 WidenedAngles widen_small_angles(const std::vector<std::array<uint32_t, 4>>& quads,
                                  const std::vector<std::array<int32_t, 2>>& quad_sides,
                                  const std::vector<Slide>& slides, const std::vector<Vec3>& centre,
-                                 const PointBoxes& boxes, const Vec3& across, double below_deg,
-                                 std::vector<Vec3>& points) {
+                                 const PointBoxes& boxes, const Vec3& across,
+                                 const AngleLimits& limits, std::vector<Vec3>& points) {
   WidenedAngles result;
-  const double limit = std::cos(below_deg * M_PI / 180);
+  const auto cosine_of = [](double deg) { return std::cos(deg * M_PI / 180); };
+  const double limit = cosine_of(limits.below_deg);
+  const double far_limit = cosine_of(std::min(limits.far_below_deg, limits.below_deg));
   const QuadsAround around = quads_around(quads, points.size());
   // The worst (largest) smallest-angle cosine among the quads around p.
   const auto worst_around = [&](uint32_t p) {
@@ -150,13 +152,16 @@ WidenedAngles widen_small_angles(const std::vector<std::array<uint32_t, 4>>& qua
       for (const double fraction : {0.25, 0.125, -0.125, -0.25})
         along.push_back(geometry::scale(curve, fraction));
     }
-    std::vector<Vec3> across_moves;
-    for (int k = 0; k < 3; ++k)
-      for (const double sign : {-1.0, 1.0}) {
-        Vec3 move{0, 0, 0};
-        move[k] = sign * across[k];
-        across_moves.push_back(move);
-      }
+    const auto across_moves = [&](double fraction) {
+      std::vector<Vec3> moves;
+      for (int k = 0; k < 3; ++k)
+        for (const double sign : {-1.0, 1.0}) {
+          Vec3 move{0, 0, 0};
+          move[k] = sign * fraction * across[k];
+          moves.push_back(move);
+        }
+      return moves;
+    };
     double best = before;
     Vec3 best_place = from;
     const auto try_moves = [&](const std::vector<Vec3>& moves) {
@@ -170,7 +175,11 @@ WidenedAngles widen_small_angles(const std::vector<std::array<uint32_t, 4>>& qua
       }
     };
     try_moves(along);
-    if (best > limit) try_moves(across_moves);
+    if (best > far_limit) {
+      try_moves(across_moves(1));
+    } else if (best > limit) {
+      try_moves(across_moves(limits.short_fraction));
+    }
     points[p] = best_place;
     return points[p] != from;
   };

@@ -44,10 +44,24 @@ struct WidenedAngles {
   size_t points_moved = 0;
 };
 
+// Which quads are widened, and how far their points may move across the
+// surface. A move across changes the shape inside the box: a quarter voxel
+// clears most thin triangles but, made wherever an angle is below 30
+// degrees, it roughens the surface and costs small labels their volume; a
+// sixteenth lifts the angles between 20 and 30 degrees without either.
+struct AngleLimits {
+  double below_deg = 20;  // quads whose best split has an angle below this
+  // Below this many degrees a point may move the whole `across` step; at
+  // angles from here up to below_deg, short_fraction of it.
+  double far_below_deg = 20;
+  double short_fraction = 0.25;
+};
+
 // Moves the points of quads whose best split has an angle below
-// `below_deg`, each held in its box around its `centre`:
-// along the surface first, and where that is not enough, by `across` along
-// a voxel axis. Positions, boxes and moves are in mm along the voxel axes.
+// limits.below_deg, each held in its box around its `centre`: along the
+// surface first, and where that is not enough, along a voxel axis by
+// `across` (or the short part of it; AngleLimits). Positions, boxes and
+// moves are in mm along the voxel axes.
 // `quad_sides` orient the quads (a quad's normal points from its lower side
 // label to its higher one, as for every quad between the same two labels).
 // A point moves only when the smallest angle of its quads grows, so the
@@ -56,7 +70,7 @@ WidenedAngles widen_small_angles(const std::vector<std::array<uint32_t, 4>>& qua
                                  const std::vector<std::array<int32_t, 2>>& quad_sides,
                                  const std::vector<Slide>& slides,
                                  const std::vector<geometry::Vec3>& centre, const PointBoxes& boxes,
-                                 const geometry::Vec3& across, double below_deg,
+                                 const geometry::Vec3& across, const AngleLimits& limits,
                                  std::vector<geometry::Vec3>& points);
 
 // A move in a crossing pair goes back by half of what is left of it this

@@ -26,8 +26,10 @@ namespace labelmesh {
 namespace {
 
 // Delivered surfaces have no triangle angle below this where sliding
-// points inside their boxes can widen it (conforming/widen_small_angles.h).
-constexpr double kWidenAnglesBelowDeg = 20;
+// points inside their boxes can widen it (conforming/widen_small_angles.h);
+// below kWidenFarBelowDeg the points may move farther across the surface.
+constexpr double kWidenAnglesBelowDeg = 30;
+constexpr double kWidenFarBelowDeg = 20;
 
 conforming::InterfaceParams interface_params(const NetOptions& options) {
   conforming::InterfaceParams params;
@@ -38,6 +40,7 @@ conforming::InterfaceParams interface_params(const NetOptions& options) {
   params.restore_volumes = options.restore_volumes;
   params.subdivide_thick_quads = false;
   params.widen_angles_below_deg = kWidenAnglesBelowDeg;
+  params.widen_far_below_deg = kWidenFarBelowDeg;
   params.split_sheets = true;
   return params;
 }

@@ -58,7 +58,7 @@ TEST(WidenSmallAngles, TwoPointsPressedTogetherSlideApartAlongTheSurface) {
   PointBoxes boxes;
   boxes.half = {0.475, 0.475, 0.475};
   const auto widened = widen_small_angles(net.quads, net.sides, net.slides, net.centre, boxes,
-                                          {0.2, 0.2, 0.2}, 20, net.points);
+                                          {0.2, 0.2, 0.2}, {.below_deg = 20}, net.points);
   EXPECT_GE(widened.points_moved, 1u);
   EXPECT_GE(smallest_angle_deg(net), 20);
   for (size_t p = 0; p < net.points.size(); ++p) {
@@ -79,9 +79,47 @@ TEST(WidenSmallAngles, WideAnglesAreLeftAlone) {
   PointBoxes boxes;
   boxes.half = {0.475, 0.475, 0.475};
   const auto widened = widen_small_angles(net.quads, net.sides, net.slides, net.centre, boxes,
-                                          {0.2, 0.2, 0.2}, 20, net.points);
+                                          {0.2, 0.2, 0.2}, {.below_deg = 20}, net.points);
   EXPECT_EQ(widened.points_moved, 0u);
   EXPECT_EQ(net.points, moved_before);
+}
+
+// Point (1, 1) lifted h above the flat net, the only point that may move:
+// its quads are steep, and sliding along the surface does not widen them
+// (its neighbours sit around it alike), so only a move along z does.
+FlatNet net_with_a_peak(double h) {
+  FlatNet net = flat_net();
+  net.points[5][2] = h;
+  for (auto& slide : net.slides) slide.kind = Slide::Kind::kFixed;
+  net.slides[5].kind = Slide::Kind::kSurface;
+  return net;
+}
+
+TEST(WidenSmallAngles, AnglesBetweenTheLimitsMoveAcrossOnlyTheShortStep) {
+  PointBoxes boxes;
+  boxes.half = {0.475, 0.475, 5};
+  const AngleLimits limits{.below_deg = 30, .far_below_deg = 20, .short_fraction = 0.25};
+  // h = 3: the best split's smallest angle is 25.8 degrees.
+  FlatNet between = net_with_a_peak(3);
+  const double before = smallest_angle_deg(between);
+  ASSERT_GT(before, 20);
+  ASSERT_LT(before, 30);
+  widen_small_angles(between.quads, between.sides, between.slides, between.centre, boxes,
+                     {0.2, 0.2, 0.2}, limits, between.points);
+  EXPECT_GT(smallest_angle_deg(between), before);
+  // At most one short step (0.05) down in each of the three passes.
+  const double lowered = 3 - between.points[5][2];
+  EXPECT_GT(lowered, 0.04);
+  EXPECT_LE(lowered, 3 * 0.05 + 1e-12);
+  EXPECT_EQ(between.points[5][0], 1);
+  EXPECT_EQ(between.points[5][1], 1);
+
+  // h = 5: 15.9 degrees, below the far limit: the whole step.
+  FlatNet far = net_with_a_peak(5);
+  ASSERT_LT(smallest_angle_deg(far), 20);
+  widen_small_angles(far.quads, far.sides, far.slides, far.centre, boxes, {0.2, 0.2, 0.2}, limits,
+                     far.points);
+  EXPECT_GE(5 - far.points[5][2], 0.2 - 1e-12);
 }
 
 // A move in a crossing pair is taken back by halves while the pair still
