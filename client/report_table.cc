@@ -35,9 +35,9 @@ std::string report_table(const v1::Report& report) {
   std::map<int32_t, std::string> warnings;
   for (const auto& warning : report.warnings()) warnings[warning.label()] = warning.reason();
 
-  std::string table =
-      row("%7s  %s %-12s %8s %8s %8s %14s %10s  %s\n", "label", name_cell("name").c_str(),
-          "surface", "nodes", "min_ang", "max_ang", "volume (mm3)", "hausdorff", "warning");
+  std::string table = row("%7s  %s %-12s %8s %8s %8s %8s %14s %10s  %s\n", "label",
+                          name_cell("name").c_str(), "surface", "nodes", "min_ang", "tri<30",
+                          "max_ang", "volume (mm3)", "hausdorff", "warning");
   for (const auto& s : report.surfaces()) {
     if (!s.output() && s.error().empty()) continue;
     const std::string name = name_cell(names[s.label()]);
@@ -47,9 +47,9 @@ std::string report_table(const v1::Report& report) {
       continue;
     }
     const std::string hausdorff = s.has_hausdorff_mm() ? format_fixed(s.hausdorff_mm(), 3) : "-";
-    table += row("%7d  %s %-12s %8u %8.2f %8.2f %14.1f %10s  %s\n", s.label(), name.c_str(),
-                 s.stage().c_str(), s.nodes(), s.min_angle_deg(), s.max_angle_deg(), s.volume_mm3(),
-                 hausdorff.c_str(), warnings[s.label()].c_str());
+    table += row("%7d  %s %-12s %8u %8.2f %8u %8.2f %14.1f %10s  %s\n", s.label(), name.c_str(),
+                 s.stage().c_str(), s.nodes(), s.min_angle_deg(), s.triangles_below_30_deg(),
+                 s.max_angle_deg(), s.volume_mm3(), hausdorff.c_str(), warnings[s.label()].c_str());
   }
   const bool tetrahedra_only = report.has_volume() && (report.volume().mesher() == "tetgen" ||
                                                        report.volume().mesher() == "conforming");

@@ -321,6 +321,7 @@ v1::Report make_report(const MeshResult& result, const MeshParams& params) {
     entry->set_triangles(s.triangles);
     entry->set_min_angle_deg(s.min_angle_deg);
     entry->set_max_angle_deg(s.max_angle_deg);
+    entry->set_triangles_below_30_deg(s.triangles_below_30_deg);
     entry->set_boundary_edges(s.boundary_edges);
     entry->set_non_manifold_edges(s.non_manifold_edges);
     entry->set_non_manifold_vertices(s.non_manifold_vertices);

@@ -221,13 +221,14 @@ std::string notes_cell(const v1::Report& report, int32_t label, const v1::Surfac
 std::string surface_cells(const v1::SurfaceSummary* s) {
   if (!s || !s->output()) {
     std::string out = cat("<td>", s ? html_escape(s->stage()) : std::string(kNone), "</td>");
-    for (int i = 0; i < 6; ++i) out += cat("<td class=\"num\">", kNone, "</td>");
+    for (int i = 0; i < 7; ++i) out += cat("<td class=\"num\">", kNone, "</td>");
     return out;
   }
   const auto num = [](const std::string& text) { return cat("<td class=\"num\">", text, "</td>"); };
   return cat("<td>", html_escape(s->stage()), "</td>", num(cat(s->nodes())),
              num(cat(s->triangles())), num(fixed(s->min_angle_deg(), 2)),
-             num(fixed(s->max_angle_deg(), 2)), num(fixed(s->volume_mm3(), 1)),
+             num(cat(s->triangles_below_30_deg())), num(fixed(s->max_angle_deg(), 2)),
+             num(fixed(s->volume_mm3(), 1)),
              num(s->has_hausdorff_mm() ? fixed(s->hausdorff_mm(), 3) : std::string(kNone)));
 }
 
@@ -235,7 +236,8 @@ std::string label_table(const v1::Report& report) {
   std::string out =
       "<h2>Labels</h2>\n<table>\n<tr><th>Label</th><th>Name</th><th>Voxels</th>"
       "<th>Voxel volume (mm&sup3;)</th><th>Surface</th><th>Nodes</th><th>Triangles</th>"
-      "<th>Min angle (&deg;)</th><th>Max angle (&deg;)</th><th>Surface volume (mm&sup3;)</th>"
+      "<th>Min angle (&deg;)</th><th>Triangles with an angle below 30&deg;</th>"
+      "<th>Max angle (&deg;)</th><th>Surface volume (mm&sup3;)</th>"
       "<th>Hausdorff to Marching Cubes (mm)</th><th>Warnings and errors</th></tr>\n";
   for (const auto& label : report.input().labels()) {
     const auto* surface = final_surface(report, label.label());

@@ -147,6 +147,7 @@ SurfaceStatistics compute_surface_statistics(const TriangleMesh& mesh) {
       s.min_angle_deg = std::min(s.min_angle_deg, a);
       s.max_angle_deg = std::max(s.max_angle_deg, a);
     }
+    if (std::min({angles[0], angles[1], angles[2]}) < kWellShapedDeg) ++s.triangles_below_30_deg;
     s.area_mm2 += 0.5 * norm(cross(sub(p1, p0), sub(p2, p0)));
     for (int e = 0; e < 3; ++e) {
       const uint32_t a = t[e], b = t[(e + 1) % 3];

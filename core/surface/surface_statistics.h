@@ -9,12 +9,17 @@
 
 namespace labelmesh::surface {
 
+// The smallest angle the paper's surfaces keep, degrees.
+inline constexpr double kWellShapedDeg = 30;
+
 struct SurfaceStatistics {
   uint32_t nodes = 0;
   uint32_t triangles = 0;
   // Smallest and largest interior angle over all triangles, degrees.
   double min_angle_deg = 0;
   double max_angle_deg = 0;
+  // Triangles with an angle below kWellShapedDeg.
+  uint32_t triangles_below_30_deg = 0;
   // Edges with one incident triangle.
   uint32_t boundary_edges = 0;
   // Edges with three or more incident triangles.

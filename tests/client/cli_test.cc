@@ -85,7 +85,9 @@ TEST(Cli, MeshWritesSurfacesAndReport) {
             (std::vector<std::string>{"read", "drawn_grid", "label_statistics", "marching_cubes",
                                       "surface_statistics", "write", "report_pictures"}));
   // The raw JSON keeps the proto field names.
-  EXPECT_NE(slurp(dir / "out" / "report.json").find("\"min_angle_deg\""), std::string::npos);
+  const std::string json = slurp(dir / "out" / "report.json");
+  EXPECT_NE(json.find("\"min_angle_deg\""), std::string::npos);
+  EXPECT_NE(json.find("\"triangles_below_30_deg\""), std::string::npos);
 }
 
 // Names from an ITK-SNAP label file reach the file names and the report.

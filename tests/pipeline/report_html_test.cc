@@ -86,6 +86,7 @@ v1::Report sample_report() {
   liver.set_volume_mm3(17012.34);
   liver.set_hausdorff_mm(1.23456);
   auto& hostile = add_surface(report, 2, "mask", 210, 20.5, 130.25);
+  hostile.set_triangles_below_30_deg(37);
   hostile.set_output(true);
   hostile.set_volume_mm3(600.5);
   hostile.set_hausdorff_mm(2.5);
@@ -162,6 +163,7 @@ TEST(ReportHtml, ShowsEveryLabelsOutputFigures) {
                              ">1.235<",
                              ">mask<",
                              ">20.50<",
+                             ">37<",
                              ">130.25<",
                              ">2.500<",
                              "outside tolerance: mask surface, Hausdorff 2.50 mm",

@@ -27,6 +27,7 @@ TEST(SurfaceStatistics, Tetrahedron) {
   EXPECT_NEAR(s.volume_mm3, 1.0 / 6.0, 1e-12);
   EXPECT_NEAR(s.min_angle_deg, 45.0, 1e-9);
   EXPECT_NEAR(s.max_angle_deg, 90.0, 1e-9);
+  EXPECT_EQ(s.triangles_below_30_deg, 0u);
   EXPECT_NEAR(s.area_mm2, 1.5 + std::sqrt(3.0) / 2, 1e-12);
 }
 
@@ -101,6 +102,20 @@ TEST(SurfaceStatistics, SliverTriangleAngles) {
   const auto s = compute_surface_statistics(m);
   EXPECT_LT(s.min_angle_deg, 0.2);
   EXPECT_GT(s.max_angle_deg, 179.5);
+}
+
+// A triangle whose apex sits h above the middle of a unit base has base
+// angles atan(2 h): below 30 degrees for h < 0.2887.
+TEST(SurfaceStatistics, CountsTrianglesWithAnAngleBelowThirtyDegrees) {
+  TriangleMesh m;
+  for (const double h : {0.25, 0.28, 0.29, 0.5, 0.87}) {
+    const auto base = static_cast<uint32_t>(m.points.size());
+    m.points.push_back({0, 0, 3 * h});
+    m.points.push_back({1, 0, 3 * h});
+    m.points.push_back({0.5, h, 3 * h});
+    m.triangles.push_back({base, base + 1, base + 2});
+  }
+  EXPECT_EQ(compute_surface_statistics(m).triangles_below_30_deg, 2u);
 }
 
 }  // namespace
