@@ -32,6 +32,7 @@
 #include "core/conforming/net_label_surface.h"
 #include "core/pipeline/label_net_surfaces.h"
 #include "core/pipeline/pipeline.h"
+#include "core/surface/surface_statistics.h"
 #include "core/surface/voxel_fidelity.h"
 #include "core/surface/write_surface.h"
 #include "core/util/side_by_side.h"
@@ -245,6 +246,8 @@ struct VolumeFigures {
   int labels_above_mc_nodes = 0;
   // Points sharper than kSharpDeficitRad (sharp_points.h), over all labels.
   testing::SharpPoints ours_sharp, slicer_sharp;
+  // Triangles, and those with an angle below 30 degrees, over all labels.
+  uint64_t ours_triangles = 0, ours_below_30 = 0, slicer_triangles = 0, slicer_below_30 = 0;
 };
 
 // A volume file read, with its labels (every one, in statistics order).
@@ -416,6 +419,11 @@ int bench_volume(const std::string& path, int rounds) {
             a.voxels ? 100 * a.voxels->volume_change : -1.0);
     if (ours->stage.rfind("poisson", 0) == 0) ++f.ours_poisson;
     f.ours_min_angle = std::min(f.ours_min_angle, ours->statistics.min_angle_deg);
+    f.ours_triangles += ours->statistics.triangles;
+    f.ours_below_30 += ours->statistics.triangles_below_30_deg;
+    const auto slicer_statistics = surface::compute_surface_statistics(slicer[i].mesh);
+    f.slicer_triangles += slicer_statistics.triangles;
+    f.slicer_below_30 += slicer_statistics.triangles_below_30_deg;
     if (mc != nullptr) {
       f.ours_nodes += ours->statistics.nodes;
       f.mc_nodes += mc->statistics.nodes;
@@ -501,6 +509,18 @@ int bench_volume(const std::string& path, int rounds) {
       100.0 * double(f.ours_sharp.sharp) / double(std::max<size_t>(1, f.ours_sharp.points)),
       f.slicer_sharp.sharp, f.slicer_sharp.points,
       100.0 * double(f.slicer_sharp.sharp) / double(std::max<size_t>(1, f.slicer_sharp.points)));
+  const auto per_million = [](uint64_t part, uint64_t whole) {
+    return 1e6 * double(part) / double(std::max<uint64_t>(1, whole));
+  };
+  std::printf(
+      "  triangles with an angle below 30 deg: ours %llu of %llu (%.0f per million), "
+      "Slicer-like %llu of %llu (%.0f per million)\n",
+      static_cast<unsigned long long>(f.ours_below_30),
+      static_cast<unsigned long long>(f.ours_triangles),
+      per_million(f.ours_below_30, f.ours_triangles),
+      static_cast<unsigned long long>(f.slicer_below_30),
+      static_cast<unsigned long long>(f.slicer_triangles),
+      per_million(f.slicer_below_30, f.slicer_triangles));
   std::printf(
       "  Slicer-like against the voxels, median over labels: misclassified %.2f %% of boundary "
       "voxels, Hausdorff %.2f voxels, |volume change| %.2f %%\n",
