@@ -88,6 +88,13 @@ std::vector<Point> sample_points(const TriangleMesh& mesh, double spacing) {
   return samples;
 }
 
+}  // namespace
+
+// The distance measurement's parts, named so that DistanceMeasurement::State
+// may hold them: a type from an unnamed namespace in a member of a named
+// one is a warning once files are compiled together.
+namespace distance_parts {
+
 struct OneSided {
   double max_squared = 0;
   Point farthest = Point(0, 0, 0);
@@ -111,6 +118,11 @@ struct Direction {
   const Tree* tree;
 };
 
+}  // namespace distance_parts
+
+namespace {
+using distance_parts::Direction;
+using distance_parts::OneSided;
 }  // namespace
 
 constexpr size_t kSeedEvery = 4;
