@@ -783,7 +783,7 @@ InterfaceSurface label_interfaces(const volume::LabelVolume& volume,
         slides[p].curve = {stencil.neighbours[first], stencil.neighbours[first + 1]};
       }
     }
-    // Across the surface by a quarter of the grid's own voxel.
+    // Across the surface by about a quarter of the grid's own voxel.
     const Vec3 across{0.5 * half * geometry.spacing[0], 0.5 * half * geometry.spacing[1],
                       0.5 * half * geometry.spacing[2]};
     // A cap's points may leave its plane inwards where that widens a thin

@@ -56,10 +56,11 @@ struct InterfaceParams {
   // After smoothing, move the points of quads whose triangles have an angle
   // below this many degrees inside their boxes where that widens the angle
   // (widen_small_angles.h); 0: leave them. Not with subdivide_thick_quads.
-  // Across the surface a point moves a quarter voxel where the angle is
-  // below widen_far_below_deg, a sixteenth where it lies between the two.
+  // Across the surface a point moves about a quarter voxel where the angle
+  // is below widen_far_below_deg, about a sixteenth where it lies between
+  // the two (AngleLimits).
   double widen_angles_below_deg = 0;
-  double widen_far_below_deg = 0;
+  double widen_far_below_deg = 20;
   // Cut each quad on a grid with thicker slices into near-square ones (for
   // tetrahedra); surfaces keep one quad per voxel face.
   bool subdivide_thick_quads = true;

@@ -45,15 +45,17 @@ struct WidenedAngles {
 };
 
 // Which quads are widened, and how far their points may move across the
-// surface. A move across changes the shape inside the box: a quarter voxel
-// clears most thin triangles but, made wherever an angle is below 30
-// degrees, it roughens the surface and costs small labels their volume; a
-// sixteenth lifts the angles between 20 and 30 degrees without either.
+// surface, which changes the shape inside the box: a whole step where the
+// angle is far below the limit, a short one near it (docs/design-notes.md,
+// "Thin triangles on the net").
 struct AngleLimits {
-  double below_deg = 20;  // quads whose best split has an angle below this
-  // Below this many degrees a point may move the whole `across` step; at
-  // angles from here up to below_deg, short_fraction of it.
+  // Degrees: quads whose best split has an angle below this are widened.
+  double below_deg = 20;
+  // Degrees: below this a point may move the whole `across` step; from here
+  // up to below_deg, short_fraction of it. At or above below_deg: the whole
+  // step throughout.
   double far_below_deg = 20;
+  // The short step as a fraction of the whole one.
   double short_fraction = 0.25;
 };
 

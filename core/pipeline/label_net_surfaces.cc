@@ -25,9 +25,9 @@
 namespace labelmesh {
 namespace {
 
-// Delivered surfaces have no triangle angle below this where sliding
-// points inside their boxes can widen it (conforming/widen_small_angles.h);
-// below kWidenFarBelowDeg the points may move farther across the surface.
+// Thin triangles are widened towards this angle where moving points inside
+// their boxes can (conforming/widen_small_angles.h); below kWidenFarBelowDeg
+// the points may move farther across the surface.
 constexpr double kWidenAnglesBelowDeg = 30;
 constexpr double kWidenFarBelowDeg = 20;
 

@@ -18,7 +18,8 @@ struct SurfaceStatistics {
   // Smallest and largest interior angle over all triangles, degrees.
   double min_angle_deg = 0;
   double max_angle_deg = 0;
-  // Triangles with an angle below kWellShapedDeg.
+  // Triangles with an angle below kWellShapedDeg (the name says 30: the
+  // two change together).
   uint32_t triangles_below_30_deg = 0;
   // Edges with one incident triangle.
   uint32_t boundary_edges = 0;

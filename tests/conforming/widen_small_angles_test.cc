@@ -120,6 +120,12 @@ TEST(WidenSmallAngles, AnglesBetweenTheLimitsMoveAcrossOnlyTheShortStep) {
   widen_small_angles(far.quads, far.sides, far.slides, far.centre, boxes, {0.2, 0.2, 0.2}, limits,
                      far.points);
   EXPECT_GE(5 - far.points[5][2], 0.2 - 1e-12);
+
+  // A far limit at the limit itself: the whole step below it.
+  FlatNet whole = net_with_a_peak(3);
+  widen_small_angles(whole.quads, whole.sides, whole.slides, whole.centre, boxes, {0.2, 0.2, 0.2},
+                     {.below_deg = 30, .far_below_deg = 30}, whole.points);
+  EXPECT_GE(3 - whole.points[5][2], 0.2 - 1e-12);
 }
 
 // A move in a crossing pair is taken back by halves while the pair still
