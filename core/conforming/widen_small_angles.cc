@@ -202,9 +202,7 @@ WidenedAngles widen_small_angles(const std::vector<std::array<uint32_t, 4>>& qua
   // Where each moved point started: one moved in a pass may come back in a
   // later one, and counts only if it ends elsewhere.
   std::unordered_map<uint32_t, Vec3> started;
-  // A few passes: a point that moves changes its neighbours' quads too.
-  constexpr int kPasses = 3;
-  for (int pass = 0; pass < kPasses && !candidates.empty(); ++pass) {
+  for (int pass = 0; pass < kWideningPasses && !candidates.empty(); ++pass) {
     std::vector<uint32_t> moved_now;
     for (const uint32_t p : candidates) {
       const Vec3 from = points[p];

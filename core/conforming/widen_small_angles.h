@@ -59,6 +59,12 @@ struct AngleLimits {
   double short_fraction = 0.25;
 };
 
+// Passes over the thin quads' points: a point that moves changes its
+// neighbours' quads too, and later passes visit only those. Six leave half
+// as many triangles below 30 degrees as three on the brain, at the same
+// time; ten no fewer than six.
+inline constexpr int kWideningPasses = 6;
+
 // Moves the points of quads whose best split has an angle below
 // limits.below_deg, each held in its box around its `centre`: along the
 // surface first, and where that is not enough, along a voxel axis by
