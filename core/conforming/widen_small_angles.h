@@ -60,9 +60,8 @@ struct AngleLimits {
 };
 
 // Passes over the thin quads' points: a point that moves changes its
-// neighbours' quads too, and later passes visit only those. Six leave half
-// as many triangles below 30 degrees as three on the brain, at the same
-// time; ten no fewer than six.
+// neighbours' quads too, and later passes visit only those. Beyond six,
+// passes leave hardly fewer thin triangles (docs/design-notes.md).
 inline constexpr int kWideningPasses = 6;
 
 // Moves the points of quads whose best split has an angle below
