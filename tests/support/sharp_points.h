@@ -7,7 +7,6 @@
 #pragma once
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -15,6 +14,7 @@
 #include <vector>
 
 #include "core/surface/triangle_mesh.h"
+#include "core/util/vec3.h"
 
 namespace labelmesh::testing {
 
@@ -32,18 +32,11 @@ inline SharpPoints sharp_points(const surface::TriangleMesh& mesh, double defici
   for (const auto& t : mesh.triangles) {
     for (int k = 0; k < 3; ++k) {
       const auto& a = mesh.points[t[k]];
-      const auto& b = mesh.points[t[(k + 1) % 3]];
-      const auto& c = mesh.points[t[(k + 2) % 3]];
-      std::array<double, 3> u{}, v{};
-      for (int i = 0; i < 3; ++i) {
-        u[i] = b[i] - a[i];
-        v[i] = c[i] - a[i];
-      }
-      const double uu = u[0] * u[0] + u[1] * u[1] + u[2] * u[2];
-      const double vv = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
-      const double uv = u[0] * v[0] + u[1] * v[1] + u[2] * v[2];
-      if (uu > 0 && vv > 0)
-        angle[t[k]] += std::acos(std::clamp(uv / std::sqrt(uu * vv), -1.0, 1.0));
+      const geometry::Vec3 u = geometry::sub(mesh.points[t[(k + 1) % 3]], a);
+      const geometry::Vec3 v = geometry::sub(mesh.points[t[(k + 2) % 3]], a);
+      const double lengths = geometry::norm(u) * geometry::norm(v);
+      if (lengths > 0)
+        angle[t[k]] += std::acos(std::clamp(geometry::dot(u, v) / lengths, -1.0, 1.0));
       used[t[k]] = true;
       edges.emplace_back(std::min(t[k], t[(k + 1) % 3]), std::max(t[k], t[(k + 1) % 3]));
     }
