@@ -7,6 +7,7 @@
 #include <unordered_map>
 #include <utility>
 
+#include "core/conforming/cap_rims.h"
 #include "core/conforming/constrained_smoothing.h"
 #include "core/conforming/cube_sheets.h"
 #include "core/conforming/marked_cubes.h"
@@ -763,6 +764,7 @@ InterfaceSurface label_interfaces(const volume::LabelVolume& volume,
     for (size_t p = 0; p < net.label_count.size(); ++p) boxes.narrow[p] = net.label_count[p] > 2;
   }
   hold_at_edges(net.centre, geometry, boxes);
+  if (params.follow_cap_rims) figures.rim_points = follow_cap_rims(boxes, net.label_count, stencil);
   std::vector<Vec3> points = net.centre;
   smooth_in_boxes(stencil, net.centre, boxes, params, points);
   if (params.restore_volumes) restore_volumes(net, net.centre, boxes, points);

@@ -67,6 +67,9 @@ struct InterfaceParams {
   // A point per sheet through a cube (cube_sheets.h), so that two faces a
   // voxel apart can part; not on a grid cut into thinner slices.
   bool split_sheets = false;
+  // Smooth the rim of each flat cap on the volume's edge as a curve
+  // (cap_rims.h), not held to the last slice's pixel steps by the cap.
+  bool follow_cap_rims = false;
   // With split_sheets: voxels (linear indices into the volume, x fastest,
   // sorted) whose cubes keep one point, where parted faces crossed.
   std::vector<uint64_t> joined_voxels;
@@ -81,6 +84,9 @@ struct InterfaceFigures {
   size_t junction_points = 0;
   size_t curve_points = 0;
   size_t fixed_points = 0;
+  // Points on the rim of a cap on the volume's edge, smoothed along the rim
+  // only (cap_rims.h).
+  size_t rim_points = 0;
   // The farthest any point lies from its staircase position, mm: the surface
   // is within this distance of the voxel boundary (both share triangles).
   double max_offset_mm = 0;

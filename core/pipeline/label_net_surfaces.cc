@@ -42,6 +42,7 @@ conforming::InterfaceParams interface_params(const NetOptions& options) {
   params.widen_angles_below_deg = kWidenAnglesBelowDeg;
   params.widen_far_below_deg = kWidenFarBelowDeg;
   params.split_sheets = true;
+  params.follow_cap_rims = true;
   return params;
 }
 
