@@ -43,6 +43,7 @@
 #include "support/analytic_shapes.h"
 #include "support/label_overlap.h"
 #include "support/organs_on_slices.h"
+#include "support/rim_turns.h"
 #include "support/sharp_points.h"
 #include "support/slicer_like.h"
 
@@ -246,6 +247,8 @@ struct VolumeFigures {
   int labels_above_mc_nodes = 0;
   // Points sharper than kSharpDeficitRad (sharp_points.h), over all labels.
   testing::SharpPoints ours_sharp, slicer_sharp;
+  // Our caps' rims on the volume's edge (rim_turns.h), over all labels.
+  testing::RimTurns ours_rims;
   // Triangles, and those with an angle below 30 degrees, over all labels.
   uint64_t ours_triangles = 0, ours_below_30 = 0, slicer_triangles = 0, slicer_below_30 = 0;
 };
@@ -437,6 +440,7 @@ int bench_volume(const std::string& path, int rounds) {
     };
     add_sharp(ours->mesh, f.ours_sharp);
     add_sharp(slicer[i].mesh, f.slicer_sharp);
+    testing::add_rim_turns(ours->mesh, drawn ? drawn->geometry : volume.geometry, f.ours_rims);
     if (const char* out = std::getenv("LABELMESH_BENCH_OUT")) {
       const std::string stem = std::string(out) + "/label" + std::to_string(labels[i]);
       (void)surface::write_surface(slicer[i].mesh, stem + "-slicer.stl",
@@ -509,6 +513,12 @@ int bench_volume(const std::string& path, int rounds) {
       100.0 * double(f.ours_sharp.sharp) / double(std::max<size_t>(1, f.ours_sharp.points)),
       f.slicer_sharp.sharp, f.slicer_sharp.points,
       100.0 * double(f.slicer_sharp.sharp) / double(std::max<size_t>(1, f.slicer_sharp.points)));
+  if (f.ours_rims.points > 0)
+    std::printf(
+        "  rims of caps on the volume's edge: %zu points, turning %.1f deg on average, more than "
+        "30 deg at %.1f %%\n",
+        f.ours_rims.points, f.ours_rims.sum_deg / double(f.ours_rims.points),
+        100.0 * double(f.ours_rims.over_30_deg) / double(f.ours_rims.points));
   const auto per_million = [](uint64_t part, uint64_t whole) {
     return 1e6 * double(part) / double(std::max<uint64_t>(1, whole));
   };
