@@ -7,8 +7,8 @@ namespace labelmesh::conforming {
 
 size_t follow_cap_rims(const PointBoxes& boxes, const std::vector<uint8_t>& label_count,
                        Stencil& stencil) {
+  if (boxes.pinned.empty() || stencil.start.empty()) return 0;
   const size_t n = stencil.start.size() - 1;
-  if (boxes.pinned.empty()) return 0;
   // The one plane a point is pinned to, 0 for none or a corner of the
   // volume's box (pinned to two planes or three).
   const auto plane = [&](size_t p) -> uint8_t {
@@ -26,34 +26,25 @@ size_t follow_cap_rims(const PointBoxes& boxes, const std::vector<uint8_t>& labe
       }
     }
   }
-  Stencil followed;
-  followed.start.assign(n + 1, 0);
-  followed.neighbours.reserve(stencil.neighbours.size());
-  followed.along_curve = stencil.along_curve;
+  const auto on_rim_with = [&](size_t p, uint32_t q) { return rim[q] && plane(q) == plane(p); };
+  // Compacted in place: a point's new list never ends after its old one.
   size_t following = 0;
+  uint32_t write = 0;
   for (size_t p = 0; p < n; ++p) {
-    followed.start[p] = static_cast<uint32_t>(followed.neighbours.size());
     const uint32_t first = stencil.start[p], last = stencil.start[p + 1];
+    stencil.start[p] = write;
     size_t on_rim = 0;
-    if (rim[p]) {
-      for (uint32_t i = first; i < last; ++i) {
-        const uint32_t q = stencil.neighbours[i];
-        if (rim[q] && plane(q) == plane(p)) ++on_rim;
-      }
-    }
-    if (on_rim == 2) {
-      for (uint32_t i = first; i < last; ++i) {
-        const uint32_t q = stencil.neighbours[i];
-        if (rim[q] && plane(q) == plane(p)) followed.neighbours.push_back(q);
-      }
-      ++following;
-    } else {
-      followed.neighbours.insert(followed.neighbours.end(), stencil.neighbours.begin() + first,
-                                 stencil.neighbours.begin() + last);
+    if (rim[p])
+      for (uint32_t i = first; i < last; ++i) on_rim += on_rim_with(p, stencil.neighbours[i]);
+    const bool follows = on_rim == 2;
+    following += follows;
+    for (uint32_t i = first; i < last; ++i) {
+      const uint32_t q = stencil.neighbours[i];
+      if (!follows || on_rim_with(p, q)) stencil.neighbours[write++] = q;
     }
   }
-  followed.start[n] = static_cast<uint32_t>(followed.neighbours.size());
-  stencil = std::move(followed);
+  stencil.start[n] = write;
+  stencil.neighbours.resize(write);
   return following;
 }
 

@@ -15,11 +15,15 @@ namespace labelmesh::conforming {
 
 // Neighbours each point averages over: every neighbour on a patch between
 // two labels; on a junction curve held sharp, only its two neighbours on the
-// curve. Points where such curves meet or end have none and stay fixed.
+// curve; on the rim of a cap on the volume's edge, only its two neighbours on
+// the rim (cap_rims.h). Points where such curves meet or end have none and
+// stay fixed.
 struct Stencil {
   std::vector<uint32_t> start;  // CSR offsets, one past the last point
   std::vector<uint32_t> neighbours;
-  // Per point: smoothed along a junction curve (its two neighbours).
+  // Per point: smoothed along a junction curve (its two neighbours), which
+  // the angle widening slides it along. Rim points are not marked: they
+  // slide over the surface.
   std::vector<bool> along_curve;
 };
 

@@ -146,6 +146,7 @@ absl::StatusOr<LayerNet> layer_net(const volume::LabelVolume& layer,
   conforming::InterfaceParams flat = interface_params(options);
   flat.smoothing_rounds = 0;
   flat.widen_angles_below_deg = 0;
+  flat.follow_cap_rims = false;
   made.staircase = conforming::label_interfaces(layer, here, flat, figures);
   return made;
 }

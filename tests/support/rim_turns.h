@@ -28,7 +28,10 @@ struct RimTurns {
 // Adds `mesh`'s rim points to `sum`. A point lies on an edge plane when its
 // index along an axis of `geometry` is -1/2 or the last voxel's plus 1/2; a
 // cap triangle has its three points on one plane, and a rim edge is a cap
-// triangle's edge that a triangle off the cap shares.
+// triangle's edge that a triangle off the cap shares. Read from delivered
+// surfaces, the measure is approximate: a rim point the angle widening slid
+// off the plane breaks its rim there, and on thick slices a wall point held
+// at the edge by its wide box counts as on the cap.
 inline void add_rim_turns(const surface::TriangleMesh& mesh, const volume::ImageGeometry& geometry,
                           RimTurns& sum) {
   constexpr double kOnPlane = 1e-6;  // voxels
