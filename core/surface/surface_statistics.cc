@@ -19,9 +19,9 @@ using geometry::norm;
 using geometry::sub;
 using Vec = geometry::Vec3;
 
-// Angle between two edge vectors, degrees; robust near 0 and 180.
+// Angle between two edge vectors, degrees.
 double angle_deg(const Vec& u, const Vec& v) {
-  return std::atan2(norm(cross(u, v)), dot(u, v)) * 180.0 / std::numbers::pi;
+  return geometry::angle_between(u, v) * 180.0 / std::numbers::pi;
 }
 
 using geometry::DisjointSets;

@@ -64,10 +64,8 @@ inline void add_rim_turns(const surface::TriangleMesh& mesh, const volume::Image
     if (ends.size() != 2) continue;
     const geometry::Vec3 in = geometry::sub(mesh.points[p], mesh.points[ends[0]]);
     const geometry::Vec3 out = geometry::sub(mesh.points[ends[1]], mesh.points[p]);
-    const double lengths = geometry::norm(in) * geometry::norm(out);
-    if (lengths <= 0) continue;
-    const double turn =
-        std::acos(std::clamp(geometry::dot(in, out) / lengths, -1.0, 1.0)) * 180 / M_PI;
+    if (geometry::norm(in) * geometry::norm(out) <= 0) continue;
+    const double turn = geometry::angle_between(in, out) * 180 / M_PI;
     ++sum.points;
     sum.sum_deg += turn;
     if (turn > 30) ++sum.over_30_deg;

@@ -32,11 +32,8 @@ inline SharpPoints sharp_points(const surface::TriangleMesh& mesh, double defici
   for (const auto& t : mesh.triangles) {
     for (int k = 0; k < 3; ++k) {
       const auto& a = mesh.points[t[k]];
-      const geometry::Vec3 u = geometry::sub(mesh.points[t[(k + 1) % 3]], a);
-      const geometry::Vec3 v = geometry::sub(mesh.points[t[(k + 2) % 3]], a);
-      const double lengths = geometry::norm(u) * geometry::norm(v);
-      if (lengths > 0)
-        angle[t[k]] += std::acos(std::clamp(geometry::dot(u, v) / lengths, -1.0, 1.0));
+      angle[t[k]] += geometry::angle_between(geometry::sub(mesh.points[t[(k + 1) % 3]], a),
+                                             geometry::sub(mesh.points[t[(k + 2) % 3]], a));
       used[t[k]] = true;
       edges.emplace_back(std::min(t[k], t[(k + 1) % 3]), std::max(t[k], t[(k + 1) % 3]));
     }
