@@ -84,9 +84,23 @@ PaddedLabels padded_labels(const volume::LabelVolume& volume, std::vector<int32_
 // of their volume (the frog's tissues of 4 to 121 voxels lost 11 to 49 %).
 constexpr uint64_t kSharpJunctionLabelVoxels = 500;
 
-// The labels of `labels` with fewer than kSharpJunctionLabelVoxels voxels
-// times `parts` (the thinner slices each drawn one was cut into), sorted.
-std::vector<int32_t> small_labels(const PaddedLabels& labels, int parts) {
+// Labels of fewer voxels than this keep their voxels' shape: every point
+// next to them stays. Smoothed, a lone voxel among three labels kept 62 %
+// of its volume, and no move along the normals can give it back where all
+// its points are junction points.
+constexpr uint64_t kFixedLabelVoxels = 27;
+
+// The labels next to which junction curves are held sharp, and those next
+// to which every point stays (each sorted).
+struct SmallLabels {
+  std::vector<int32_t> sharp;
+  std::vector<int32_t> fixed;
+};
+
+// The labels of `labels` with fewer than kSharpJunctionLabelVoxels (and
+// kFixedLabelVoxels) voxels times `parts` (the thinner slices each drawn
+// one was cut into).
+SmallLabels small_labels(const PaddedLabels& labels, int parts) {
   std::unordered_map<int32_t, uint64_t> voxels;
   const auto& all = labels.labels;
   for (size_t run = 0; run < all.size();) {
@@ -95,11 +109,15 @@ std::vector<int32_t> small_labels(const PaddedLabels& labels, int parts) {
     voxels[all[run]] += end - run;
     run = end;
   }
-  std::vector<int32_t> small;
-  for (const auto& [label, count] : voxels)
-    if (label != kOutside && count < kSharpJunctionLabelVoxels * uint64_t(std::max(parts, 1)))
-      small.push_back(label);
-  std::sort(small.begin(), small.end());
+  SmallLabels small;
+  const auto times = uint64_t(std::max(parts, 1));
+  for (const auto& [label, count] : voxels) {
+    if (label == kOutside) continue;
+    if (count < kSharpJunctionLabelVoxels * times) small.sharp.push_back(label);
+    if (count < kFixedLabelVoxels * times) small.fixed.push_back(label);
+  }
+  std::sort(small.sharp.begin(), small.sharp.end());
+  std::sort(small.fixed.begin(), small.fixed.end());
   return small;
 }
 
@@ -112,8 +130,10 @@ struct Net {
   // Where cubes hold a point per sheet (cube_sheets.h): each numbered
   // cube's first point, and one past the last; empty otherwise.
   std::vector<uint32_t> first_point;
-  // There too: points whose sheets hold a small label (small_labels).
+  // There too: points whose sheets hold a small label, and a label kept
+  // fixed (small_labels).
   std::vector<bool> near_small;
+  std::vector<bool> near_fixed;
   std::vector<std::array<uint32_t, 4>> quads;
   std::vector<std::array<int32_t, 2>> quad_sides;
   std::vector<uint8_t> quad_axis;                    // the axis between the quad's two voxels
@@ -213,7 +233,7 @@ bool touches_joined(const PaddedLabels& labels, const std::array<int64_t, 3>& di
 // (sorted) marks the points next to small labels.
 Net net_points(const PaddedLabels& labels, const std::array<double, 3>& spacing,
                const std::vector<VoxelPair>& pairs, MarkedCubes& cubes, bool split,
-               const std::vector<int32_t>& small, const std::array<int64_t, 3>& dims,
+               const SmallLabels& small, const std::array<int64_t, 3>& dims,
                const std::vector<uint64_t>& joined) {
   // A cube's corners hold more than one label exactly when one of its edges
   // joins two different labels, and every such edge's quad uses the four
@@ -246,19 +266,24 @@ Net net_points(const PaddedLabels& labels, const std::array<double, 3>& spacing,
     if (touches_joined(labels, dims, joined, a, b, c)) {
       net.centre.push_back(centre);
       net.label_count.push_back(distinct_labels(corner));
-      net.near_small.push_back(holds_small(corner, small));
+      net.near_small.push_back(holds_small(corner, small.sharp));
+      net.near_fixed.push_back(holds_small(corner, small.fixed));
       return;
     }
     const CubeSheets sheets = cube_sheets(corner);
     for (int g = 0; g < sheets.sheet_count; ++g) {
       net.centre.push_back(centre);
       net.label_count.push_back(sheets.labels[g]);
-      bool near = false;
+      bool near = false, near_fixed = false;
       for (int k = 0; k < sheets.pair_count; ++k)
         if (sheets.sheet[k] == g)
-          for (const int32_t label : sheets.pairs[k])
-            near = near || std::binary_search(small.begin(), small.end(), label);
+          for (const int32_t label : sheets.pairs[k]) {
+            near = near || std::binary_search(small.sharp.begin(), small.sharp.end(), label);
+            near_fixed =
+                near_fixed || std::binary_search(small.fixed.begin(), small.fixed.end(), label);
+          }
       net.near_small.push_back(near);
+      net.near_fixed.push_back(near_fixed);
     }
   });
   if (split) net.first_point.push_back(static_cast<uint32_t>(net.centre.size()));
@@ -348,14 +373,15 @@ void hold_junction(uint32_t p, size_t first, size_t on_curve, const std::array<u
 // where three labels meet is mostly a band, not a curve (a gap of outside one
 // voxel wide between two organs, a thin tissue between them), and held to
 // its curves the surface kept its staircase there. Only next to a label in
-// `small` (sorted) is the curve held sharp, as Frisken's nets do: a junction
+// `small.sharp` is the curve held sharp, as Frisken's nets do: a junction
 // point then averages over its two neighbours on the curve, and stays where
 // it has another count or, with `fix_turns_back` (on thinner slices, whose
 // interpolated labels make such curves), where its curve turns back.
 // Anywhere, a junction point with fewer than two junction neighbours (a
-// curve's end, a lone cube holding three labels) stays.
+// curve's end, a lone cube holding three labels) stays, and so does every
+// point next to a label in `small.fixed`.
 Stencil smoothing_stencil(const Net& net, const PaddedLabels& labels, const MarkedCubes& cubes,
-                          const std::vector<int32_t>& small, bool fix_turns_back,
+                          const SmallLabels& small, bool fix_turns_back,
                           InterfaceFigures& figures) {
   constexpr std::array<std::array<int, 2>, 6> kDirections{
       {{2, -1}, {1, -1}, {0, -1}, {0, 1}, {1, 1}, {2, 1}}};  // axis, sign
@@ -364,8 +390,8 @@ Stencil smoothing_stencil(const Net& net, const PaddedLabels& labels, const Mark
   stencil.start.assign(n + 1, 0);
   stencil.neighbours.reserve(4 * n);
   stencil.along_curve.assign(n, false);
-  const auto next_to_small = [&](const std::array<int64_t, 3>& cube) {
-    return holds_small(corners(labels, cube[0], cube[1], cube[2]), small);
+  const auto next_to = [&](const std::array<int64_t, 3>& cube, const std::vector<int32_t>& some) {
+    return holds_small(corners(labels, cube[0], cube[1], cube[2]), some);
   };
   cubes.for_each_point([&](size_t i, uint32_t p) {
     stencil.start[p] = static_cast<uint32_t>(stencil.neighbours.size());
@@ -405,9 +431,14 @@ Stencil smoothing_stencil(const Net& net, const PaddedLabels& labels, const Mark
       }
       ++on_curve;
     }
+    if (junction) ++figures.junction_points;
+    if (!small.fixed.empty() && next_to(cube, small.fixed)) {
+      stencil.neighbours.resize(first);
+      ++figures.fixed_points;
+      return;
+    }
     if (!junction) return;
-    ++figures.junction_points;
-    if (on_curve >= 2 && !next_to_small(cube)) return;
+    if (on_curve >= 2 && !next_to(cube, small.sharp)) return;
     hold_junction(p, first, on_curve, curve,
                   on_curve == 2 && fix_turns_back && turns_back(cube, taken, cubes, net), stencil,
                   figures);
@@ -420,8 +451,9 @@ Stencil smoothing_stencil(const Net& net, const PaddedLabels& labels, const Mark
 // points are neighbours when a quad has both as consecutive corners (as in
 // smoothing_stencil, where they share a face whose voxels differ). Junction
 // points follow smoothing_stencil's rules, without the turn test (such nets
-// are not made on thinner slices), and a point holds its curve when a small
-// label is on its own sheet, not merely in its cube.
+// are not made on thinner slices), and a point holds its curve (or stays,
+// next to a label kept fixed) when such a label is on its own sheet, not
+// merely in its cube.
 Stencil stencil_from_quads(const Net& net, InterfaceFigures& figures) {
   const size_t n = net.centre.size();
   // Each point's quad neighbours, with repeats (an edge lies on two quads
@@ -461,8 +493,13 @@ Stencil stencil_from_quads(const Net& net, InterfaceFigures& figures) {
       if (on_curve < 2) curve[on_curve] = q;
       ++on_curve;
     }
+    if (net.label_count[p] > 2) ++figures.junction_points;
+    if (net.near_fixed[p]) {
+      stencil.neighbours.resize(first);
+      ++figures.fixed_points;
+      continue;
+    }
     if (net.label_count[p] <= 2) continue;
-    ++figures.junction_points;
     if (on_curve >= 2 && !net.near_small[p]) continue;
     hold_junction(static_cast<uint32_t>(p), first, on_curve, curve, /*turns_back=*/false, stencil,
                   figures);
@@ -728,12 +765,11 @@ InterfaceSurface label_interfaces(const volume::LabelVolume& volume,
     const auto find_small = [&] {
       return params.smoothing_rounds > 0 || params.widen_angles_below_deg > 0
                  ? small_labels(padded, params.drawn_axis >= 0 ? params.drawn_parts : 1)
-                 : std::vector<int32_t>{};
+                 : SmallLabels{};
     };
     const bool split = params.split_sheets && params.drawn_axis < 0;
     net = net_points(padded, geometry.spacing, pairs, cubes, split,
-                     split ? find_small() : std::vector<int32_t>{}, geometry.dims,
-                     params.joined_voxels);
+                     split ? find_small() : SmallLabels{}, geometry.dims, params.joined_voxels);
     // On one point per cube the quads and the smoothing stencil only read
     // the numbered cubes and write apart: they are made side by side. The
     // quads' arrays are reserved here, so that they belong to this thread's

@@ -79,8 +79,9 @@ struct InterfaceFigures {
   size_t points = 0;
   size_t triangles = 0;
   // Points where three or more labels meet; of those, the ones smoothed
-  // along their junction curve only (next to a small label) and the fixed
-  // ones where such curves meet or end.
+  // along their junction curve only (next to a small label). Fixed points:
+  // where such curves meet or end, and every point next to a label of a few
+  // voxels, which keeps its voxels' shape.
   size_t junction_points = 0;
   size_t curve_points = 0;
   size_t fixed_points = 0;

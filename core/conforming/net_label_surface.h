@@ -35,7 +35,7 @@ struct NetLabelSurface {
 
 // How far a split copy moves from the shared point towards the centre of its
 // own voxels, as a fraction of the way.
-inline constexpr double kSplitNudge = 0.1;
+inline constexpr double kSplitNudge = 0.05;
 
 // The surface of `label` in `net` (empty when no triangle bounds it).
 // `geometry` is the volume the net was built from.
