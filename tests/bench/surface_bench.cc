@@ -153,6 +153,7 @@ int bench_phantoms() {
                                 {"1x1x3 mm oblique", {1, 1, 3}, 25},
                                 // The ellipsoid's poles and the torus's top lie on slice
                                 // centres above; here they end between two slices.
+                                {"3 mm, half up", {3, 3, 3}, 0, 0.5},
                                 {"1x1x3 mm, half up", {1, 1, 3}, 0, 0.5},
                                 {"0.6x0.6x4 half up", {0.6, 0.6, 4}, 0, 0.5}};
   const std::vector<AnalyticShape> shapes{
