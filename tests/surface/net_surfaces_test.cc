@@ -728,6 +728,46 @@ TEST(NetSurfacesRealData, MrLabelsAreFaithfulAndSmooth) {
   EXPECT_THAT(run_pipeline(path, strict, {}), testing::IsOk());
 }
 
+// The volumes with the most and the smallest labels: 1 mm brain (40
+// labels, two of four voxels) and frog (25 tissues, one of four lone
+// voxels where three others meet). Every label is the net within the
+// voxel tolerance, closed, manifold, without self-intersection, and with
+// at most one triangle in a thousand below 30 degrees: the run has no
+// warning, so --strict would accept it.
+class EveryLabelTheNet : public ::testing::TestWithParam<std::pair<const char*, size_t>> {};
+
+TEST_P(EveryLabelTheNet, WithinTheVoxelToleranceWithoutWarnings) {
+  LABELMESH_SKIP_WITHOUT_SHARED_DATA();
+  const auto path = testing::shared_data(GetParam().first);
+  if (!std::filesystem::exists(path)) GTEST_SKIP() << "missing " << path;
+  auto result = run_pipeline(path, MeshParams{}, {});
+  ASSERT_THAT(result, testing::IsOk());
+  size_t nets = 0;
+  uint64_t triangles = 0, below_30 = 0;
+  for (const auto& s : result->surfaces) {
+    if (!s.is_output) continue;
+    SCOPED_TRACE("label " + std::to_string(s.label));
+    EXPECT_EQ(s.stage, "net");
+    ASSERT_TRUE(s.fidelity.has_value());
+    EXPECT_TRUE(s.fidelity->within_tolerance());
+    EXPECT_TRUE(s.statistics.closed);
+    EXPECT_TRUE(s.statistics.manifold);
+    EXPECT_EQ(s.self_intersections, uint64_t{0});
+    nets += s.stage == "net";
+    triangles += s.statistics.triangles;
+    below_30 += s.statistics.triangles_below_30_deg;
+  }
+  EXPECT_EQ(nets, GetParam().second);
+  EXPECT_LE(below_30 * 1000, triangles);
+  for (const auto& warning : result->warnings)
+    ADD_FAILURE() << "label " << warning.label << ": " << warning.reason;
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    SharedVolumes, EveryLabelTheNet,
+    ::testing::Values(std::pair<const char*, size_t>{"iso2mesh_brain_seg_converted.nii.gz", 40},
+                      std::pair<const char*, size_t>{"frogtissue.mhd", 25}));
+
 // Touching MR organs share their interfaces: no node of one label's surface
 // lies inside another's by more than a tenth of a voxel, where the same
 // labels smoothed each on its own (the Slicer-like surfaces) enter each
