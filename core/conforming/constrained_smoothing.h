@@ -16,8 +16,8 @@ namespace labelmesh::conforming {
 // Neighbours each point averages over: every neighbour on a patch between
 // two labels; on a junction curve held sharp, only its two neighbours on the
 // curve; on the rim of a cap on the volume's edge, only its two neighbours on
-// the rim (cap_rims.h). Points where such curves meet or end have none and
-// stay fixed.
+// the rim (cap_rims.h). Points where such curves meet or end, and points
+// next to a label of a few voxels, have none and stay fixed.
 struct Stencil {
   std::vector<uint32_t> start;  // CSR offsets, one past the last point
   std::vector<uint32_t> neighbours;

@@ -85,9 +85,9 @@ PaddedLabels padded_labels(const volume::LabelVolume& volume, std::vector<int32_
 constexpr uint64_t kSharpJunctionLabelVoxels = 500;
 
 // Labels of fewer voxels than this keep their voxels' shape: every point
-// next to them stays. Smoothed, a lone voxel among three labels kept 62 %
-// of its volume, and no move along the normals can give it back where all
-// its points are junction points.
+// next to them stays. Smoothed, the frog's tissue of four lone voxels, each
+// where three other labels meet, kept 62 % of its volume, and the volume
+// step cannot give it back: it moves no point where three labels meet.
 constexpr uint64_t kFixedLabelVoxels = 27;
 
 // The labels next to which junction curves are held sharp, and those next
@@ -130,8 +130,8 @@ struct Net {
   // Where cubes hold a point per sheet (cube_sheets.h): each numbered
   // cube's first point, and one past the last; empty otherwise.
   std::vector<uint32_t> first_point;
-  // There too: points whose sheets hold a small label, and a label kept
-  // fixed (small_labels).
+  // There too, per point: whether its sheets hold a label in
+  // SmallLabels::sharp, and one in SmallLabels::fixed (small_labels).
   std::vector<bool> near_small;
   std::vector<bool> near_fixed;
   std::vector<std::array<uint32_t, 4>> quads;
@@ -230,7 +230,7 @@ bool touches_joined(const PaddedLabels& labels, const std::array<int64_t, 3>& di
 // numbered in cube index order.
 // With `split`, a point per sheet through the cube (cube_sheets.h), but one
 // in cubes with a corner among `joined` (touches_joined), and `small`
-// (sorted) marks the points next to small labels.
+// marks the points next to small labels (Net::near_small, near_fixed).
 Net net_points(const PaddedLabels& labels, const std::array<double, 3>& spacing,
                const std::vector<VoxelPair>& pairs, MarkedCubes& cubes, bool split,
                const SmallLabels& small, const std::array<int64_t, 3>& dims,
@@ -274,15 +274,17 @@ Net net_points(const PaddedLabels& labels, const std::array<double, 3>& spacing,
     for (int g = 0; g < sheets.sheet_count; ++g) {
       net.centre.push_back(centre);
       net.label_count.push_back(sheets.labels[g]);
-      bool near = false, near_fixed = false;
+      bool near_sharp = false;
+      bool near_fixed = false;
       for (int k = 0; k < sheets.pair_count; ++k)
         if (sheets.sheet[k] == g)
           for (const int32_t label : sheets.pairs[k]) {
-            near = near || std::binary_search(small.sharp.begin(), small.sharp.end(), label);
+            near_sharp =
+                near_sharp || std::binary_search(small.sharp.begin(), small.sharp.end(), label);
             near_fixed =
                 near_fixed || std::binary_search(small.fixed.begin(), small.fixed.end(), label);
           }
-      net.near_small.push_back(near);
+      net.near_small.push_back(near_sharp);
       net.near_fixed.push_back(near_fixed);
     }
   });
@@ -390,8 +392,8 @@ Stencil smoothing_stencil(const Net& net, const PaddedLabels& labels, const Mark
   stencil.start.assign(n + 1, 0);
   stencil.neighbours.reserve(4 * n);
   stencil.along_curve.assign(n, false);
-  const auto next_to = [&](const std::array<int64_t, 3>& cube, const std::vector<int32_t>& some) {
-    return holds_small(corners(labels, cube[0], cube[1], cube[2]), some);
+  const auto next_to = [&](const std::array<int64_t, 3>& cube, const std::vector<int32_t>& these) {
+    return holds_small(corners(labels, cube[0], cube[1], cube[2]), these);
   };
   cubes.for_each_point([&](size_t i, uint32_t p) {
     stencil.start[p] = static_cast<uint32_t>(stencil.neighbours.size());
@@ -591,10 +593,10 @@ std::vector<double> label_moves(const std::vector<std::array<uint32_t, 2>>& pair
 // and a point between two labels by the difference of theirs. A thin label
 // between two thick ones so takes its volume from them, the thick ones
 // pass what they give on to their own neighbours or the outside, and the
-// outside moves nothing. Points where more than one pair meets stay; every
-// point stays in its box.
-void restore_volumes(const Net& net, const std::vector<Vec3>& centre, const PointBoxes& boxes,
-                     std::vector<Vec3>& points) {
+// outside moves nothing. Points where more than one pair meets stay, and so
+// do the points the stencil keeps fixed; every point stays in its box.
+void restore_volumes(const Net& net, const Stencil& stencil, const std::vector<Vec3>& centre,
+                     const PointBoxes& boxes, std::vector<Vec3>& points) {
   const SideSlots slots = side_slots(net);
   const auto outside = static_cast<uint32_t>(
       std::lower_bound(slots.labels.begin(), slots.labels.end(), kOutside) - slots.labels.begin());
@@ -649,6 +651,8 @@ void restore_volumes(const Net& net, const std::vector<Vec3>& centre, const Poin
         normal[p] = geometry::add(normal[p], n);
       }
     }
+    for (size_t p = 0; p < points.size(); ++p)
+      if (stencil.start[p] == stencil.start[p + 1]) point_pair[p] = kMore;
     // The area each pair's moving points carry: a point moved by d along
     // its normal moves a quarter of each of its quads by d.
     for (size_t q = 0; q < net.quads.size(); ++q) {
@@ -803,7 +807,7 @@ InterfaceSurface label_interfaces(const volume::LabelVolume& volume,
   if (params.follow_cap_rims) figures.rim_points = follow_cap_rims(boxes, net.label_count, stencil);
   std::vector<Vec3> points = net.centre;
   smooth_in_boxes(stencil, net.centre, boxes, params, points);
-  if (params.restore_volumes) restore_volumes(net, net.centre, boxes, points);
+  if (params.restore_volumes) restore_volumes(net, stencil, net.centre, boxes, points);
   std::vector<Vec3> before_widening;
   // Widened nets keep two triangles per quad (the take-back splits quads
   // again), so a net cut into smaller quads is not widened.

@@ -34,7 +34,9 @@ struct NetLabelSurface {
 };
 
 // How far a split copy moves from the shared point towards the centre of its
-// own voxels, as a fraction of the way.
+// own voxels, as a fraction of the way: enough to part the copies, little
+// enough that a label of a few voxels touching along edges keeps its
+// volume (a tenth took 11 % of four voxels in a row).
 inline constexpr double kSplitNudge = 0.05;
 
 // The surface of `label` in `net` (empty when no triangle bounds it).

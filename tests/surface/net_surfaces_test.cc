@@ -381,20 +381,43 @@ TEST(NetSurfaces, AThinLabelBetweenTwoThickOnesKeepsItsVolume) {
   }
 }
 
-// A label of a few voxels keeps its voxels' shape. Label 3 is four voxels
-// in a row, touching along edges, on the diagonal interface between labels
-// 1 and 2 (every point of it a junction point, as in the frog's tissue of
-// four voxels); label 4 is one voxel on label 1's face. Smoothed, label 3
-// kept 62 % of its volume (outside the 10 % allowed labels of fewer than
-// 1,000 voxels), and moves along the normals cannot give back a volume
-// that only junction points bound.
-TEST(NetSurfaces, ALabelOfAFewVoxelsKeepsItsVoxelsShape) {
-  const auto volume = testing::label_grid({14, 14, 14}, [](int i, int j, int k) -> uint8_t {
+// Label 3 is four voxels in a row, touching along edges, on the diagonal
+// interface between labels 1 and 2 (as the frog's tissue of four lone
+// voxels sits where three others meet); label 4 is one voxel on label 1's
+// face.
+volume::LabelVolume labels_of_a_few_voxels() {
+  return testing::label_grid({14, 14, 14}, [](int i, int j, int k) -> uint8_t {
     if (k == 5 && i + j == 14 && i >= 5 && i <= 8) return 3;
     if (i == 1 && j == 5 && k == 5) return 4;
     if (std::min({i, j, k}) < 2 || std::max({i, j, k}) > 11) return 0;
     return i + j + k < 20 ? 1 : 2;
   });
+}
+
+// Both stencils (a point per sheet, and one per cube as on thinner slices)
+// keep every point next to a label of a few voxels where it is: the lone
+// voxel's surface is its cube.
+TEST(NetSurfaces, PointsNextToALabelOfAFewVoxelsStayWithEitherStencil) {
+  const auto volume = labels_of_a_few_voxels();
+  for (const bool split : {true, false}) {
+    auto params = net_interface_params(NetOptions{});
+    params.split_sheets = split;
+    conforming::InterfaceFigures figures;
+    const auto net = conforming::label_interfaces(volume, {}, params, figures);
+    const auto lone = conforming::net_label_surface(net, 4, volume.geometry);
+    ASSERT_EQ(lone.mesh.points.size(), 8u) << split;
+    EXPECT_EQ(lone.mesh.points, lone.staircase.points) << split;
+    EXPECT_NEAR(surface::signed_volume(lone.mesh), 1.0, 1e-12) << split;
+    EXPECT_GE(figures.fixed_points, 8u) << split;
+  }
+}
+
+// A label of a few voxels keeps its voxels' shape through the pipeline.
+// Smoothed, the row kept 39 % of its volume (outside the 10 % allowed
+// labels of fewer than 1,000 voxels), and its split copies, moved a tenth
+// of the way, took 11 % of the frog's row.
+TEST(NetSurfaces, ALabelOfAFewVoxelsKeepsItsVoxelsShape) {
+  const auto volume = labels_of_a_few_voxels();
   auto result = run_pipeline_on_volume(volume, MeshParams{}, {});
   ASSERT_THAT(result, testing::IsOk());
   for (const int32_t label : {1, 2, 3, 4}) {
