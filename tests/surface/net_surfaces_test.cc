@@ -475,6 +475,38 @@ TEST(NetSurfaces, ThickSliceShapesAreTruerThanTheSlicerLikePipeline) {
   }
 }
 
+// The torus's top and the ellipsoid's poles lie on slice centres of these
+// grids centred on the shapes, so their voxels end a slice short of the
+// true shape there (the 3 mm torus's normals' 95th percentile 11.2
+// degrees). Half a slice up they end between slices, as organs do, and
+// the net is within a quarter of the smallest spacing and 10 degrees,
+// closer with truer normals than the Slicer-like surface.
+TEST(NetSurfaces, ShapesEndingBetweenSlicesAreTruerThanTheSlicerLikePipeline) {
+  struct Case {
+    testing::AnalyticShape shape;
+    std::array<double, 3> spacing;
+  };
+  const std::vector<Case> cases{{testing::torus_shape(25, 9), {3, 3, 3}},
+                                {testing::ellipsoid_shape(32, 22, 15), {3, 3, 3}},
+                                {testing::torus_shape(25, 9), {1, 1, 3}},
+                                {testing::ellipsoid_shape(32, 22, 15), {1, 1, 3}}};
+  for (const auto& [shape, spacing] : cases) {
+    SCOPED_TRACE(shape.name + " " + std::to_string(spacing[0]));
+    const auto both = both_surfaces(testing::sample_shape(shape, spacing, 0, 0.5));
+    ASSERT_EQ(both.slicer.size(), 1u);
+    ASSERT_THAT(both.result, testing::IsOk());
+    const auto* ours = both.ours();
+    ASSERT_NE(ours, nullptr);
+    EXPECT_EQ(ours->stage, "net");
+    const auto mine = testing::shape_error(ours->mesh, shape);
+    const auto theirs = testing::shape_error(both.slicer.front().mesh, shape);
+    EXPECT_LT(mine.rms_mm, theirs.rms_mm);
+    EXPECT_LT(mine.normal_p95_deg, theirs.normal_p95_deg);
+    EXPECT_LT(mine.rms_mm, 0.25 * spacing[0]);
+    EXPECT_LT(mine.normal_p95_deg, 10);
+  }
+}
+
 // A tube 9 mm across whose top and bottom lie on drawn slices' centres: two
 // slices hold it, and its voxels end a whole slice short of the next. The
 // thinner grid keeps its voxels' volume, so the net does too and is
