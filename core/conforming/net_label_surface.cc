@@ -181,6 +181,12 @@ NetLabelSurface net_label_surface(const InterfaceSurface& net, int32_t label,
       ++voxel_count[p];
     }
   }
+  // A copy `fraction` of the way from its net point towards its voxels.
+  const auto nudged = [&](size_t p, double fraction) {
+    const Vec3& at = net.points[source[p]];
+    const Vec3 towards = geometry::scale(voxel_sum[p], 1.0 / voxel_count[p]);
+    return geometry::add(at, geometry::scale(geometry::sub(towards, at), fraction));
+  };
   mesh.points.resize(source.size());
   staircase.points.resize(source.size());
   for (size_t p = 0; p < source.size(); ++p) {
@@ -188,9 +194,7 @@ NetLabelSurface net_label_surface(const InterfaceSurface& net, int32_t label,
     staircase.points[p] = net.staircase[source[p]];
     if (copies[source[p]] < 2) continue;
     ++result.split_points;
-    const Vec3 towards = geometry::scale(voxel_sum[p], 1.0 / voxel_count[p]);
-    mesh.points[p] = geometry::add(
-        mesh.points[p], geometry::scale(geometry::sub(towards, mesh.points[p]), kSplitNudge));
+    mesh.points[p] = nudged(p, kSplitNudge);
   }
   staircase.triangles = mesh.triangles;
   for (uint32_t t = 0; t < mesh.triangles.size(); ++t)
@@ -199,6 +203,26 @@ NetLabelSurface net_label_surface(const InterfaceSurface& net, int32_t label,
         result.moved_triangles.push_back(t);
         break;
       }
+  // Where the copies' sheets still pass through each other, the copies in
+  // the crossing triangles move twice as far, and again.
+  std::vector<double> fraction(source.size(), kSplitNudge);
+  for (int farther = 0;; ++farther) {
+    const auto pairs =
+        surface::crossing_triangles_near(mesh.points, mesh.triangles, result.moved_triangles);
+    result.split_crossings = pairs.size();
+    if (pairs.empty() || farther == kSplitNudgeDoublings) break;
+    std::vector<uint32_t> crossing;
+    for (const auto& [a, b] : pairs)
+      for (const uint32_t t : {a, b})
+        for (const uint32_t p : mesh.triangles[t])
+          if (copies[source[p]] >= 2) crossing.push_back(p);
+    std::sort(crossing.begin(), crossing.end());
+    crossing.erase(std::unique(crossing.begin(), crossing.end()), crossing.end());
+    for (const uint32_t p : crossing) {
+      fraction[p] *= 2;
+      mesh.points[p] = nudged(p, fraction[p]);
+    }
+  }
   return result;
 }
 
@@ -217,9 +241,7 @@ uint64_t net_label_self_intersections(const InterfaceSurface& net,
   uint64_t count = 0;
   for (const auto& [a, b] : net_crossings)
     if (kept(a) && kept(b)) ++count;
-  return count +
-         surface::crossing_triangles_near(cut.mesh.points, cut.mesh.triangles, cut.moved_triangles)
-             .size();
+  return count + cut.split_crossings;
 }
 
 }  // namespace labelmesh::conforming
