@@ -10,6 +10,7 @@
 #include "core/conforming/cap_rims.h"
 #include "core/conforming/constrained_smoothing.h"
 #include "core/conforming/cube_sheets.h"
+#include "core/conforming/keep_label_volumes.h"
 #include "core/conforming/marked_cubes.h"
 #include "core/conforming/widen_small_angles.h"
 #include "core/util/side_by_side.h"
@@ -510,169 +511,6 @@ Stencil stencil_from_quads(const Net& net, InterfaceFigures& figures) {
   return stencil;
 }
 
-// Each quad's two sides as slots into one sorted list of the net's labels,
-// so that per-label sums are arrays rather than hash maps.
-struct SideSlots {
-  std::vector<int32_t> labels;                 // sorted, kOutside among them
-  std::vector<std::array<uint32_t, 2>> sides;  // per quad
-};
-
-SideSlots side_slots(const Net& net) {
-  SideSlots slots;
-  for (const auto& sides : net.quad_sides)
-    slots.labels.insert(slots.labels.end(), sides.begin(), sides.end());
-  std::sort(slots.labels.begin(), slots.labels.end());
-  slots.labels.erase(std::unique(slots.labels.begin(), slots.labels.end()), slots.labels.end());
-  const auto slot = [&](int32_t label) {
-    return static_cast<uint32_t>(std::lower_bound(slots.labels.begin(), slots.labels.end(), label) -
-                                 slots.labels.begin());
-  };
-  slots.sides.reserve(net.quad_sides.size());
-  for (const auto& sides : net.quad_sides) slots.sides.push_back({slot(sides[0]), slot(sides[1])});
-  return slots;
-}
-
-// Each label's enclosed volume over its quads (split 0-1-2, 0-2-3), with
-// points `x`, by slot: the quads are wound from sides[0] into sides[1], so a
-// quad adds to sides[0]'s volume and takes from sides[1]'s.
-std::vector<double> label_volumes(const Net& net, const SideSlots& slots,
-                                  const std::vector<Vec3>& x) {
-  std::vector<double> volume(slots.labels.size(), 0);
-  for (size_t q = 0; q < net.quads.size(); ++q) {
-    const auto& c = net.quads[q];
-    const double v = (geometry::dot(x[c[0]], geometry::cross(x[c[1]], x[c[2]])) +
-                      geometry::dot(x[c[0]], geometry::cross(x[c[2]], x[c[3]]))) /
-                     6;
-    volume[slots.sides[q][0]] += v;
-    volume[slots.sides[q][1]] -= v;
-  }
-  return volume;
-}
-
-// Rounds of giving labels back their volume, and of the label-graph
-// solve within each.
-constexpr int kRestoreRounds = 6;
-constexpr int kSolveSweeps = 200;
-
-// The move d[l] of each label's boundary (mm, outward) that gives every
-// label back `lost[l]` (mm^3) when a point between labels l and m moves by
-// d[l] - d[m]: for each label, the sum over its neighbours m of
-// area[l m] (d[l] - d[m]) is lost[l], with the outside's move 0. Gauss-Seidel
-// sweeps; the system is a graph Laplacian held at the outside, so they
-// converge where a label reaches the outside through its neighbours, and a
-// label whose moving area is nil keeps d = 0.
-std::vector<double> label_moves(const std::vector<std::array<uint32_t, 2>>& pairs,
-                                const std::vector<double>& pair_area,
-                                const std::vector<double>& lost, uint32_t outside) {
-  const size_t n = lost.size();
-  std::vector<std::vector<std::pair<uint32_t, double>>> around(n);
-  std::vector<double> total(n, 0);
-  for (size_t k = 0; k < pairs.size(); ++k) {
-    if (pair_area[k] <= 0) continue;
-    const auto [l, m] = pairs[k];
-    around[l].push_back({m, pair_area[k]});
-    around[m].push_back({l, pair_area[k]});
-    total[l] += pair_area[k];
-    total[m] += pair_area[k];
-  }
-  std::vector<double> d(n, 0);
-  for (int sweep = 0; sweep < kSolveSweeps; ++sweep) {
-    for (size_t l = 0; l < n; ++l) {
-      if (l == outside || total[l] <= 0) continue;
-      double sum = lost[l];
-      for (const auto& [m, a] : around[l]) sum += a * d[m];
-      d[l] = sum / total[l];
-    }
-  }
-  return d;
-}
-
-// Moves the points that lie between one pair of sides along their normal,
-// so that each label keeps its voxels' volume where smoothing shrank it
-// (thin labels most): each label's boundary moves out by d (label_moves),
-// and a point between two labels by the difference of theirs. A thin label
-// between two thick ones so takes its volume from them, the thick ones
-// pass what they give on to their own neighbours or the outside, and the
-// outside moves nothing. Points where more than one pair meets stay, and so
-// do the points the stencil keeps fixed; every point stays in its box.
-void restore_volumes(const Net& net, const Stencil& stencil, const std::vector<Vec3>& centre,
-                     const PointBoxes& boxes, std::vector<Vec3>& points) {
-  const SideSlots slots = side_slots(net);
-  const auto outside = static_cast<uint32_t>(
-      std::lower_bound(slots.labels.begin(), slots.labels.end(), kOutside) - slots.labels.begin());
-  const bool has_outside = outside < slots.labels.size() && slots.labels[outside] == kOutside;
-  const auto is_outside = [&](uint32_t slot) { return has_outside && slot == outside; };
-  const auto target = label_volumes(net, slots, centre);
-  // Each quad's pair of sides, ordered: the outside (if there) second, two
-  // labels by slot; and the list of pairs.
-  std::vector<std::array<uint32_t, 2>> quad_pair(net.quads.size()), pairs;
-  std::vector<uint32_t> pair_of(net.quads.size());
-  {
-    for (size_t q = 0; q < net.quads.size(); ++q) {
-      auto sides = slots.sides[q];
-      if (is_outside(sides[0]) || (!is_outside(sides[1]) && sides[0] > sides[1]))
-        std::swap(sides[0], sides[1]);
-      quad_pair[q] = sides;
-    }
-    pairs = quad_pair;
-    std::sort(pairs.begin(), pairs.end());
-    pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
-    for (size_t q = 0; q < net.quads.size(); ++q)
-      pair_of[q] = static_cast<uint32_t>(
-          std::lower_bound(pairs.begin(), pairs.end(), quad_pair[q]) - pairs.begin());
-  }
-  // Per point: its pair (kMore where several meet) and its area-weighted
-  // normal from the pair's first side into its second.
-  constexpr uint32_t kNoPair = UINT32_MAX, kMore = UINT32_MAX - 1;
-  std::vector<uint32_t> point_pair(points.size());
-  std::vector<Vec3> normal(points.size());
-  std::vector<double> pair_area(pairs.size()), lost(slots.labels.size());
-  std::vector<double> quad_area(net.quads.size());
-  for (int round = 0; round < kRestoreRounds; ++round) {
-    const auto now = label_volumes(net, slots, points);
-    std::fill(point_pair.begin(), point_pair.end(), kNoPair);
-    std::fill(normal.begin(), normal.end(), Vec3{0, 0, 0});
-    std::fill(pair_area.begin(), pair_area.end(), 0.0);
-    for (size_t q = 0; q < net.quads.size(); ++q) {
-      const auto& c = net.quads[q];
-      // Twice the quad's vector area, pointing from sides[0] to sides[1].
-      Vec3 n = geometry::add(geometry::cross(geometry::sub(points[c[1]], points[c[0]]),
-                                             geometry::sub(points[c[2]], points[c[0]])),
-                             geometry::cross(geometry::sub(points[c[2]], points[c[0]]),
-                                             geometry::sub(points[c[3]], points[c[0]])));
-      if (quad_pair[q][0] != slots.sides[q][0]) n = geometry::scale(n, -1);
-      quad_area[q] = 0.5 * geometry::norm(n);
-      for (const uint32_t p : c) {
-        if (point_pair[p] == kNoPair) {
-          point_pair[p] = pair_of[q];
-        } else if (point_pair[p] != pair_of[q]) {
-          point_pair[p] = kMore;
-        }
-        normal[p] = geometry::add(normal[p], n);
-      }
-    }
-    for (size_t p = 0; p < points.size(); ++p)
-      if (stencil.start[p] == stencil.start[p + 1]) point_pair[p] = kMore;
-    // The area each pair's moving points carry: a point moved by d along
-    // its normal moves a quarter of each of its quads by d.
-    for (size_t q = 0; q < net.quads.size(); ++q) {
-      int moving = 0;
-      for (const uint32_t p : net.quads[q]) moving += point_pair[p] == pair_of[q];
-      pair_area[pair_of[q]] += quad_area[q] * moving / 4;
-    }
-    for (size_t l = 0; l < lost.size(); ++l) lost[l] = target[l] - now[l];
-    const auto d = label_moves(pairs, pair_area, lost, has_outside ? outside : kNoPair);
-    for (size_t p = 0; p < points.size(); ++p) {
-      const double length = geometry::norm(normal[p]);
-      if (point_pair[p] >= kMore || length == 0) continue;
-      const auto& [first, second] = pairs[point_pair[p]];
-      const double move = d[first] - d[second];
-      points[p] = boxes.hold(p, centre[p],
-                             geometry::add(points[p], geometry::scale(normal[p], move / length)));
-    }
-  }
-}
-
 // On a grid with thicker slices along some axis, a quad is as long as the
 // slice along that axis and as short as the pixel along the others: its
 // triangles would be needles, and so would the tetrahedra on them. Each quad
@@ -807,7 +645,13 @@ InterfaceSurface label_interfaces(const volume::LabelVolume& volume,
   if (params.follow_cap_rims) figures.rim_points = follow_cap_rims(boxes, net.label_count, stencil);
   std::vector<Vec3> points = net.centre;
   smooth_in_boxes(stencil, net.centre, boxes, params, points);
-  if (params.restore_volumes) restore_volumes(net, stencil, net.centre, boxes, points);
+  if (params.restore_volumes) {
+    // Points the stencil holds still stay.
+    std::vector<bool> held(points.size());
+    for (size_t p = 0; p < points.size(); ++p) held[p] = stencil.start[p] == stencil.start[p + 1];
+    LabelVolumeKeeper(net.quads, net.quad_sides, held, net.centre)
+        .restore(boxes, net.centre, kVolumeRounds, points);
+  }
   std::vector<Vec3> before_widening;
   // Widened nets keep two triangles per quad (the take-back splits quads
   // again), so a net cut into smaller quads is not widened.
