@@ -39,6 +39,12 @@ struct InterfaceParams {
   // thin label between others takes its volume from them, and they from
   // the outside.
   bool restore_volumes = false;
+  // With restore_volumes, the smoothing also pauses this many times, evenly
+  // spaced, for one round of giving volume back. A label three voxels
+  // across shrinks around its cross-section under smoothing and, pressed
+  // against its boxes, keeps their corners; given its volume back as it
+  // goes, it stays off them and round.
+  int volume_pauses = 0;
   // The box along each axis is this many times cube_fraction's (a grid cut
   // into thinner slices may let its points move as far as the thick ones').
   std::array<double, 3> box_scale{1, 1, 1};

@@ -38,6 +38,7 @@ conforming::InterfaceParams interface_params(const NetOptions& options) {
   params.inflate_step = options.inflate_step;
   params.cube_fraction = options.cube_fraction;
   params.restore_volumes = options.restore_volumes;
+  params.volume_pauses = options.volume_pauses;
   params.subdivide_thick_quads = false;
   params.widen_angles_below_deg = kWidenAnglesBelowDeg;
   params.widen_far_below_deg = kWidenFarBelowDeg;
@@ -53,6 +54,9 @@ absl::Status check_net_options(const NetOptions& options) {
   if (!(options.shrink_step > 0 && options.shrink_step < 1 && options.inflate_step < 0 &&
         -options.inflate_step < 1))
     return absl::InvalidArgumentError("net smoothing steps: shrink in (0, 1), inflate in (-1, 0)");
+  if (options.volume_pauses < 0 || options.volume_pauses > 10)
+    return absl::InvalidArgumentError(
+        cat("net volume pauses: ", options.volume_pauses, " is outside 0..10"));
   if (options.thin_grid_rounds_factor < 1 || options.thin_grid_rounds_factor > 8)
     return absl::InvalidArgumentError(
         cat("net thin-grid rounds factor: ", options.thin_grid_rounds_factor, " is outside 1..8"));

@@ -72,7 +72,7 @@ double median(std::vector<double> v) {
 }
 
 // Default options, or the net's from LABELMESH_NET_ROUNDS, _THIN_FACTOR,
-// _INFLATE, _CUBE, _THICK and _WIDEN, and with LABELMESH_NET_ONLY the net
+// _INFLATE, _CUBE, _THICK, _WIDEN and _PAUSES, and with LABELMESH_NET_ONLY the net
 // alone (for tuning).
 MeshParams our_params() {
   MeshParams params;
@@ -86,6 +86,7 @@ MeshParams our_params() {
     params.guard.fall_back = false;
   }
   if (std::getenv("LABELMESH_NET_NO_RESTORE")) params.net.restore_volumes = false;
+  if (const char* v = std::getenv("LABELMESH_NET_PAUSES")) params.net.volume_pauses = std::atoi(v);
   if (const char* v = std::getenv("LABELMESH_NET_CUBE")) params.net.cube_fraction = std::atof(v);
   if (const char* v = std::getenv("LABELMESH_NET_THICK")) params.net.thick_ratio = std::atof(v);
   if (const char* v = std::getenv("LABELMESH_NET_WIDEN"))

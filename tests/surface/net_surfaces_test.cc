@@ -439,7 +439,10 @@ TEST(NetSurfaces, ALabelOfAFewVoxelsKeepsItsVoxelsShape) {
 }
 
 // Analytic shapes on the grids hospitals send: closer to the true surface,
-// with truer normals, than the Slicer-like pipeline on the same volume.
+// with truer normals, than the Slicer-like pipeline on the same volume. The
+// thin tube is three voxels across: smoothed without the volume step's
+// pauses, its cross-section shrank against the voxels' corners (normals'
+// 95th percentile 18.7 degrees, the Slicer-like 16.2).
 TEST(NetSurfaces, ThickSliceShapesAreTruerThanTheSlicerLikePipeline) {
   struct Case {
     testing::AnalyticShape shape;
@@ -449,7 +452,8 @@ TEST(NetSurfaces, ThickSliceShapesAreTruerThanTheSlicerLikePipeline) {
                                 {testing::ellipsoid_shape(32, 22, 15), {0.6, 0.6, 4}},
                                 {testing::sphere_shape(25), {1, 1, 3}},
                                 {testing::ellipsoid_shape(32, 22, 15), {1, 1, 3}},
-                                {testing::torus_shape(25, 9), {3, 3, 3}}};
+                                {testing::torus_shape(25, 9), {3, 3, 3}},
+                                {testing::torus_shape(25, 4.5, "thin tube"), {3, 3, 3}}};
   for (const auto& [shape, spacing] : cases) {
     const auto both = both_surfaces(testing::sample_shape(shape, spacing));
     ASSERT_EQ(both.slicer.size(), 1u);
