@@ -54,7 +54,7 @@ std::vector<double> label_moves(const std::vector<std::array<uint32_t, 2>>& pair
 LabelVolumeKeeper::LabelVolumeKeeper(const std::vector<std::array<uint32_t, 4>>& quads,
                                      const std::vector<std::array<int32_t, 2>>& quad_sides,
                                      const std::vector<bool>& held, const std::vector<Vec3>& centre)
-    : quads_(quads) {
+    : quads_(quads), centre_(centre) {
   for (const auto& sides : quad_sides) labels_.insert(labels_.end(), sides.begin(), sides.end());
   std::sort(labels_.begin(), labels_.end());
   labels_.erase(std::unique(labels_.begin(), labels_.end()), labels_.end());
@@ -126,8 +126,8 @@ std::vector<double> LabelVolumeKeeper::label_volumes(const std::vector<Vec3>& x)
   return volume;
 }
 
-void LabelVolumeKeeper::restore(const PointBoxes& boxes, const std::vector<Vec3>& centre,
-                                int rounds, std::vector<Vec3>& points) const {
+void LabelVolumeKeeper::restore(const PointBoxes& boxes, int rounds,
+                                std::vector<Vec3>& points) const {
   // Per moving point, its area-weighted normal from its pair's first side
   // into its second.
   std::vector<Vec3> normal(points.size());
@@ -157,7 +157,7 @@ void LabelVolumeKeeper::restore(const PointBoxes& boxes, const std::vector<Vec3>
       if (point_pair_[p] == kMoreThanOne || length == 0) continue;
       const auto& [first, second] = pairs_[point_pair_[p]];
       const double move = d[first] - d[second];
-      points[p] = boxes.hold(p, centre[p],
+      points[p] = boxes.hold(p, centre_[p],
                              geometry::add(points[p], geometry::scale(normal[p], move / length)));
     }
   }

@@ -645,19 +645,22 @@ InterfaceSurface label_interfaces(const volume::LabelVolume& volume,
   if (params.follow_cap_rims) figures.rim_points = follow_cap_rims(boxes, net.label_count, stencil);
   std::vector<Vec3> points = net.centre;
   if (params.restore_volumes) {
-    // Points the stencil holds still stay.
-    std::vector<bool> held(points.size());
-    for (size_t p = 0; p < points.size(); ++p) held[p] = stencil.start[p] == stencil.start[p + 1];
-    const LabelVolumeKeeper keeper(net.quads, net.quad_sides, held, net.centre);
+    const LabelVolumeKeeper keeper = [&] {
+      // Points the stencil holds still stay.
+      std::vector<bool> held(points.size());
+      for (size_t p = 0; p < points.size(); ++p) held[p] = stencil.start[p] == stencil.start[p + 1];
+      return LabelVolumeKeeper(net.quads, net.quad_sides, held, net.centre);
+    }();
     // The rounds in pieces, one round of the volume step between them and
-    // all of its rounds after the last.
-    const int pieces = std::max(1, params.volume_pauses + 1);
+    // all of its rounds after the last; no piece without rounds.
+    const int pieces =
+        std::clamp(params.smoothing_rounds, 1, std::max(1, params.volume_pauses + 1));
     InterfaceParams piece = params;
     for (int k = 0; k < pieces; ++k) {
       piece.smoothing_rounds =
           params.smoothing_rounds * (k + 1) / pieces - params.smoothing_rounds * k / pieces;
       smooth_in_boxes(stencil, net.centre, boxes, piece, points);
-      keeper.restore(boxes, net.centre, k + 1 < pieces ? 1 : kVolumeRounds, points);
+      keeper.restore(boxes, k + 1 < pieces ? 1 : kVolumeRounds, points);
     }
   } else {
     smooth_in_boxes(stencil, net.centre, boxes, params, points);

@@ -34,10 +34,10 @@ struct InterfaceParams {
   // fraction of half the voxel: below 1, so points of neighbouring cubes
   // never meet.
   double cube_fraction = 0.9;
-  // After smoothing, give each label back the volume smoothing took, by
-  // moving the points between one pair of sides along their normals: a
-  // thin label between others takes its volume from them, and they from
-  // the outside.
+  // While and after smoothing, give each label back the volume smoothing
+  // took, by moving the points between one pair of sides along their
+  // normals: a thin label between others takes its volume from them, and
+  // they from the outside.
   bool restore_volumes = false;
   // With restore_volumes, the smoothing also pauses this many times, evenly
   // spaced, for one round of giving volume back. A label three voxels

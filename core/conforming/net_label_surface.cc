@@ -112,7 +112,8 @@ Vec3 voxel_centre(uint64_t padded, const InterfaceSurface& net,
 }  // namespace
 
 NetLabelSurface net_label_surface(const InterfaceSurface& net, int32_t label,
-                                  const volume::ImageGeometry& geometry) {
+                                  const volume::ImageGeometry& geometry,
+                                  SplitCrossings split_crossings) {
   // The label's triangles, wound outward, and the voxel each bounds.
   std::vector<std::array<uint32_t, 3>> triangles;
   std::vector<uint64_t> voxel;
@@ -203,26 +204,43 @@ NetLabelSurface net_label_surface(const InterfaceSurface& net, int32_t label,
         result.moved_triangles.push_back(t);
         break;
       }
-  // Where the copies' sheets still pass through each other, the copies in
-  // the crossing triangles move twice as far, and again.
+  if (split_crossings == SplitCrossings::kLeave) return result;
+  // Where two moved triangles still pass through each other, the copies in
+  // them move twice as far; a doubling that leaves more crossing pairs is
+  // taken back, and the parting stops.
   std::vector<double> fraction(source.size(), kSplitNudge);
-  for (int farther = 0;; ++farther) {
-    const auto pairs =
-        surface::crossing_triangles_near(mesh.points, mesh.triangles, result.moved_triangles);
-    result.split_crossings = pairs.size();
-    if (pairs.empty() || farther == kSplitNudgeDoublings) break;
+  const auto crossing_pairs = [&] {
+    return surface::crossing_triangles_near(mesh.points, mesh.triangles, result.moved_triangles);
+  };
+  auto pairs = crossing_pairs();
+  for (int doubling = 0; doubling < kSplitNudgeDoublings && !pairs.empty(); ++doubling) {
     std::vector<uint32_t> crossing;
-    for (const auto& [a, b] : pairs)
+    for (const auto& [a, b] : pairs) {
+      if (!std::binary_search(result.moved_triangles.begin(), result.moved_triangles.end(), a) ||
+          !std::binary_search(result.moved_triangles.begin(), result.moved_triangles.end(), b))
+        continue;
       for (const uint32_t t : {a, b})
         for (const uint32_t p : mesh.triangles[t])
           if (copies[source[p]] >= 2) crossing.push_back(p);
+    }
+    if (crossing.empty()) break;
     std::sort(crossing.begin(), crossing.end());
     crossing.erase(std::unique(crossing.begin(), crossing.end()), crossing.end());
+    std::vector<Vec3> before;
+    before.reserve(crossing.size());
     for (const uint32_t p : crossing) {
-      fraction[p] *= 2;
-      mesh.points[p] = nudged(p, fraction[p]);
+      before.push_back(mesh.points[p]);
+      mesh.points[p] = nudged(p, 2 * fraction[p]);
     }
+    auto after = crossing_pairs();
+    if (after.size() > pairs.size()) {
+      for (size_t i = 0; i < crossing.size(); ++i) mesh.points[crossing[i]] = before[i];
+      break;
+    }
+    for (const uint32_t p : crossing) fraction[p] *= 2;
+    pairs = std::move(after);
   }
+  result.split_crossings = pairs.size();
   return result;
 }
 

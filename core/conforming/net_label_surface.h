@@ -32,7 +32,7 @@ struct NetLabelSurface {
   // where the net has them.
   std::vector<uint32_t> moved_triangles;
   // Crossing pairs of triangles with one of moved_triangles among them,
-  // left after the copies moved farther apart.
+  // left after the copies moved farther apart (SplitCrossings::kPart).
   uint64_t split_crossings = 0;
 };
 
@@ -41,20 +41,27 @@ struct NetLabelSurface {
 // enough that a label of a few voxels touching along edges keeps its
 // volume (a tenth took 11 % of four voxels in a row).
 inline constexpr double kSplitNudge = 0.05;
-// Where the copies' sheets pass through each other (smoothing can leave two
-// sheets that touch along an edge pinched across it), the copies in the
-// crossing triangles move twice as far, up to this many times.
+// Where two copies' triangles pass through each other (smoothing can leave
+// two sheets that touch along an edge pinched across it), the copies'
+// fraction is doubled, at most this many times: at most 0.4 of the way.
 inline constexpr int kSplitNudgeDoublings = 3;
+static_assert(kSplitNudge * (1 << kSplitNudgeDoublings) < 0.5);
+
+// Whether net_label_surface parts split copies whose triangles cross and
+// counts the pairs left, or leaves them (a cut read only for its staircase).
+enum class SplitCrossings { kPart, kLeave };
 
 // The surface of `label` in `net` (empty when no triangle bounds it).
 // `geometry` is the volume the net was built from.
 NetLabelSurface net_label_surface(const InterfaceSurface& net, int32_t label,
-                                  const volume::ImageGeometry& geometry);
+                                  const volume::ImageGeometry& geometry,
+                                  SplitCrossings split_crossings = SplitCrossings::kPart);
 
 // Crossing triangle pairs of `cut`, the surface of `label` in `net`, given
 // the net's own crossing pairs (surface::crossing_triangles): the net's pairs
 // of two triangles of the label where it keeps the net's triangles, and
-// those around its split copies (NetLabelSurface::split_crossings). The same count as
+// those around its split copies (NetLabelSurface::split_crossings; the cut
+// made with SplitCrossings::kPart). The same count as
 // surface::count_self_intersections on cut.mesh, for a fraction of the work
 // when the net's pairs serve all its labels.
 uint64_t net_label_self_intersections(const InterfaceSurface& net,

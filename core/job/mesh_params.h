@@ -43,9 +43,10 @@ struct NetOptions {
   // Give each label back the volume smoothing took from it (thin labels
   // shrink most), from the outside or through its neighbours.
   bool restore_volumes = true;
-  // The smoothing pauses this many times, evenly spaced, for one round of
-  // giving volume back: a label three voxels across then keeps its round
-  // cross-section instead of shrinking against the voxels' corners.
+  // With restore_volumes, the smoothing pauses this many times (0 to 10),
+  // evenly spaced, for one round of giving volume back: a label three
+  // voxels across then keeps its round cross-section instead of shrinking
+  // against the voxels' corners.
   int volume_pauses = 2;
   // An axis whose spacing is at least thick_ratio times the others' is cut
   // into slices about thin_ratio times theirs by shape-based interpolation

@@ -253,7 +253,9 @@ class LabelGuard {
       cut_ = conforming::net_label_surface(net_, label_.label, net_geometry_);
       if (staircase_net_ != nullptr)
         voxel_boundary_ =
-            conforming::net_label_surface(*staircase_net_, label_.label, layer_.geometry).staircase;
+            conforming::net_label_surface(*staircase_net_, label_.label, layer_.geometry,
+                                          conforming::SplitCrossings::kLeave)
+                .staircase;
     }
     if (cut_.mesh.triangles.empty())
       return absl::InternalError(cat("label ", label_.label, ": the surface net has no triangle"));

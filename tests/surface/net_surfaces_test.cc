@@ -440,9 +440,9 @@ TEST(NetSurfaces, ALabelOfAFewVoxelsKeepsItsVoxelsShape) {
 
 // Analytic shapes on the grids hospitals send: closer to the true surface,
 // with truer normals, than the Slicer-like pipeline on the same volume. The
-// thin tube is three voxels across: smoothed without the volume step's
-// pauses, its cross-section shrank against the voxels' corners (normals'
-// 95th percentile 18.7 degrees, the Slicer-like 16.2).
+// thin tube is three voxels across: its cross-section keeps round only
+// where the smoothing pauses to give the volume back (docs/pipeline.md,
+// the net's step 3).
 TEST(NetSurfaces, ThickSliceShapesAreTruerThanTheSlicerLikePipeline) {
   struct Case {
     testing::AnalyticShape shape;
