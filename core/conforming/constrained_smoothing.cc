@@ -34,7 +34,7 @@ Lanes to_lanes(const Vec3& v) {
 }  // namespace
 
 void smooth_in_boxes(const Stencil& stencil, const std::vector<Vec3>& centre,
-                     const PointBoxes& point_boxes, const InterfaceParams& params,
+                     const PointBoxes& point_boxes, const InterfaceParams& params, int rounds,
                      std::vector<Vec3>& points) {
   const Vec3& half_box = point_boxes.half;
   const size_t n = points.size();
@@ -118,7 +118,7 @@ void smooth_in_boxes(const Stencil& stencil, const std::vector<Vec3>& centre,
       to[p] = hi < moved ? hi : moved;
     }
   };
-  const int steps = 2 * params.smoothing_rounds;
+  const int steps = 2 * rounds;
   if (n < kThreadedSmoothingPoints) {
     for (int s = 0; s < steps; ++s) step_range(s, 0, n);
   } else {

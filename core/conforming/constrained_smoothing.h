@@ -27,12 +27,12 @@ struct Stencil {
   std::vector<bool> along_curve;
 };
 
-// params.smoothing_rounds rounds of a shrink_step and an inflate_step, each
-// point moving towards the mean of its stencil neighbours and held in its
-// box around centre[p]. Points without neighbours stay exactly where they
+// `rounds` rounds of params' shrink_step and inflate_step, each point
+// moving towards the mean of its stencil neighbours and held in its box
+// around centre[p]. Points without neighbours stay exactly where they
 // are. Two threads share large nets; the result is the same as one thread's.
 void smooth_in_boxes(const Stencil& stencil, const std::vector<geometry::Vec3>& centre,
-                     const PointBoxes& boxes, const InterfaceParams& params,
+                     const PointBoxes& boxes, const InterfaceParams& params, int rounds,
                      std::vector<geometry::Vec3>& points);
 
 }  // namespace labelmesh::conforming

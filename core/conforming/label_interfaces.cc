@@ -655,15 +655,14 @@ InterfaceSurface label_interfaces(const volume::LabelVolume& volume,
     // all of its rounds after the last; no piece without rounds.
     const int pieces =
         std::clamp(params.smoothing_rounds, 1, std::max(1, params.volume_pauses + 1));
-    InterfaceParams piece = params;
     for (int k = 0; k < pieces; ++k) {
-      piece.smoothing_rounds =
+      const int rounds =
           params.smoothing_rounds * (k + 1) / pieces - params.smoothing_rounds * k / pieces;
-      smooth_in_boxes(stencil, net.centre, boxes, piece, points);
+      smooth_in_boxes(stencil, net.centre, boxes, params, rounds, points);
       keeper.restore(boxes, k + 1 < pieces ? 1 : kVolumeRounds, points);
     }
   } else {
-    smooth_in_boxes(stencil, net.centre, boxes, params, points);
+    smooth_in_boxes(stencil, net.centre, boxes, params, params.smoothing_rounds, points);
   }
   std::vector<Vec3> before_widening;
   // Widened nets keep two triangles per quad (the take-back splits quads

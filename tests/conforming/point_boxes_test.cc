@@ -124,7 +124,7 @@ TEST(PointBoxes, SmoothingStepsKeepPointsOffDrawnSlices) {
   InterfaceParams params;
   params.smoothing_rounds = 100;
   params.inflate_step = params.shrink_step;  // plain averaging: no overshoot to read
-  smooth_in_boxes(stencil, centre, boxes, params, points);
+  smooth_in_boxes(stencil, centre, boxes, params, params.smoothing_rounds, points);
   EXPECT_DOUBLE_EQ(points[0][2], 2.0);
   EXPECT_NEAR(points[1][2], 4.0, 1e-5);
   EXPECT_GT(points[2][2], 3.9);
