@@ -129,6 +129,57 @@ TEST(NetLabelSurface, VoxelsTouchingAlongAnEdgeOrACornerStayManifold) {
   }
 }
 
+TEST(NetLabelSurface, SplitCopiesWhoseSheetsCrossMoveFartherApart) {
+  // Two columns of label 1, (1, 1, k) and (2, 2, k) for k = 1..6, meet along
+  // the edge x = y = 1.5. Halfway up, one point of each column's face beside
+  // the edge is pulled across the gap of outside between the two faces, as
+  // smoothing can pinch two sheets that meet along an edge: the split copies,
+  // a twentieth of the way towards their voxels, leave the faces crossing.
+  const auto volume = testing::label_grid({5, 5, 8}, [](int i, int j, int k) -> uint8_t {
+    return k >= 1 && k <= 6 && ((i == 1 && j == 1) || (i == 2 && j == 2)) ? 1 : 0;
+  });
+  auto net = staircase_net(volume);
+  int pinched = 0;
+  for (auto p = 0u; p < net.points.size(); ++p) {
+    const auto& at = net.staircase[p];
+    if (at[2] != 3.5) continue;
+    if (at[0] == 1.5 && at[1] == 0.5) net.points[p][0] += 2.0, ++pinched;  // first column's
+    if (at[0] == 2.5 && at[1] == 1.5) net.points[p][1] -= 0.6, ++pinched;  // second's
+  }
+  ASSERT_EQ(pinched, 2);
+  const auto left =
+      conforming::net_label_surface(net, 1, volume.geometry, conforming::SplitCrossings::kLeave);
+  const auto parted = conforming::net_label_surface(net, 1, volume.geometry);
+  ASSERT_GT(left.split_points, 0u);
+  EXPECT_GT(surface::count_self_intersections(left.mesh).value_or(0), 0u);
+
+  EXPECT_EQ(parted.split_crossings, 0u);
+  EXPECT_EQ(surface::count_self_intersections(parted.mesh), uint64_t{0});
+  const auto statistics = surface::compute_surface_statistics(parted.mesh);
+  EXPECT_TRUE(statistics.closed);
+  EXPECT_TRUE(statistics.manifold);
+  // Only split copies moved farther, each 2, 4 or 8 times as far from its
+  // net point; the staircase stays where it was.
+  ASSERT_EQ(parted.mesh.points.size(), left.mesh.points.size());
+  int farther = 0;
+  for (size_t p = 0; p < parted.mesh.points.size(); ++p) {
+    EXPECT_EQ(parted.staircase.points[p], left.staircase.points[p]);
+    if (parted.mesh.points[p] == left.mesh.points[p]) continue;
+    ++farther;
+    const auto net_point =
+        std::find(net.staircase.begin(), net.staircase.end(), left.staircase.points[p]) -
+        net.staircase.begin();
+    const auto& from = net.points[static_cast<size_t>(net_point)];
+    const double ratio = geometry::norm(geometry::sub(parted.mesh.points[p], from)) /
+                         geometry::norm(geometry::sub(left.mesh.points[p], from));
+    EXPECT_TRUE(std::abs(ratio - 2) < 1e-9 || std::abs(ratio - 4) < 1e-9 ||
+                std::abs(ratio - 8) < 1e-9)
+        << ratio;
+  }
+  EXPECT_GT(farther, 0);
+  EXPECT_LE(farther, static_cast<int>(parted.split_points));
+}
+
 TEST(VoxelFidelity, TheStaircaseIsExactAndAShrunkCopyIsNot) {
   const auto phantom = volume::make_phantom(volume::PhantomShape::kSphere);
   const auto& v = phantom.volume;
