@@ -8,11 +8,14 @@
 //              surfaces (both pipelines alternating, from reading the file),
 //              the axis-aligned area share per label (median), and how many
 //              labels each pipeline keeps within the voxel tolerance.
+//   alignments the phantoms with their slices shifted by quarters of a slice:
+//              each method's error averaged over the shifts, and its worst;
 //   shares     the phantoms' axis-aligned area share beside the true shape's;
 //   slices     five touching labels on three 5 mm slices of 512 x 512 pixels,
 //              as a DICOM SEG of a short series holds them, timed as the
 //              volumes are (the file is written to the temporary directory).
-// Usage: labelmesh_surface_bench [phantoms|shares|volumes|slices|all] [ROUNDS] [FILE ...]
+// Usage: labelmesh_surface_bench [phantoms|alignments|shares|volumes|slices|all] [ROUNDS] [FILE
+// ...]
 #if __has_include(<malloc.h>)
 #include <malloc.h>
 #endif
@@ -189,6 +192,66 @@ int bench_phantoms() {
                   shape.name.c_str(), grid.name, e_mc.rms_mm, e_mc.normal_p95_deg, e_slicer.rms_mm,
                   e_slicer.normal_p95_deg, e_ours.rms_mm, e_ours.normal_p95_deg,
                   e_ours.rms_mm / smallest, made->method.c_str());
+    }
+  }
+  return failures;
+}
+
+// The phantoms on the axis-aligned grids with the slices shifted by 0, 1/4,
+// 1/2 and 3/4 of a slice: where a shape ends between slice centres decides
+// how much of it the voxels show, so each method's error is averaged over
+// where the slices fall, and its worst shift printed beside.
+int bench_alignments() {
+  const std::vector<Grid> grids{
+      {"3 mm", {3, 3, 3}, 0}, {"1x1x3 mm", {1, 1, 3}, 0}, {"0.6x0.6x4 mm", {0.6, 0.6, 4}, 0}};
+  const std::vector<AnalyticShape> shapes{
+      testing::sphere_shape(25), testing::ellipsoid_shape(32, 22, 15), testing::torus_shape(25, 9),
+      testing::torus_shape(25, 4.5, "thin tube")};
+  constexpr int kShifts = 4;
+  // LABELMESH_BENCH_SHIFTS=1 prints each shift's row too.
+  const bool print_shifts = std::getenv("LABELMESH_BENCH_SHIFTS") != nullptr;
+  std::printf("mean (worst) over %d shifts of the slices\n", kShifts);
+  std::printf("%-10s %-13s | %-26s | %-26s | %-26s\n", "shape", "grid", "MC rms mm / p95 deg",
+              "Slicer-like", "ours");
+  int failures = 0;
+  for (const auto& grid : grids) {
+    for (const auto& shape : shapes) {
+      struct Sum {
+        double rms = 0, p95 = 0, worst_rms = 0, worst_p95 = 0;
+        void add(const testing::ShapeError& e) {
+          rms += e.rms_mm / kShifts;
+          p95 += e.normal_p95_deg / kShifts;
+          worst_rms = std::max(worst_rms, e.rms_mm);
+          worst_p95 = std::max(worst_p95, e.normal_p95_deg);
+        }
+      } mc, slicer, ours;
+      bool made_all = true;
+      for (int shift = 0; shift < kShifts; ++shift) {
+        Grid shifted = grid;
+        shifted.shift_slices = double(shift) / kShifts;
+        const auto made = phantom_surfaces(shape, shifted);
+        if (!made) {
+          made_all = false;
+          break;
+        }
+        const auto slicer_error = testing::shape_error(made->slicer, shape);
+        const auto our_error = testing::shape_error(made->ours, shape);
+        mc.add(testing::shape_error(made->marching_cubes, shape));
+        slicer.add(slicer_error);
+        ours.add(our_error);
+        if (print_shifts)
+          std::printf("  %-10s %-13s %.2f slice up: Slicer-like %.3f / %.1f, ours %.3f / %.1f\n",
+                      shape.name.c_str(), grid.name, shifted.shift_slices, slicer_error.rms_mm,
+                      slicer_error.normal_p95_deg, our_error.rms_mm, our_error.normal_p95_deg);
+      }
+      if (!made_all) {
+        ++failures;
+        continue;
+      }
+      std::printf("%-10s %-13s", shape.name.c_str(), grid.name);
+      for (const Sum* s : {&mc, &slicer, &ours})
+        std::printf(" | %5.3f (%5.3f) / %4.1f (%4.1f)", s->rms, s->worst_rms, s->p95, s->worst_p95);
+      std::printf("\n");
     }
   }
   return failures;
@@ -592,6 +655,7 @@ int main(int argc, char** argv) {
   }
   int failures = 0;
   if (what == "phantoms" || what == "all") failures += bench_phantoms();
+  if (what == "alignments" || what == "all") failures += bench_alignments();
   if (what == "shares" || what == "all") failures += bench_shares();
   if (what == "volumes" || what == "all")
     for (const auto& f : files) failures += bench_volume(f, rounds);

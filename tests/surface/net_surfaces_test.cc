@@ -562,6 +562,38 @@ TEST(NetSurfaces, ShapesEndingBetweenSlicesAreTruerThanTheSlicerLikePipeline) {
   }
 }
 
+// Where a shape ends between two slice centres decides how much of it the
+// voxels show: the 1 x 1 x 3 mm torus whose top lies on a slice centre is
+// farther from the true one than the Slicer-like surface (0.668 mm against
+// 0.603), and the thin tube half a slice up has wider normals (21.8 degrees
+// against 12.8). With the slices shifted by 0, 1/4, 1/2 and 3/4 of a slice,
+// the net's mean error is the smaller in both.
+TEST(NetSurfaces, AveragedOverWhereSlicesFallShapesAreTruerThanTheSlicerLike) {
+  constexpr int kShifts = 4;
+  for (const auto& shape :
+       {testing::torus_shape(25, 9), testing::torus_shape(25, 4.5, "thin tube")}) {
+    SCOPED_TRACE(shape.name);
+    double mine_rms = 0, mine_p95 = 0, theirs_rms = 0, theirs_p95 = 0;
+    for (int shift = 0; shift < kShifts; ++shift) {
+      const auto both =
+          both_surfaces(testing::sample_shape(shape, {1, 1, 3}, 0, double(shift) / kShifts));
+      ASSERT_EQ(both.slicer.size(), 1u);
+      ASSERT_THAT(both.result, testing::IsOk());
+      const auto* ours = both.ours();
+      ASSERT_NE(ours, nullptr);
+      EXPECT_EQ(ours->stage, "net") << shift;
+      const auto mine = testing::shape_error(ours->mesh, shape);
+      const auto theirs = testing::shape_error(both.slicer.front().mesh, shape);
+      mine_rms += mine.rms_mm / kShifts;
+      mine_p95 += mine.normal_p95_deg / kShifts;
+      theirs_rms += theirs.rms_mm / kShifts;
+      theirs_p95 += theirs.normal_p95_deg / kShifts;
+    }
+    EXPECT_LT(mine_rms, theirs_rms);
+    EXPECT_LT(mine_p95, theirs_p95);
+  }
+}
+
 // A tube 9 mm across whose top and bottom lie on drawn slices' centres: two
 // slices hold it, and its voxels end a whole slice short of the next. The
 // thinner grid keeps its voxels' volume, so the net does too and is
