@@ -31,6 +31,26 @@ vtkSmartPointer<vtkImageData> padded_box(vtkImageData* image, const std::array<i
   return pad->GetOutput();
 }
 
+// The outward boundary of the voxels of `image` equal to `value` inside [lo, hi].
+TriangleMesh contour_value(vtkImageData* image, int32_t value, const std::array<int64_t, 3>& lo,
+                           const std::array<int64_t, 3>& hi,
+                           const volume::ImageGeometry& geometry) {
+  vtkNew<vtkDiscreteFlyingEdges3D> contour;
+  contour->SetInputData(padded_box(image, lo, hi));
+  contour->SetValue(0, value);
+  contour->ComputeNormalsOff();
+  contour->ComputeGradientsOff();
+  contour->ComputeScalarsOff();
+  contour->Update();
+  TriangleMesh mesh = to_patient_space(contour->GetOutput(), geometry);
+  // The contour's winding is consistent, so a negative enclosed volume means
+  // every triangle faces inwards (mirrored grids): flip once per surface.
+  if (signed_volume(mesh) < 0) mesh.flip_orientation();
+  return mesh;
+}
+
+}  // namespace
+
 TriangleMesh to_patient_space(vtkPolyData* contour, const volume::ImageGeometry& geometry) {
   TriangleMesh mesh;
   vtkPoints* points = contour->GetPoints();
@@ -52,26 +72,6 @@ TriangleMesh to_patient_space(vtkPolyData* contour, const volume::ImageGeometry&
   }
   return mesh;
 }
-
-// The outward boundary of the voxels of `image` equal to `value` inside [lo, hi].
-TriangleMesh contour_value(vtkImageData* image, int32_t value, const std::array<int64_t, 3>& lo,
-                           const std::array<int64_t, 3>& hi,
-                           const volume::ImageGeometry& geometry) {
-  vtkNew<vtkDiscreteFlyingEdges3D> contour;
-  contour->SetInputData(padded_box(image, lo, hi));
-  contour->SetValue(0, value);
-  contour->ComputeNormalsOff();
-  contour->ComputeGradientsOff();
-  contour->ComputeScalarsOff();
-  contour->Update();
-  TriangleMesh mesh = to_patient_space(contour->GetOutput(), geometry);
-  // The contour's winding is consistent, so a negative enclosed volume means
-  // every triangle faces inwards (mirrored grids): flip once per surface.
-  if (signed_volume(mesh) < 0) mesh.flip_orientation();
-  return mesh;
-}
-
-}  // namespace
 
 absl::StatusOr<std::vector<TriangleMesh>> extract_component_surfaces(
     const volume::LabelComponents& components, const std::vector<int32_t>& ids,

@@ -13,6 +13,8 @@
 #include "core/volume/label_statistics.h"
 #include "core/volume/label_volume.h"
 
+class vtkPolyData;
+
 namespace labelmesh::surface {
 
 struct LabelSurface {
@@ -35,5 +37,9 @@ absl::StatusOr<std::vector<LabelSurface>> extract_surfaces(
 absl::StatusOr<std::vector<TriangleMesh>> extract_component_surfaces(
     const volume::LabelComponents& components, const std::vector<int32_t>& ids,
     const volume::ImageGeometry& geometry, const RunContext& context);
+
+// The triangles of a contour of a volume's image (whose coordinates are
+// voxel indices), with their points in patient (LPS) space.
+TriangleMesh to_patient_space(vtkPolyData* contour, const volume::ImageGeometry& geometry);
 
 }  // namespace labelmesh::surface

@@ -11,10 +11,10 @@
 #include <vtkImageGaussianSmooth.h>
 #include <vtkImageThreshold.h>
 #include <vtkNew.h>
-#include <vtkPolyData.h>
 
 #include <cmath>
 
+#include "core/surface/extract_surfaces.h"
 #include "core/surface/surface_statistics.h"
 #include "core/surface/triangle_mesh.h"
 #include "core/volume/label_statistics.h"
@@ -54,25 +54,7 @@ inline surface::TriangleMesh gaussian_iso_surface(const volume::LabelVolume& vol
   contour->ComputeGradientsOff();
   contour->ComputeScalarsOff();
   contour->Update();
-  // The volume's image holds voxel indices as coordinates.
-  vtkPolyData* out = contour->GetOutput();
-  surface::TriangleMesh mesh;
-  vtkPoints* points = out->GetPoints();
-  const vtkIdType count = points ? points->GetNumberOfPoints() : 0;
-  mesh.points.resize(static_cast<size_t>(count));
-  for (vtkIdType i = 0; i < count; ++i) {
-    double index[3];
-    points->GetPoint(i, index);
-    mesh.points[static_cast<size_t>(i)] =
-        volume.geometry.to_physical({index[0], index[1], index[2]});
-  }
-  vtkCellArray* polys = out->GetPolys();
-  vtkIdType size = 0;
-  const vtkIdType* ids = nullptr;
-  for (polys->InitTraversal(); polys->GetNextCell(size, ids);)
-    if (size == 3)
-      mesh.triangles.push_back({static_cast<uint32_t>(ids[0]), static_cast<uint32_t>(ids[1]),
-                                static_cast<uint32_t>(ids[2])});
+  surface::TriangleMesh mesh = surface::to_patient_space(contour->GetOutput(), volume.geometry);
   if (surface::signed_volume(mesh) < 0) mesh.flip_orientation();
   return mesh;
 }
