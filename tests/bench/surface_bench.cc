@@ -34,6 +34,8 @@
 #include <string>
 #include <vector>
 
+#include "bench/bench_inputs.h"
+#include "bench/blur_bench.h"
 #include "core/conforming/label_interfaces.h"
 #include "core/conforming/net_label_surface.h"
 #include "core/pipeline/label_net_surfaces.h"
@@ -47,7 +49,6 @@
 #include "core/volume/read_label_volume.h"
 #include "core/volume/write_label_volume.h"
 #include "support/analytic_shapes.h"
-#include "support/gaussian_iso.h"
 #include "support/label_overlap.h"
 #include "support/organs_on_slices.h"
 #include "support/rim_turns.h"
@@ -55,6 +56,7 @@
 #include "support/slicer_like.h"
 
 using namespace labelmesh;
+using namespace labelmesh::bench;
 using labelmesh::testing::AnalyticShape;
 
 namespace {
@@ -69,36 +71,6 @@ double seconds_of(const std::function<void()>& f) {
   const auto start = std::chrono::steady_clock::now();
   f();
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
-
-double median(std::vector<double> v) {
-  if (v.empty()) return 0;
-  std::sort(v.begin(), v.end());
-  const size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
-// Default options, or the net's from LABELMESH_NET_ROUNDS, _THIN_FACTOR,
-// _INFLATE, _CUBE, _THICK, _WIDEN and _PAUSES, and with LABELMESH_NET_ONLY the net
-// alone (for tuning).
-MeshParams our_params() {
-  MeshParams params;
-  if (const char* v = std::getenv("LABELMESH_NET_ROUNDS"))
-    params.net.smoothing_rounds = std::atoi(v);
-  if (const char* v = std::getenv("LABELMESH_NET_THIN_FACTOR"))
-    params.net.thin_grid_rounds_factor = std::atoi(v);
-  if (const char* v = std::getenv("LABELMESH_NET_INFLATE")) params.net.inflate_step = std::atof(v);
-  if (std::getenv("LABELMESH_NET_ONLY")) {
-    params.net.poisson_max_anisotropy = 0;
-    params.guard.fall_back = false;
-  }
-  if (std::getenv("LABELMESH_NET_NO_RESTORE")) params.net.restore_volumes = false;
-  if (const char* v = std::getenv("LABELMESH_NET_PAUSES")) params.net.volume_pauses = std::atoi(v);
-  if (const char* v = std::getenv("LABELMESH_NET_CUBE")) params.net.cube_fraction = std::atof(v);
-  if (const char* v = std::getenv("LABELMESH_NET_THICK")) params.net.thick_ratio = std::atof(v);
-  if (const char* v = std::getenv("LABELMESH_NET_WIDEN"))
-    params.net.between_drawn_widening = std::atof(v);
-  return params;
 }
 
 // Our delivered surface of label 1, and its method.
@@ -324,22 +296,6 @@ struct VolumeFigures {
   uint64_t ours_triangles = 0, ours_below_30 = 0, slicer_triangles = 0, slicer_below_30 = 0;
   uint64_t mc_triangles = 0, mc_below_30 = 0;
 };
-
-// A volume file read, with its labels (every one, in statistics order).
-struct ReadVolume {
-  volume::LabelVolume volume;
-  volume::VolumeStatistics statistics;
-  std::vector<int32_t> labels;
-};
-
-std::optional<ReadVolume> read_volume(const std::string& path) {
-  auto volume = volume::read_label_volume(path, {}, RunContext{});
-  if (!volume.ok()) return std::nullopt;
-  ReadVolume read{std::move(*volume), {}, {}};
-  read.statistics = volume::compute_label_statistics(read.volume);
-  for (const auto& l : read.statistics.labels) read.labels.push_back(l.label);
-  return read;
-}
 
 // Our surfaces without the guard's checks: the file read, the shared net
 // built and smoothed as the pipeline does by default, and every label cut
@@ -648,69 +604,6 @@ int bench_three_slices(int rounds) {
   const int failures = bench_volume(path.string(), rounds);
   if (out == nullptr) std::filesystem::remove(path);
   return failures;
-}
-
-// The trade a Gaussian blur of each label's mask makes between steps and
-// faithfulness, on the file's grid: for each blur, the median over labels of
-// 1,000 voxels or more of its surface's axis-aligned share and of the
-// boundary voxel centres it puts on the wrong side, and how many labels stay
-// within 1 % of them; then per label the least share a blur gives within
-// 1 %, beside the Slicer-like share and ours. Of the guard's bounds only
-// that one is applied to the blurs, a lighter test than ours pass.
-int bench_blurs(const std::string& path) {
-  std::printf("\n%s\n", path.c_str());
-  const auto read = read_volume(path);
-  const auto result = run_pipeline(path, our_params(), RunContext{});
-  if (!read || !result.ok()) {
-    std::printf("  failed to read or mesh\n");
-    return 1;
-  }
-  if (result->input.file_geometry)
-    std::printf("  (meshed on the grid its labels were drawn on; the blurs run on the file's)\n");
-  const auto slicer = testing::slicer_like_surfaces(read->volume, read->statistics, read->labels);
-  const std::vector<double> sigmas{0.5, 0.6, 0.7, 0.8, 1.0, 1.5};
-  std::vector<std::vector<double>> shares(sigmas.size()), wrong(sigmas.size());
-  std::vector<int> within(sigmas.size(), 0);
-  std::vector<double> least_within, slicer_share, our_share;
-  for (size_t i = 0; i < read->labels.size() && i < slicer.size(); ++i) {
-    const auto* label = read->statistics.find(read->labels[i]);
-    if (label == nullptr || label->voxels < 1000) continue;
-    const SurfaceResult* ours = nullptr;
-    for (const auto& s : result->surfaces)
-      if (s.label == label->label && s.is_output) ours = &s;
-    const auto slicer_voxels =
-        surface::measure_voxel_fidelity(slicer[i].mesh, read->volume, *label, {});
-    if (ours == nullptr || !ours->axis_aligned_share || !slicer_voxels.ok()) continue;
-    double least = 1;
-    for (size_t k = 0; k < sigmas.size(); ++k) {
-      const auto blurred = testing::gaussian_iso_surface(read->volume, *label, sigmas[k]);
-      const auto voxels = surface::measure_voxel_fidelity(blurred, read->volume, *label, {});
-      if (!voxels.ok()) continue;
-      shares[k].push_back(100 * voxels->axis_aligned_share);
-      wrong[k].push_back(100 * voxels->misclassified_fraction());
-      if (voxels->misclassified_fraction() <= 0.01) {
-        ++within[k];
-        least = std::min(least, voxels->axis_aligned_share);
-      }
-    }
-    least_within.push_back(100 * least);
-    slicer_share.push_back(100 * slicer_voxels->axis_aligned_share);
-    our_share.push_back(100 * *ours->axis_aligned_share);
-  }
-  if (least_within.empty()) {
-    std::printf("  no label of 1,000 voxels or more\n");
-    return 0;
-  }
-  for (size_t k = 0; k < sigmas.size(); ++k)
-    std::printf(
-        "  blur of %.1f voxels: median share %.1f %%, median misclassified %.2f %%, labels "
-        "within 1 %%: %d of %zu\n",
-        sigmas[k], median(shares[k]), median(wrong[k]), within[k], shares[k].size());
-  std::printf(
-      "  median over %zu labels: least share within 1 %% by a blur %.1f %% (none within: "
-      "100), Slicer-like %.1f %%, ours %.1f %%\n",
-      least_within.size(), median(least_within), median(slicer_share), median(our_share));
-  return 0;
 }
 
 }  // namespace
