@@ -105,12 +105,10 @@ void fill_triangle(Canvas& canvas, const std::array<Vec, 3>& v, const std::array
   }
 }
 
-// Flat shading: full colour facing the viewer, darker as it turns away;
-// either side of a triangle lit alike.
-std::array<uint8_t, 3> shade(const std::array<uint8_t, 3>& rgb, const std::array<Vec, 3>& corners,
+// Flat shading of a triangle with normal `n` (any length): full colour
+// facing the viewer, darker as it turns away; either side lit alike.
+std::array<uint8_t, 3> shade(const std::array<uint8_t, 3>& rgb, const Vec& n,
                              const Vec& toward_viewer) {
-  const Vec n =
-      geometry::cross(geometry::sub(corners[1], corners[0]), geometry::sub(corners[2], corners[0]));
   const double length = geometry::norm(n);
   const double facing = length > 0 ? std::abs(dot(n, toward_viewer)) / length : 0;
   const double light = 0.3 + 0.7 * facing;
@@ -160,8 +158,13 @@ Picture draw_surfaces(const std::vector<ColouredSurface>& surfaces, PictureView 
     const auto& points = surface.mesh->points;
     for (const auto& t : surface.mesh->triangles) {
       const std::array<Vec, 3> corners{points[t[0]], points[t[1]], points[t[2]]};
+      const Vec n = geometry::cross(geometry::sub(corners[1], corners[0]),
+                                    geometry::sub(corners[2], corners[0]));
+      // On a closed surface the nearest triangle along any line of sight
+      // faces the viewer: the others never show.
+      if (surface.closed_outward && dot(n, camera.toward_viewer) <= 0) continue;
       fill_triangle(canvas, {to_screen(corners[0]), to_screen(corners[1]), to_screen(corners[2])},
-                    shade(surface.rgb, corners, camera.toward_viewer));
+                    shade(surface.rgb, n, camera.toward_viewer));
     }
   }
   return downsampled(canvas);

@@ -46,6 +46,8 @@ std::vector<ColouredSurface> coloured_surfaces(const MeshResult& result) {
   for (const auto& surface : result.surfaces) {
     if (!surface.is_output || surface.mesh.triangles.empty()) continue;
     ColouredSurface coloured{surface.label, &surface.mesh, kPalette[surfaces.size() % 8]};
+    coloured.closed_outward = surface.statistics.closed && surface.statistics.manifold &&
+                              surface.statistics.volume_mm3 > 0;
     for (const auto& description : result.input.descriptions) {
       if (description.label == surface.label && description.colour)
         coloured.rgb = *description.colour;

@@ -10,6 +10,10 @@
 
 #include <array>
 #include <cmath>
+#include <vector>
+
+#include "core/surface/surface_statistics.h"
+#include "support/lat_long_sphere.h"
 
 namespace labelmesh {
 namespace {
@@ -108,6 +112,39 @@ TEST(SurfacePicture, ABoxCoversTheAreaItsShapeAndTheMarginGive) {
   // Seen end on, the 20 x 20 mm end fills the same 270 px square.
   const Picture side = draw_surfaces({{1, &bar, kRed}}, PictureView::kLeft, 300);
   EXPECT_NEAR(double(side.covered_pixels()), 270.0 * 270.0, 0.03 * 270.0 * 270.0);
+}
+
+TEST(SurfacePicture, ClosedSurfacesLookTheSameWithTheirBackFacesLeftOut) {
+  auto sphere = testing::lat_long_sphere(24, 48);
+  if (surface::signed_volume(sphere) < 0) sphere.flip_orientation();
+  for (auto& p : sphere.points) p[0] += 6;  // half in front of the box, half inside it
+  const auto cube = box({-4, 0, 0}, {8, 6, 12});
+  for (const auto view : {PictureView::kAnterior, PictureView::kLeft, PictureView::kInferior}) {
+    std::vector<ColouredSurface> surfaces{{1, &sphere, kRed}, {2, &cube, kBlue}};
+    const Picture every_face = draw_surfaces(surfaces, view, 200);
+    for (auto& s : surfaces) s.closed_outward = true;
+    const Picture front_faces = draw_surfaces(surfaces, view, 200);
+    EXPECT_GT(every_face.covered_pixels(), 10000u);
+    EXPECT_EQ(front_faces.rgb, every_face.rgb) << int(view);
+  }
+  // Marked closed and outward, a face turned away from the viewer is not
+  // drawn: the box's posterior face (normal +y, LPS) seen from the front.
+  surface::TriangleMesh posterior = cube;
+  posterior.triangles.clear();
+  for (const auto& tri : cube.triangles) {
+    const auto& a = cube.points[tri[0]];
+    const auto& b = cube.points[tri[1]];
+    const auto& c = cube.points[tri[2]];
+    const double normal_y =
+        (c[0] - a[0]) * (b[2] - a[2]) - (c[2] - a[2]) * (b[0] - a[0]);  // (b - a) x (c - a), y
+    if (normal_y > 0) posterior.triangles.push_back(tri);
+  }
+  ASSERT_EQ(posterior.triangles.size(), 2u);
+  EXPECT_GT(draw_surfaces({{2, &posterior, kBlue}}, PictureView::kAnterior, 64).covered_pixels(),
+            1000u);
+  ColouredSurface marked{2, &posterior, kBlue};
+  marked.closed_outward = true;
+  EXPECT_EQ(draw_surfaces({marked}, PictureView::kAnterior, 64).covered_pixels(), 0u);
 }
 
 TEST(SurfacePicture, PngBytesReadBackAsTheSamePicture) {
