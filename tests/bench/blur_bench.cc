@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "bench/bench_inputs.h"
+#include "core/pipeline/surface_fidelity.h"
 #include "core/surface/voxel_fidelity.h"
 #include "support/gaussian_iso.h"
 #include "support/slicer_like.h"
@@ -25,8 +26,8 @@ int bench_blurs(const std::string& path) {
   const auto slicer = testing::slicer_like_surfaces(read->volume, read->statistics, read->labels);
   const std::vector<double> sigmas{0.5, 0.6, 0.7, 0.8, 1.0, 1.5};
   std::vector<std::vector<double>> shares(sigmas.size()), wrong(sigmas.size());
-  std::vector<int> within(sigmas.size(), 0);
-  std::vector<double> least_within, slicer_share, our_share;
+  std::vector<int> within(sigmas.size(), 0), within_all(sigmas.size(), 0);
+  std::vector<double> least_within, least_within_all, slicer_share, our_share;
   for (size_t i = 0; i < read->labels.size() && i < slicer.size(); ++i) {
     const auto* label = read->statistics.find(read->labels[i]);
     if (label == nullptr || label->voxels < 1000) continue;
@@ -35,8 +36,9 @@ int bench_blurs(const std::string& path) {
       if (s.label == label->label && s.is_output) ours = &s;
     const auto slicer_voxels =
         surface::measure_voxel_fidelity(slicer[i].mesh, read->volume, *label, {});
-    if (ours == nullptr || !ours->axis_aligned_share || !slicer_voxels.ok()) continue;
-    double least = 1;
+    if (ours == nullptr || !ours->axis_aligned_share || !ours->fidelity || !slicer_voxels.ok())
+      continue;
+    double least = 1, least_all = 1;
     for (size_t k = 0; k < sigmas.size(); ++k) {
       const auto blurred = testing::gaussian_iso_surface(read->volume, *label, sigmas[k]);
       const auto voxels = surface::measure_voxel_fidelity(blurred, read->volume, *label, {});
@@ -47,8 +49,17 @@ int bench_blurs(const std::string& path) {
         ++within[k];
         least = std::min(least, voxels->axis_aligned_share);
       }
+      // Every bound of the guard's but the distance, which takes a
+      // staircase to measure.
+      SurfaceAttempt attempt;
+      attempt.voxels = *voxels;
+      if (is_within(attempt, ours->fidelity->tolerance)) {
+        ++within_all[k];
+        least_all = std::min(least_all, voxels->axis_aligned_share);
+      }
     }
     least_within.push_back(100 * least);
+    least_within_all.push_back(100 * least_all);
     slicer_share.push_back(100 * slicer_voxels->axis_aligned_share);
     our_share.push_back(100 * *ours->axis_aligned_share);
   }
@@ -59,12 +70,13 @@ int bench_blurs(const std::string& path) {
   for (size_t k = 0; k < sigmas.size(); ++k)
     std::printf(
         "  blur of %.1f voxels: median share %.1f %%, median misclassified %.2f %%, labels "
-        "within 1 %%: %d of %zu\n",
-        sigmas[k], median(shares[k]), median(wrong[k]), within[k], shares[k].size());
+        "within 1 %%: %d of %zu (within the volume and reach bounds too: %d)\n",
+        sigmas[k], median(shares[k]), median(wrong[k]), within[k], shares[k].size(), within_all[k]);
   std::printf(
-      "  median over %zu labels: least share within 1 %% by a blur %.1f %% (none within: "
-      "100), Slicer-like %.1f %%, ours %.1f %%\n",
-      least_within.size(), median(least_within), median(slicer_share), median(our_share));
+      "  median over %zu labels: least share within 1 %% by a blur %.1f %% (within the volume "
+      "and reach bounds too %.1f %%; none within: 100), Slicer-like %.1f %%, ours %.1f %%\n",
+      least_within.size(), median(least_within), median(least_within_all), median(slicer_share),
+      median(our_share));
   return 0;
 }
 

@@ -11,9 +11,9 @@ namespace labelmesh::bench {
 // or more of its surface's axis-aligned share and of the boundary voxel
 // centres it puts on the wrong side, and how many labels stay within 1 % of
 // them; then per label the least share a blur gives within 1 %, beside the
-// Slicer-like share and ours. Only that one of the guard's bounds is applied
-// to the blurs, a lighter test than ours pass. Prints; 1 when `path` cannot
-// be read or meshed.
+// Slicer-like share and ours; and the same with the guard's volume and reach
+// bounds applied too (not its distance bound, which ours pass as well).
+// Prints; 1 when `path` cannot be read or meshed.
 int bench_blurs(const std::string& path);
 
 }  // namespace labelmesh::bench
