@@ -24,8 +24,9 @@ struct ColouredSurface {
   int32_t label = 0;
   const surface::TriangleMesh* mesh = nullptr;
   std::array<uint8_t, 3> rgb{200, 200, 200};
-  // Closed and wound outward: its triangles facing away from the viewer
-  // are hidden behind its own and need not be drawn.
+  // Closed, wound outward throughout and not crossing itself: its
+  // triangles facing away from the viewer are hidden behind its own and
+  // need not be drawn.
   bool closed_outward = false;
 };
 

@@ -48,8 +48,9 @@ std::vector<ColouredSurface> coloured_surfaces(const MeshResult& result) {
   for (const auto& surface : result.surfaces) {
     if (!surface.is_output || surface.mesh.triangles.empty()) continue;
     ColouredSurface coloured{surface.label, &surface.mesh, kPalette[surfaces.size() % 8]};
-    coloured.closed_outward = surface.statistics.closed && surface.statistics.manifold &&
-                              surface.statistics.volume_mm3 > 0;
+    const auto& s = surface.statistics;
+    coloured.closed_outward = s.closed && s.manifold && s.consistently_wound && s.volume_mm3 > 0 &&
+                              surface.self_intersections == uint64_t{0};
     for (const auto& description : result.input.descriptions) {
       if (description.label == surface.label && description.colour)
         coloured.rgb = *description.colour;
@@ -227,6 +228,7 @@ absl::Status write_all(MeshResult& result, const MeshParams& params, const std::
   absl::Status written;
   side_by_side(
       [&] {
+        if (context.stop_requested()) return;
         const auto start = std::chrono::steady_clock::now();
         pictures = make_surface_pictures(coloured);
         picture_seconds = seconds_since(start);

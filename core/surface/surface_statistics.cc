@@ -150,8 +150,12 @@ SurfaceStatistics compute_surface_statistics(const TriangleMesh& mesh) {
     if (std::min({angles[0], angles[1], angles[2]}) < kWellShapedDeg) ++s.triangles_below_30_deg;
     s.area_mm2 += 0.5 * norm(cross(sub(p1, p0), sub(p2, p0)));
     for (int e = 0; e < 3; ++e) {
+      // The edge's points, lower first, and in the lowest bit which way
+      // the triangle runs it (point ids stay below 2^31: a mesh that large
+      // would not fit in memory).
       const uint32_t a = t[e], b = t[(e + 1) % 3];
-      edges.push_back(uint64_t{std::min(a, b)} << 32 | std::max(a, b));
+      edges.push_back(uint64_t{std::min(a, b)} << 33 | uint64_t{std::max(a, b)} << 1 |
+                      (a > b ? 1u : 0u));
       used[a] = 1;
     }
     sets.unite(t[0], t[1]);
@@ -159,11 +163,13 @@ SurfaceStatistics compute_surface_statistics(const TriangleMesh& mesh) {
   }
   std::sort(edges.begin(), edges.end());
   int64_t unique_edges = 0;
+  uint32_t wound_alike = 0;  // edges of two triangles that run them the same way
   for (size_t i = 0; i < edges.size();) {
     size_t j = i + 1;
-    while (j < edges.size() && edges[j] == edges[i]) ++j;
+    while (j < edges.size() && edges[j] >> 1 == edges[i] >> 1) ++j;
     ++unique_edges;
     if (j - i == 1) ++s.boundary_edges;
+    if (j - i == 2 && edges[i] == edges[i + 1]) ++wound_alike;
     if (j - i > 2) ++s.non_manifold_edges;
     i = j;
   }
@@ -176,6 +182,7 @@ SurfaceStatistics compute_surface_statistics(const TriangleMesh& mesh) {
   s.non_manifold_vertices = count_non_manifold_vertices(mesh);
   s.closed = s.boundary_edges == 0;
   s.manifold = s.non_manifold_edges == 0 && s.non_manifold_vertices == 0;
+  s.consistently_wound = wound_alike == 0;
   s.euler_characteristic =
       used_vertices - unique_edges + static_cast<int64_t>(mesh.triangles.size());
   s.volume_mm3 = signed_volume(mesh);

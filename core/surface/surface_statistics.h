@@ -29,6 +29,9 @@ struct SurfaceStatistics {
   uint32_t non_manifold_vertices = 0;
   bool closed = false;    // no boundary edges
   bool manifold = false;  // no non-manifold edges or vertices
+  // Every edge of two triangles runs opposite ways in them: the triangles
+  // are wound alike.
+  bool consistently_wound = false;
   // V - E + F over the used vertices: 2 per sphere-like component.
   int64_t euler_characteristic = 0;
   // Connected components (through shared vertices).

@@ -95,6 +95,20 @@ TEST(SurfaceStatistics, OrientedManifoldNeedsOneWindingAndOneFanPerPoint) {
   EXPECT_FALSE(is_oriented_manifold(degenerate));
 }
 
+TEST(SurfaceStatistics, OneTriangleTurnedOverIsNotWoundAlike) {
+  EXPECT_TRUE(compute_surface_statistics(tetrahedron()).consistently_wound);
+  auto inside_out = tetrahedron();
+  inside_out.flip_orientation();
+  EXPECT_TRUE(compute_surface_statistics(inside_out).consistently_wound);
+  // Still closed and manifold.
+  auto turned = tetrahedron();
+  std::swap(turned.triangles[0][1], turned.triangles[0][2]);
+  const auto s = compute_surface_statistics(turned);
+  EXPECT_TRUE(s.closed);
+  EXPECT_TRUE(s.manifold);
+  EXPECT_FALSE(s.consistently_wound);
+}
+
 TEST(SurfaceStatistics, SliverTriangleAngles) {
   TriangleMesh m;
   m.points = {{0, 0, 0}, {1, 0, 0}, {0.5, 1e-3, 0}};
