@@ -317,9 +317,11 @@ class LabelGuard {
     attempt.min_angle_deg = candidate.statistics.min_angle_deg;
     attempt.max_angle_deg = candidate.statistics.max_angle_deg;
     attempt.voxels = voxels;
-    // A surface must also be closed and manifold to be delivered.
-    if (!candidate.statistics.closed || !candidate.statistics.manifold)
-      attempt.error = "the surface is not a closed 2-manifold";
+    // A surface must also be a closed manifold wound alike throughout to be
+    // delivered.
+    const auto& s = candidate.statistics;
+    if (!s.closed || !s.manifold || !s.consistently_wound)
+      attempt.error = "the surface is not a closed 2-manifold wound alike throughout";
     attempt.within_tolerance = is_within(attempt, tolerance_);
     fidelity_.attempts.push_back(std::move(attempt));
     candidates_.push_back(std::move(candidate));

@@ -223,6 +223,9 @@ surface::SurfaceStatistics measure_attempt(const TriangleMesh& mesh,
   attempt.mean_distance_mm = distance.mean_mm;
   attempt.min_angle_deg = statistics.min_angle_deg;
   attempt.max_angle_deg = statistics.max_angle_deg;
+  // Triangles turned against their neighbours make the inside and outside
+  // disagree from one part of the surface to the next.
+  if (!statistics.consistently_wound) attempt.error = "its triangles are not wound alike";
   attempt.within_tolerance = is_within(attempt, tolerance);
   return statistics;
 }
